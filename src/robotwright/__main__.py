@@ -1,0 +1,5 @@
+import sys
+
+from robotwright.cli import main
+
+sys.exit(main())

@@ -1,0 +1,46 @@
+"""The ``robotwright`` command line: one entry point, one subcommand per job.
+
+Each subsystem keeps its subcommands in its own module that exposes
+``register(subparsers)``; this file only lists those modules, so adding a
+command never touches another subsystem's code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from robotwright.errors import RobotwrightError
+
+# Modules that expose ``register(subparsers: argparse._SubParsersAction) -> None``.
+_COMMAND_MODULES: tuple[str, ...] = (
+    "robotwright.hrdf.cli",
+    "robotwright.demo",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="robotwright",
+        description="Describe, generate, compose and sense robots for simulation.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for module_name in _COMMAND_MODULES:
+        importlib.import_module(module_name).register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except RobotwrightError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,67 @@
+"""Exception and warning types that carry file / row / column / element context."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One problem found in an input.
+
+    Attributes:
+        file: the file the problem is in (path as given, or a file name inside a folder).
+        message: what is wrong and what was expected.
+        row: 0-based data row of a CSV table (header not counted), or None.
+        column: the CSV column or YAML key, or None.
+        element: an XML element description (e.g. ``<joint name="knee">``), or None.
+        severity: ``"error"`` or ``"warning"``.
+    """
+
+    file: str
+    message: str
+    row: int | None = None
+    column: str | None = None
+    element: str | None = None
+    severity: str = "error"
+
+    def __str__(self) -> str:
+        where = [self.file]
+        if self.row is not None:
+            where.append(f"row {self.row}")
+        if self.column is not None:
+            where.append(f"column '{self.column}'")
+        if self.element is not None:
+            where.append(self.element)
+        return f"{': '.join(where)}: {self.message}"
+
+
+class RobotwrightError(Exception):
+    """Base class of every error raised by robotwright."""
+
+
+class ProblemsError(RobotwrightError):
+    """An error carrying a list of :class:`Problem` (all problems found, not only the first)."""
+
+    def __init__(self, problems: list[Problem], summary: str | None = None) -> None:
+        self.problems = list(problems)
+        errors = [p for p in self.problems if p.severity == "error"]
+        head = summary or f"{len(errors)} problem(s) found"
+        body = "\n".join(f"  - {p}" for p in self.problems)
+        super().__init__(f"{head}:\n{body}" if body else head)
+
+
+class HRDFError(ProblemsError):
+    """An HRDF folder or model is invalid."""
+
+
+class GeneratorError(RobotwrightError):
+    """A generator was used wrongly (e.g. generate before load) or cannot represent its input."""
+
+
+class ConversionError(ProblemsError):
+    """A conversion would lose or change meaning and ``strict=True`` was requested, or it failed."""
+
+
+class ConversionWarning(UserWarning):
+    """An element was dropped or approximated during a conversion (named in the message)."""
