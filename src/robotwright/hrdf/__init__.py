@@ -1,0 +1,43 @@
+"""HRDF: the folder-based robot description (hurodes-compatible, extended)."""
+
+from robotwright.hrdf.model import (
+    ACTUATOR_TYPES,
+    FORMAT_VERSION,
+    HRDF,
+    JOINT_TYPES,
+    SIMPLE_GEOM_TYPES,
+    Actuator,
+    Body,
+    BodyNameConfig,
+    Geom,
+    GroundConfig,
+    ImuConfig,
+    Joint,
+    MeshGeom,
+    Meta,
+    Sensor,
+    SimpleGeom,
+    SimulatorConfig,
+    Site,
+)
+
+__all__ = [
+    "ACTUATOR_TYPES",
+    "FORMAT_VERSION",
+    "HRDF",
+    "JOINT_TYPES",
+    "SIMPLE_GEOM_TYPES",
+    "Actuator",
+    "Body",
+    "BodyNameConfig",
+    "Geom",
+    "GroundConfig",
+    "ImuConfig",
+    "Joint",
+    "MeshGeom",
+    "Meta",
+    "Sensor",
+    "SimpleGeom",
+    "SimulatorConfig",
+    "Site",
+]

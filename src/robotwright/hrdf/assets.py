@@ -1,0 +1,53 @@
+"""Finding robots by name: ``$HURODES_ASSETS_PATH/robots/<name>``, then bundled robots."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from robotwright.errors import RobotwrightError
+
+#: Folder of the robots shipped with robotwright.
+BUNDLED_ROBOTS_DIR = Path(__file__).resolve().parents[1] / "robots"
+#: Environment variable naming the assets root (the seed's variable).
+ASSETS_ENV = "HURODES_ASSETS_PATH"
+
+
+class RobotNotFoundError(RobotwrightError):
+    """No robot of that name under any assets root."""
+
+
+def search_roots() -> list[Path]:
+    """Folders searched for ``<name>``, in order."""
+    roots = []
+    env = os.environ.get(ASSETS_ENV)
+    if env:
+        roots.append(Path(env) / "robots")
+    roots.append(BUNDLED_ROBOTS_DIR)
+    return roots
+
+
+def bundled_robot_names() -> list[str]:
+    """Names of the robots shipped with robotwright."""
+    return sorted(p.name for p in BUNDLED_ROBOTS_DIR.iterdir() if (p / "meta.yaml").is_file())
+
+
+def find_robot(name: str) -> Path:
+    """The folder of robot ``name`` (names may contain ``/`` for nested folders)."""
+    tried = []
+    for root in search_roots():
+        candidate = root / name
+        tried.append(str(candidate))
+        if (candidate / "meta.yaml").is_file():
+            return candidate
+    raise RobotNotFoundError(
+        f"no robot named '{name}': looked in {tried}; bundled robots: {bundled_robot_names()}"
+    )
+
+
+def resolve_robot(name_or_path: str | Path) -> Path:
+    """A robot folder from either a path to an HRDF folder or a robot name."""
+    path = Path(name_or_path)
+    if (path / "meta.yaml").is_file():
+        return path
+    return find_robot(str(name_or_path))

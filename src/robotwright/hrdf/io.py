@@ -1,0 +1,768 @@
+"""Reading and writing HRDF folders (hurodes 0.1.9 folders and robotwright's extension).
+
+Reading collects every problem of every file before raising one
+:class:`~robotwright.errors.HRDFError`; writing goes to a temporary folder that is
+renamed into place, so a failed save leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import shutil
+import tempfile
+import warnings
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from robotwright.errors import HRDFError, Problem
+from robotwright.hrdf.model import (
+    FORMAT_VERSION,
+    HRDF,
+    Actuator,
+    Body,
+    BodyNameConfig,
+    GroundConfig,
+    ImuConfig,
+    Joint,
+    MeshGeom,
+    Meta,
+    Sensor,
+    SimpleGeom,
+    SimulatorConfig,
+    Site,
+)
+from robotwright.hrdf.tables import (
+    HURODES_TABLES,
+    NO_DEFAULT,
+    TABLES,
+    CellError,
+    Column,
+    format_cell,
+    parse_cell,
+)
+
+_RECORD_TYPES: dict[str, type] = {
+    "body": Body,
+    "joint": Joint,
+    "actuator": Actuator,
+    "mesh": MeshGeom,
+    "simple_geom": SimpleGeom,
+    "site": Site,
+    "sensor": Sensor,
+}
+
+#: meta.yaml keys hurodes defines.
+HURODES_META_KEYS: tuple[str, ...] = (
+    "body_parent_id",
+    "mesh_file_type",
+    "simulator_config",
+    "body_name_config",
+    "imu_config_list",
+    "motor_config_list",
+)
+#: meta.yaml keys robotwright adds.
+EXTENSION_META_KEYS: tuple[str, ...] = ("format_version", "floating_base", "base_joint_name")
+EXTRA_MJCF_FILE = "extra.xml"
+JOINT_MAPPING_FILE = "joint_mapping.yaml"
+
+
+# libyaml's loader is ~20x faster than the pure-Python one; both are "safe" loaders.
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+_YAML_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+
+
+class HRDFWarning(UserWarning):
+    """Something in an HRDF folder was not understood and is ignored (named in the message)."""
+
+
+@dataclass
+class _Table:
+    """Rows of one CSV file after conversion: ``rows[i]`` is a field dict or ``None``."""
+
+    rows: list[dict[str, Any] | None]
+    extra_columns: list[str]
+
+
+def _read_table(
+    path: Path, schema: list[Column], problems: list[Problem], *, hurodes_format: bool
+) -> _Table | None:
+    fname = path.name
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        problems.append(Problem(fname, f"cannot read file: {exc}"))
+        return None
+    reader = csv.reader(io.StringIO(text))
+    try:
+        header = next(reader)
+    except StopIteration:
+        problems.append(Problem(fname, "file is empty: expected a header row"))
+        return None
+    header = [h.strip() for h in header]
+    index = {h: i for i, h in enumerate(header)}
+    known: set[str] = set()
+    missing = False
+    for col in schema:
+        known.update(col.headers)
+        present = [h in index for h in col.headers]
+        if col.required and not all(present):
+            for h in col.headers:
+                if h not in index:
+                    problems.append(Problem(fname, "required column is missing", column=h))
+            missing = True
+        elif any(present) and not all(present):
+            absent = [h for h in col.headers if h not in index]
+            problems.append(
+                Problem(fname, f"vector columns incomplete: missing {absent}", column=col.csv)
+            )
+            missing = True
+    extra = [h for h in header if h not in known]
+    for h in extra:
+        problems.append(Problem(fname, "unknown column, ignored", column=h, severity="warning"))
+    if missing:
+        return None
+
+    def empty_ok_here(col: Column) -> bool:
+        return col.empty_ok and not (hurodes_format and col.csv == "range")
+
+    plan = [(col, [index[h] for h in col.headers]) for col in schema if col.headers[0] in index]
+    absent = {col.field: col.default for col in schema if col.headers[0] not in index}
+    data = [cells for cells in reader if cells and any(c.strip() for c in cells)]
+    if all(len(cells) == len(header) for cells in data):
+        fast = _convert_table_fast(data, plan, absent, empty_ok_here) if data else []
+        if fast is not None:
+            return _Table(rows=list(fast), extra_columns=extra)
+    rows: list[dict[str, Any] | None] = []
+    for row_no, cells in enumerate(data):
+        if len(cells) != len(header):
+            problems.append(
+                Problem(
+                    fname,
+                    f"row has {len(cells)} cells, header has {len(header)}",
+                    row=row_no,
+                )
+            )
+            rows.append(None)
+            continue
+        record: dict[str, Any] = {}
+        ok = True
+        for col in schema:
+            if col.headers[0] not in index:
+                record[col.field] = col.default
+                continue
+            texts = [cells[index[h]].strip() for h in col.headers]
+            if all(t == "" for t in texts):
+                if empty_ok_here(col):
+                    record[col.field] = col.default
+                    continue
+                if col.default is NO_DEFAULT or col.required:
+                    why = "empty cell: this column has no default"
+                    if hurodes_format and col.csv == "range":
+                        why = (
+                            "empty joint range in a hurodes folder (hurodes would invent "
+                            "+-3.14); give the range, or add format_version to meta.yaml "
+                            "where empty means unlimited"
+                        )
+                    problems.append(Problem(fname, why, row=row_no, column=col.headers[0]))
+                    ok = False
+                    continue
+                record[col.field] = col.default
+                continue
+            values = []
+            for h, t in zip(col.headers, texts, strict=True):
+                if t == "":
+                    problems.append(
+                        Problem(fname, "empty cell inside a vector", row=row_no, column=h)
+                    )
+                    ok = False
+                    break
+                try:
+                    values.append(parse_cell(t, col.kind))
+                except CellError as exc:
+                    problems.append(Problem(fname, str(exc), row=row_no, column=h))
+                    ok = False
+                    break
+            else:
+                record[col.field] = values[0] if col.size == 0 else tuple(values)
+        rows.append(record if ok else None)
+    return _Table(rows=rows, extra_columns=extra)
+
+
+def _floats_or_none(cells: tuple[str, ...]) -> list[float | None]:
+    return [None if t == "" else float(t) for t in cells]
+
+
+def _convert_table_fast(
+    data: list[list[str]],
+    plan: list[tuple[Column, list[int]]],
+    absent: dict[str, Any],
+    empty_ok_here: Any,
+) -> list[dict[str, Any]] | None:
+    """Convert a well-formed table column by column; ``None`` sends it to the checking path.
+
+    Any unusual cell (empty where not allowed, non-numeric, non-finite, padded) returns
+    ``None`` so that the row-by-row path can report it precisely.
+    """
+    columns = list(zip(*data, strict=True))
+    fields_: list[str] = []
+    values: list[list[Any]] = []
+    isfinite = math.isfinite
+    try:
+        for col, idx in plan:
+            if col.kind == "float":
+                parts = []
+                for i in idx:
+                    cells = columns[i]
+                    if col.empty_ok and "" in cells:
+                        if not empty_ok_here(col):
+                            return None
+                        part = _floats_or_none(cells)
+                        if not all(isfinite(v) for v in part if v is not None):
+                            return None
+                    else:
+                        part = list(map(float, cells))
+                        if not all(map(isfinite, part)):
+                            return None
+                    parts.append(part)
+                if col.size == 0:
+                    vals = parts[0]
+                else:
+                    vals = []
+                    for vec in zip(*parts, strict=True):
+                        if None in vec:
+                            if any(v is not None for v in vec):
+                                return None
+                            vals.append(col.default)
+                        else:
+                            vals.append(vec)
+            elif col.kind == "int":
+                vals = list(map(int, columns[idx[0]]))
+            else:
+                cells = columns[idx[0]]
+                if any(t == "" or t != t.strip() for t in cells):
+                    if not col.empty_ok or any(t != t.strip() for t in cells):
+                        return None
+                    vals = [col.default if t == "" else t for t in cells]
+                else:
+                    vals = list(cells)
+            fields_.append(col.field)
+            values.append(vals)
+    except ValueError:
+        return None
+    return [{**absent, **dict(zip(fields_, row, strict=True))} for row in zip(*values, strict=True)]
+
+
+def _load_yaml(path: Path, problems: list[Problem]) -> Any:
+    try:
+        return yaml.load(path.read_text(encoding="utf-8"), Loader=_YAML_LOADER)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        problems.append(Problem(path.name, f"cannot parse YAML: {exc}"))
+        return None
+
+
+def _float_list(value: Any, size: int, key: str, problems: list[Problem]) -> tuple | None:
+    if value is None:
+        return None
+    if (
+        not isinstance(value, list)
+        or len(value) != size
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+    ):
+        problems.append(Problem("meta.yaml", f"expected a list of {size} numbers", column=key))
+        return None
+    return tuple(float(v) for v in value)
+
+
+def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | None, dict]:
+    """Returns (meta, body_parent_id, robotwright keys)."""
+    meta = Meta(format_version=None, imu_config_list=None)
+    if not isinstance(raw, dict):
+        problems.append(Problem("meta.yaml", "expected a mapping of keys"))
+        return meta, None, {}
+    parent_ids = raw.get("body_parent_id")
+    if parent_ids is None:
+        problems.append(Problem("meta.yaml", "required key is missing", column="body_parent_id"))
+    elif not isinstance(parent_ids, list) or not all(
+        isinstance(p, int) and not isinstance(p, bool) for p in parent_ids
+    ):
+        problems.append(
+            Problem("meta.yaml", "expected a list of integers", column="body_parent_id")
+        )
+        parent_ids = None
+
+    mft = raw.get("mesh_file_type")
+    if mft is not None:
+        if mft not in ("stl", "obj"):
+            problems.append(
+                Problem(
+                    "meta.yaml", f"expected 'stl' or 'obj', got {mft!r}", column="mesh_file_type"
+                )
+            )
+        else:
+            meta.mesh_file_type = mft
+
+    sim = raw.get("simulator_config")
+    if sim is None:
+        meta.simulator_config = None
+    elif isinstance(sim, dict):
+        ground_raw = sim.get("ground")
+        ground = None
+        if isinstance(ground_raw, dict):
+            ground = GroundConfig(
+                type=ground_raw.get("type"),
+                contact_type=ground_raw.get("contact_type"),
+                contact_affinity=ground_raw.get("contact_affinity"),
+                friction=ground_raw.get("friction"),
+            )
+        elif ground_raw is not None:
+            problems.append(
+                Problem("meta.yaml", "expected a mapping", column="simulator_config.ground")
+            )
+        meta.simulator_config = SimulatorConfig(
+            timestep=sim.get("timestep"),
+            gravity=_float_list(sim.get("gravity"), 3, "simulator_config.gravity", problems),
+            ground=ground,
+            integrator=sim.get("integrator"),
+        )
+        for key in sim:
+            if key not in ("timestep", "gravity", "ground", "integrator"):
+                problems.append(
+                    Problem(
+                        "meta.yaml",
+                        "unknown key, ignored",
+                        column=f"simulator_config.{key}",
+                        severity="warning",
+                    )
+                )
+    else:
+        problems.append(Problem("meta.yaml", "expected a mapping", column="simulator_config"))
+
+    bnc = raw.get("body_name_config")
+    if bnc is None:
+        meta.body_name_config = None
+    elif isinstance(bnc, dict):
+        meta.body_name_config = BodyNameConfig(
+            torso_name=bnc.get("torso_name"),
+            hip_names=bnc.get("hip_names"),
+            knee_names=bnc.get("knee_names"),
+            foot_names=bnc.get("foot_names"),
+        )
+    else:
+        problems.append(Problem("meta.yaml", "expected a mapping", column="body_name_config"))
+
+    imus = raw.get("imu_config_list")
+    if imus is not None:
+        if not isinstance(imus, list):
+            problems.append(Problem("meta.yaml", "expected a list", column="imu_config_list"))
+        else:
+            meta.imu_config_list = []
+            for i, imu in enumerate(imus):
+                key = f"imu_config_list[{i}]"
+                if not isinstance(imu, dict) or not imu.get("body_name"):
+                    problems.append(
+                        Problem("meta.yaml", "expected a mapping with body_name", column=key)
+                    )
+                    continue
+                pos = _float_list(
+                    imu.get("position", [0.0, 0.0, 0.0]), 3, key + ".position", problems
+                )
+                ori = _float_list(
+                    imu.get("orientation", [1.0, 0.0, 0.0, 0.0]), 4, key + ".orientation", problems
+                )
+                value = imu.get("value") or []
+                bad = [v for v in value if v not in ("linacc", "angvel", "quat")]
+                if bad:
+                    problems.append(
+                        Problem(
+                            "meta.yaml",
+                            f"unknown IMU values {bad}: expected linacc, angvel, quat",
+                            column=key + ".value",
+                        )
+                    )
+                meta.imu_config_list.append(
+                    ImuConfig(
+                        body_name=imu["body_name"],
+                        position=pos or (0.0, 0.0, 0.0),
+                        orientation=ori or (1.0, 0.0, 0.0, 0.0),
+                        value=list(value),
+                        device_type=imu.get("device_type"),
+                        device_config_name=imu.get("device_config_name"),
+                    )
+                )
+    meta.motor_config_list = raw.get("motor_config_list")
+    meta.format_version = raw.get("format_version")
+    ext = {k: raw[k] for k in ("floating_base", "base_joint_name") if k in raw}
+    meta.extra = {k: v for k, v in raw.items() if k not in HURODES_META_KEYS + EXTENSION_META_KEYS}
+    for key in meta.extra:
+        problems.append(
+            Problem("meta.yaml", "unknown key, kept verbatim", column=key, severity="warning")
+        )
+    return meta, parent_ids, ext
+
+
+def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
+    """Read an HRDF folder, returning the model (``None`` if unreadable) and all problems.
+
+    The model is returned even when some rows had problems (those rows are left out), so
+    that semantic checks can still run; callers raise when any problem is an error.
+    """
+    from robotwright.hrdf.validate import check_model
+
+    root = Path(path)
+    problems: list[Problem] = []
+    if not root.is_dir():
+        return None, [Problem(str(root), "not a folder: expected an HRDF folder")]
+    meta_path = root / "meta.yaml"
+    if not meta_path.is_file():
+        return None, [Problem(str(meta_path), "meta.yaml is missing")]
+    meta, parent_ids, ext = _parse_meta(_load_yaml(meta_path, problems), problems)
+    hurodes_format = meta.format_version is None
+    if meta.format_version is not None and meta.format_version != FORMAT_VERSION:
+        problems.append(
+            Problem(
+                "meta.yaml",
+                f"unsupported format_version {meta.format_version!r}: expected {FORMAT_VERSION!r}",
+                column="format_version",
+            )
+        )
+
+    tables: dict[str, _Table | None] = {}
+    for stem, schema in TABLES.items():
+        csv_path = root / f"{stem}.csv"
+        if not csv_path.exists():
+            if stem == "body":
+                problems.append(Problem("body.csv", "required file is missing"))
+            tables[stem] = None
+            continue
+        if stem not in HURODES_TABLES and hurodes_format:
+            problems.append(
+                Problem(
+                    csv_path.name,
+                    "robotwright table in a folder without format_version; read anyway",
+                    severity="warning",
+                )
+            )
+        tables[stem] = _read_table(csv_path, schema, problems, hurodes_format=hurodes_format)
+
+    for child in sorted(root.iterdir()):
+        known = {f"{s}.csv" for s in TABLES} | {
+            "meta.yaml",
+            "meshes",
+            EXTRA_MJCF_FILE,
+            JOINT_MAPPING_FILE,
+        }
+        if child.name not in known and not child.name.startswith("."):
+            problems.append(Problem(child.name, "unknown file, ignored", severity="warning"))
+
+    if tables.get("body") is None:
+        return None, problems
+
+    records: dict[str, list] = {}
+    for stem, table in tables.items():
+        if table is None:
+            records[stem] = []
+            continue
+        cls = _RECORD_TYPES[stem]
+        names = {f.name for f in fields(cls)}
+        fill = {"parent": -1} if stem == "body" else {}
+        records[stem] = [
+            cls(**fill, **{k: v for k, v in row.items() if k in names}) if row is not None else None
+            for row in table.rows
+        ]
+
+    # Body ids must match row order: hurodes silently uses row order, we refuse to guess.
+    body_rows = tables["body"].rows
+    bodies: list[Body] = []
+    for i, (row, rec) in enumerate(zip(body_rows, records["body"], strict=True)):
+        if row is None:
+            bodies.append(None)  # type: ignore[arg-type]
+            continue
+        if row["id"] != i:
+            problems.append(
+                Problem(
+                    "body.csv",
+                    f"id {row['id']} does not match the row position {i}: rows must be in id order",
+                    row=i,
+                    column="id",
+                )
+            )
+        bodies.append(rec)
+    if parent_ids is not None:
+        if len(parent_ids) != len(bodies):
+            problems.append(
+                Problem(
+                    "meta.yaml",
+                    f"body_parent_id has {len(parent_ids)} entries, body.csv has {len(bodies)} rows",
+                    column="body_parent_id",
+                )
+            )
+        else:
+            bodies = [
+                None if b is None else _replace(b, parent=p)  # type: ignore[list-item]
+                for b, p in zip(bodies, parent_ids, strict=True)
+            ]
+
+    joints: list[Joint] = [j for j in records["joint"] if j is not None]
+    floating = ext.get("floating_base", True if hurodes_format else None)
+    if floating is None:
+        floating = False
+    if not isinstance(floating, bool):
+        problems.append(Problem("meta.yaml", "expected true or false", column="floating_base"))
+        floating = False
+    root_name = None
+    roots = [b for b in bodies if b is not None and b.parent == -1]
+    if len(roots) == 1:
+        root_name = roots[0].name
+    if floating and root_name is not None:
+        joints.insert(0, Joint(name=ext.get("base_joint_name"), body=root_name, type="free"))
+
+    joint_mapping = None
+    jm_path = root / JOINT_MAPPING_FILE
+    if jm_path.exists():
+        joint_mapping = _load_yaml(jm_path, problems)
+    meta.joint_mapping = joint_mapping
+    mjcf_extra = None
+    extra_path = root / EXTRA_MJCF_FILE
+    if extra_path.exists():
+        mjcf_extra = extra_path.read_text(encoding="utf-8")
+
+    hrdf = HRDF(
+        name=root.resolve().name,
+        bodies=[b for b in bodies if b is not None]
+        if all(b is not None for b in bodies)
+        else bodies,  # type: ignore[misc]
+        joints=joints,
+        actuators=[a for a in records["actuator"] if a is not None],
+        meshes=[m for m in records["mesh"] if m is not None],
+        simple_geoms=[g for g in records["simple_geom"] if g is not None],
+        sites=[s for s in records["site"] if s is not None],
+        sensors=[s for s in records["sensor"] if s is not None],
+        meta=meta,
+        mjcf_extra=mjcf_extra,
+        root_dir=root.resolve(),
+    )
+    if any(b is None for b in hrdf.bodies):
+        return None, problems
+    problems.extend(check_model(hrdf, check_files=True))
+    return hrdf, problems
+
+
+def _replace(record: Any, **changes: Any) -> Any:
+    from dataclasses import replace
+
+    return replace(record, **changes)
+
+
+def read_hrdf_dir(path: str | Path) -> HRDF:
+    """Load an HRDF folder; raise :class:`HRDFError` listing all errors, warn for the rest."""
+    hrdf, problems = collect_hrdf_dir(path)
+    errors = [p for p in problems if p.severity == "error"]
+    if errors or hrdf is None:
+        raise HRDFError(errors or problems, summary=f"invalid HRDF folder {path}")
+    for p in problems:
+        warnings.warn(f"{Path(path).name}/{p}", HRDFWarning, stacklevel=3)
+    return hrdf
+
+
+# --------------------------------------------------------------------------------- write
+
+
+def _table_rows(hrdf: HRDF, stem: str) -> list[Any]:
+    if stem == "body":
+        return list(hrdf.bodies)
+    if stem == "joint":
+        return [j for j in hrdf.joints if j.type != "free"]
+    return list(
+        {
+            "actuator": hrdf.actuators,
+            "mesh": hrdf.meshes,
+            "simple_geom": hrdf.simple_geoms,
+            "site": hrdf.sites,
+            "sensor": hrdf.sensors,
+        }[stem]
+    )
+
+
+def _column_needed(col: Column, rows: list[Any]) -> bool:
+    """hurodes columns always; extension columns only when some row differs from default."""
+    if col.required:
+        return True
+    return any(getattr(r, col.field) != col.default for r in rows)
+
+
+def table_csv(hrdf: HRDF, stem: str) -> str | None:
+    """The CSV text of one table, or ``None`` when the table has no rows."""
+    rows = _table_rows(hrdf, stem)
+    if not rows:
+        return None
+    schema = TABLES[stem]
+    cols = [c for c in schema if _column_needed(c, rows)]
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow([h for c in cols for h in c.headers])
+    for i, rec in enumerate(rows):
+        line: list[str] = []
+        for c in cols:
+            value = i if c.field == "id" else getattr(rec, c.field)
+            if c.size == 0:
+                line.append(format_cell(value))
+            elif value is None:
+                line.extend([""] * c.size)
+            else:
+                line.extend(format_cell(float(v) if c.kind == "float" else v) for v in value)
+        writer.writerow(line)
+    return out.getvalue()
+
+
+def meta_dict(hrdf: HRDF) -> dict[str, Any]:
+    """The ``meta.yaml`` mapping (hurodes keys, then robotwright's)."""
+    meta = hrdf.meta
+    sim = meta.simulator_config
+    out: dict[str, Any] = {
+        "body_parent_id": hrdf.body_parent_id,
+        "mesh_file_type": meta.mesh_file_type,
+        "simulator_config": None,
+        "body_name_config": None,
+        "imu_config_list": None,
+        "motor_config_list": meta.motor_config_list,
+    }
+    if sim is not None:
+        sim_d: dict[str, Any] = {
+            "timestep": sim.timestep,
+            "gravity": list(sim.gravity) if sim.gravity is not None else None,
+            "ground": None,
+        }
+        if sim.ground is not None:
+            sim_d["ground"] = {
+                "type": sim.ground.type,
+                "contact_type": sim.ground.contact_type,
+                "contact_affinity": sim.ground.contact_affinity,
+                "friction": sim.ground.friction,
+            }
+        if sim.integrator is not None:
+            sim_d["integrator"] = sim.integrator
+        out["simulator_config"] = sim_d
+    if meta.body_name_config is not None:
+        b = meta.body_name_config
+        out["body_name_config"] = {
+            "torso_name": b.torso_name,
+            "hip_names": b.hip_names,
+            "knee_names": b.knee_names,
+            "foot_names": b.foot_names,
+        }
+    if meta.imu_config_list is not None:
+        out["imu_config_list"] = [
+            {
+                "body_name": imu.body_name,
+                "device_config_name": imu.device_config_name,
+                "device_type": imu.device_type,
+                "orientation": list(imu.orientation),
+                "position": list(imu.position),
+                "value": list(imu.value),
+            }
+            for imu in meta.imu_config_list
+        ]
+    out["format_version"] = FORMAT_VERSION
+    out["floating_base"] = hrdf.floating_base
+    free = [j for j in hrdf.joints if j.type == "free"]
+    if free and free[0].name is not None:
+        out["base_joint_name"] = free[0].name
+    out.update(meta.extra)
+    return out
+
+
+def _atomic_dir_write(target: Path, fill: Any, overwrite: bool) -> None:
+    if target.exists() and not overwrite:
+        raise FileExistsError(f"{target} exists (pass overwrite=True to replace it)")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    try:
+        fill(tmp)
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old.", dir=target.parent))
+            os.replace(target, old / "x")
+            os.replace(tmp, target)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def _with_folder_mesh_paths(hrdf: HRDF) -> HRDF:
+    """A view of ``hrdf`` whose mesh ``file`` entries are paths inside the folder.
+
+    Meshes given by absolute paths (robots built in memory) are stored under ``meshes/``
+    with their file name; the default ``meshes/<name>.<type>`` path is kept implicit.
+    """
+    from dataclasses import replace
+
+    meshes = []
+    for mesh in hrdf.meshes:
+        src = hrdf.mesh_path(mesh)
+        file = mesh.file
+        if file is not None and Path(file).is_absolute():
+            file = f"meshes/{src.name}"
+            if file == f"meshes/{mesh.name}.{hrdf.meta.mesh_file_type}":
+                file = None
+        meshes.append(replace(mesh, file=file))
+    return replace(hrdf, meshes=meshes, root_dir=hrdf.root_dir)
+
+
+def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> Path:
+    """Write ``hrdf`` as a folder at ``path``; validate first, write atomically.
+
+    Mesh files are copied into ``meshes/`` (or to their ``file`` path inside the folder).
+
+    Raises:
+        HRDFError: the model is invalid (nothing is written).
+        FileExistsError: ``path`` exists and ``overwrite`` is false.
+    """
+    from robotwright.hrdf.validate import check_model
+
+    problems = [p for p in check_model(hrdf, check_files=True) if p.severity == "error"]
+    if problems:
+        raise HRDFError(problems, summary=f"cannot save robot '{hrdf.name}'")
+    target = Path(path)
+    sources = [hrdf.mesh_path(m) for m in hrdf.meshes]
+    hrdf = _with_folder_mesh_paths(hrdf)
+
+    def fill(tmp: Path) -> None:
+        meta_text = yaml.safe_dump(meta_dict(hrdf), default_flow_style=False, allow_unicode=True)
+        (tmp / "meta.yaml").write_text(meta_text, encoding="utf-8")
+        for stem in TABLES:
+            text = table_csv(hrdf, stem)
+            if text is not None:
+                (tmp / f"{stem}.csv").write_text(text, encoding="utf-8")
+        copied: set[str] = set()
+        for mesh, source in zip(hrdf.meshes, sources, strict=True):
+            rel = (
+                mesh.file
+                if mesh.file is not None
+                else f"meshes/{mesh.name}.{hrdf.meta.mesh_file_type}"
+            )
+            if rel in copied:
+                continue
+            copied.add(rel)
+            dest = tmp / rel
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, dest)
+        if hrdf.meta.joint_mapping is not None:
+            (tmp / JOINT_MAPPING_FILE).write_text(
+                yaml.safe_dump(
+                    hrdf.meta.joint_mapping, default_flow_style=False, allow_unicode=True
+                ),
+                encoding="utf-8",
+            )
+        if hrdf.mjcf_extra:
+            (tmp / EXTRA_MJCF_FILE).write_text(hrdf.mjcf_extra, encoding="utf-8")
+
+    _atomic_dir_write(target, fill, overwrite)
+    return target

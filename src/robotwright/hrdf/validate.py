@@ -1,0 +1,449 @@
+"""Semantic checks of an HRDF model: tree shape, references, physics, files.
+
+Each check yields :class:`~robotwright.errors.Problem` records naming the table file, the
+row (0-based data row, as in the CSV), the column and what was expected. Nothing stops at
+the first problem: callers get all of them.
+
+Tolerances (documented in ``docs/hrdf.md``):
+- quaternion norm: ``abs(|q| - 1) <= QUAT_NORM_TOL``;
+- inertia triangle inequality: ``a + b >= c * (1 - INERTIA_TRIANGLE_RTOL)`` for every
+  ordering of the principal moments.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections import Counter
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+from robotwright.errors import Problem
+from robotwright.hrdf.model import (
+    ACTUATOR_TYPES,
+    HRDF,
+    JOINT_TYPES,
+    SIMPLE_GEOM_TYPES,
+    SITE_TYPES,
+)
+
+QUAT_NORM_TOL = 1e-4
+INERTIA_TRIANGLE_RTOL = 1e-9
+AXIS_NORM_MIN = 1e-9
+
+
+def _quat_problem(q: Sequence[float]) -> str | None:
+    norm = math.sqrt(sum(v * v for v in q))
+    if abs(norm - 1.0) > QUAT_NORM_TOL:
+        return f"quaternion {tuple(q)} has norm {norm:.6g}: expected 1 (tolerance {QUAT_NORM_TOL})"
+    return None
+
+
+def _duplicates(names: Iterable[str | None]) -> set[str]:
+    counts = Counter(n for n in names if n is not None)
+    return {n for n, c in counts.items() if c > 1}
+
+
+def _check_tree(hrdf: HRDF) -> list[Problem]:
+    out: list[Problem] = []
+    n = len(hrdf.bodies)
+    if n == 0:
+        return [Problem("body.csv", "no bodies: expected at least one (the root)")]
+    roots = [i for i, b in enumerate(hrdf.bodies) if b.parent == -1]
+    if not roots:
+        out.append(
+            Problem("meta.yaml", "no root body: expected one entry -1", column="body_parent_id")
+        )
+    elif len(roots) > 1:
+        names = [hrdf.bodies[i].name for i in roots]
+        out.append(
+            Problem(
+                "meta.yaml",
+                f"several root bodies {names}: expected exactly one entry -1",
+                column="body_parent_id",
+            )
+        )
+    bad_parent = False
+    for i, b in enumerate(hrdf.bodies):
+        if b.parent != -1 and not (0 <= b.parent < n):
+            out.append(
+                Problem(
+                    "meta.yaml",
+                    f"body '{b.name}' (id {i}) has parent id {b.parent}: expected -1 or 0..{n - 1}",
+                    column="body_parent_id",
+                )
+            )
+            bad_parent = True
+        elif b.parent == i:
+            out.append(
+                Problem(
+                    "meta.yaml",
+                    f"body '{b.name}' (id {i}) is its own parent",
+                    column="body_parent_id",
+                )
+            )
+            bad_parent = True
+    if bad_parent:
+        return out
+    reported: set[int] = set()
+    for start in range(n):
+        seen: list[int] = []
+        i = start
+        while i != -1 and i not in seen:
+            seen.append(i)
+            i = hrdf.bodies[i].parent
+        if i != -1:
+            cycle = seen[seen.index(i) :]
+            if not reported.intersection(cycle):
+                reported.update(cycle)
+                names = [hrdf.bodies[k].name for k in cycle]
+                out.append(
+                    Problem(
+                        "meta.yaml",
+                        f"bodies {names} form a cycle: the body tree must be a tree",
+                        column="body_parent_id",
+                    )
+                )
+    return out
+
+
+def _check_bodies(hrdf: HRDF) -> list[Problem]:
+    out: list[Problem] = []
+    for name in sorted(_duplicates(b.name for b in hrdf.bodies)):
+        out.append(Problem("body.csv", f"duplicate body name '{name}'", column="name"))
+    for i, b in enumerate(hrdf.bodies):
+        if not b.name:
+            out.append(Problem("body.csv", "empty body name", row=i, column="name"))
+        if not b.mass > 0:
+            out.append(Problem("body.csv", f"mass {b.mass} kg: expected > 0", row=i, column="mass"))
+        for col, q in (("quat", b.quat), ("inertial_quat", b.inertial_quat)):
+            msg = _quat_problem(q)
+            if msg:
+                out.append(Problem("body.csv", msg, row=i, column=col))
+        d = b.diag_inertia
+        if any(not v > 0 for v in d):
+            out.append(
+                Problem(
+                    "body.csv", f"diag_inertia {d}: expected all > 0", row=i, column="diag_inertia"
+                )
+            )
+        else:
+            for a, bb, c in ((d[0], d[1], d[2]), (d[1], d[2], d[0]), (d[2], d[0], d[1])):
+                if a + bb < c * (1.0 - INERTIA_TRIANGLE_RTOL):
+                    out.append(
+                        Problem(
+                            "body.csv",
+                            f"diag_inertia {d} violates the triangle inequality "
+                            f"({a} + {bb} < {c}): not a physical rigid body",
+                            row=i,
+                            column="diag_inertia",
+                        )
+                    )
+                    break
+    return out
+
+
+def _check_joints(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
+    out: list[Problem] = []
+    root = hrdf.bodies[hrdf.root_index].name if any(b.parent == -1 for b in hrdf.bodies) else None
+    for name in sorted(_duplicates(j.name for j in hrdf.joints)):
+        out.append(Problem("joint.csv", f"duplicate joint name '{name}'", column="name"))
+    row = -1
+    for j in hrdf.joints:
+        if j.type == "free":
+            if j.body != root:
+                out.append(
+                    Problem(
+                        "joint.csv",
+                        f"free joint '{j.name}' on body '{j.body}': only the root body may float",
+                        column="type",
+                    )
+                )
+            continue
+        row += 1
+        if j.name is None or j.name == "":
+            out.append(Problem("joint.csv", "empty joint name", row=row, column="name"))
+        if j.type not in JOINT_TYPES:
+            out.append(
+                Problem(
+                    "joint.csv",
+                    f"joint type '{j.type}': expected one of {list(JOINT_TYPES)}",
+                    row=row,
+                    column="type",
+                )
+            )
+        if j.body not in body_names:
+            out.append(
+                Problem("joint.csv", f"unknown body '{j.body}'", row=row, column="body_name")
+            )
+        elif j.body == root and j.type != "free":
+            pass  # a joint on the root is allowed (e.g. a slide rail base)
+        if j.type in ("hinge", "slide"):
+            norm = math.sqrt(sum(v * v for v in j.axis))
+            if norm < AXIS_NORM_MIN:
+                out.append(Problem("joint.csv", f"axis {j.axis} is zero", row=row, column="axis0"))
+        if j.range is not None and j.range[0] > j.range[1]:
+            out.append(
+                Problem(
+                    "joint.csv",
+                    f"range lower {j.range[0]} > upper {j.range[1]}",
+                    row=row,
+                    column="range0",
+                )
+            )
+        for col in (
+            "armature",
+            "viscous_friction",
+            "static_friction",
+            "dynamic_friction",
+            "stiffness",
+        ):
+            if getattr(j, col) < 0:
+                out.append(
+                    Problem(
+                        "joint.csv", f"{col} {getattr(j, col)}: expected >= 0", row=row, column=col
+                    )
+                )
+    return out
+
+
+def _check_actuators(hrdf: HRDF) -> list[Problem]:
+    out: list[Problem] = []
+    joint_names = {j.name for j in hrdf.joints if j.name}
+    for name in sorted(_duplicates(a.name for a in hrdf.actuators)):
+        out.append(Problem("actuator.csv", f"duplicate actuator name '{name}'", column="name"))
+    for i, a in enumerate(hrdf.actuators):
+        if a.joint not in joint_names:
+            out.append(
+                Problem("actuator.csv", f"unknown joint '{a.joint}'", row=i, column="joint_name")
+            )
+        if a.type not in ACTUATOR_TYPES:
+            out.append(
+                Problem(
+                    "actuator.csv",
+                    f"actuator type '{a.type}': expected one of {list(ACTUATOR_TYPES)}",
+                    row=i,
+                    column="type",
+                )
+            )
+        if a.peak_torque is not None and a.peak_torque <= 0:
+            out.append(
+                Problem(
+                    "actuator.csv",
+                    f"peak_torque {a.peak_torque}: expected > 0",
+                    row=i,
+                    column="peak_torque",
+                )
+            )
+        for col in ("ctrl_range", "force_range"):
+            r = getattr(a, col)
+            if r is not None and r[0] > r[1]:
+                out.append(
+                    Problem(
+                        "actuator.csv",
+                        f"{col} lower {r[0]} > upper {r[1]}",
+                        row=i,
+                        column=f"{col}0",
+                    )
+                )
+        if a.type == "position" and a.p_gain is None:
+            out.append(
+                Problem(
+                    "actuator.csv", "position actuator needs p_gain (kp)", row=i, column="p_gain"
+                )
+            )
+        if a.type == "velocity" and a.d_gain is None:
+            out.append(
+                Problem(
+                    "actuator.csv", "velocity actuator needs d_gain (kv)", row=i, column="d_gain"
+                )
+            )
+    return out
+
+
+def _inside(root: Path, rel: str) -> bool:
+    base = root.resolve()
+    try:
+        (base / rel).resolve().relative_to(base)
+    except ValueError:
+        return False
+    return True
+
+
+def _is_file(path: Path, listings: dict[str, set[str]]) -> bool:
+    """Existence check through one directory listing per folder (meshes share a folder)."""
+    folder = str(path.parent)
+    if folder not in listings:
+        try:
+            listings[folder] = {e.name for e in os.scandir(folder) if e.is_file()}
+        except OSError:
+            listings[folder] = set()
+    return path.name in listings[folder]
+
+
+def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Problem]:
+    out: list[Problem] = []
+    listings: dict[str, set[str]] = {}
+    for table, rows in (("mesh.csv", hrdf.meshes), ("simple_geom.csv", hrdf.simple_geoms)):
+        for i, g in enumerate(rows):
+            if g.body not in body_names:
+                out.append(Problem(table, f"unknown body '{g.body}'", row=i, column="body_name"))
+            msg = _quat_problem(g.quat)
+            if msg:
+                out.append(Problem(table, msg, row=i, column="quat"))
+            if any(not 0.0 <= v <= 1.0 for v in g.rgba):
+                out.append(
+                    Problem(
+                        table, f"rgba {g.rgba}: expected values in [0, 1]", row=i, column="rgba"
+                    )
+                )
+            if g.condim not in (1, 3, 4, 6):
+                out.append(
+                    Problem(
+                        table, f"condim {g.condim}: expected 1, 3, 4 or 6", row=i, column="condim"
+                    )
+                )
+            if g.static_friction < 0:
+                out.append(
+                    Problem(
+                        table, "static_friction: expected >= 0", row=i, column="static_friction"
+                    )
+                )
+    for i, g in enumerate(hrdf.simple_geoms):
+        if g.type not in SIMPLE_GEOM_TYPES:
+            out.append(
+                Problem(
+                    "simple_geom.csv",
+                    f"geom type '{g.type}': expected one of {list(SIMPLE_GEOM_TYPES)}",
+                    row=i,
+                    column="type",
+                )
+            )
+            continue
+        used = {"sphere": 1, "capsule": 2, "cylinder": 2}.get(g.type, 3)
+        if any(not v > 0 for v in g.size[:used]):
+            out.append(
+                Problem(
+                    "simple_geom.csv",
+                    f"{g.type} size {g.size}: expected the first {used} value(s) > 0",
+                    row=i,
+                    column="size0",
+                )
+            )
+    for name in sorted(_duplicates(g.name for g in hrdf.simple_geoms)):
+        out.append(Problem("simple_geom.csv", f"duplicate geom name '{name}'", column="name"))
+    for i, m in enumerate(hrdf.meshes):
+        if not m.name:
+            out.append(Problem("mesh.csv", "empty mesh name", row=i, column="name"))
+            continue
+        if any(not s > 0 for s in m.scale):
+            out.append(
+                Problem("mesh.csv", f"scale {m.scale}: expected > 0", row=i, column="scale0")
+            )
+        if m.file is not None and hrdf.root_dir is not None and not Path(m.file).is_absolute():
+            if not _inside(hrdf.root_dir, m.file):
+                out.append(
+                    Problem(
+                        "mesh.csv",
+                        f"mesh file '{m.file}' escapes the robot folder",
+                        row=i,
+                        column="file",
+                    )
+                )
+                continue
+        if check_files:
+            path = hrdf.mesh_path(m)
+            if not _is_file(path, listings):
+                out.append(
+                    Problem("mesh.csv", f"mesh file '{path}' does not exist", row=i, column="name")
+                )
+    return out
+
+
+def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
+    out: list[Problem] = []
+    for name in sorted(_duplicates(s.name for s in hrdf.sites)):
+        out.append(Problem("site.csv", f"duplicate site name '{name}'", column="name"))
+    for i, s in enumerate(hrdf.sites):
+        if s.body not in body_names:
+            out.append(Problem("site.csv", f"unknown body '{s.body}'", row=i, column="body_name"))
+        if s.type not in SITE_TYPES:
+            out.append(
+                Problem(
+                    "site.csv",
+                    f"site type '{s.type}': expected one of {list(SITE_TYPES)}",
+                    row=i,
+                    column="type",
+                )
+            )
+        msg = _quat_problem(s.quat)
+        if msg:
+            out.append(Problem("site.csv", msg, row=i, column="quat"))
+    for name in sorted(_duplicates(s.name for s in hrdf.sensors)):
+        out.append(Problem("sensor.csv", f"duplicate sensor name '{name}'", column="name"))
+    targets = {
+        "site": {s.name for s in hrdf.sites},
+        "body": body_names,
+        "xbody": body_names,
+        "joint": {j.name for j in hrdf.joints if j.name},
+        "actuator": {a.name for a in hrdf.actuators if a.name},
+    }
+    for i, s in enumerate(hrdf.sensors):
+        known = targets.get(s.objtype)
+        if known is not None and s.objname not in known:
+            out.append(
+                Problem(
+                    "sensor.csv",
+                    f"sensor '{s.name}' reads unknown {s.objtype} '{s.objname}'",
+                    row=i,
+                    column="objname",
+                )
+            )
+    return out
+
+
+def _check_meta(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
+    out: list[Problem] = []
+    for i, imu in enumerate(hrdf.meta.imu_config_list or []):
+        if imu.body_name not in body_names:
+            out.append(
+                Problem(
+                    "meta.yaml",
+                    f"IMU on unknown body '{imu.body_name}'",
+                    column=f"imu_config_list[{i}].body_name",
+                )
+            )
+        msg = _quat_problem(imu.orientation)
+        if msg:
+            out.append(Problem("meta.yaml", msg, column=f"imu_config_list[{i}].orientation"))
+    sim = hrdf.meta.simulator_config
+    if sim is not None and sim.timestep is not None and not sim.timestep > 0:
+        out.append(
+            Problem(
+                "meta.yaml",
+                f"timestep {sim.timestep}: expected > 0",
+                column="simulator_config.timestep",
+            )
+        )
+    return out
+
+
+def check_model(hrdf: HRDF, *, check_files: bool = True) -> list[Problem]:
+    """All problems of an in-memory model (empty list when it is valid)."""
+    problems = _check_tree(hrdf)
+    problems += _check_bodies(hrdf)
+    body_names = {b.name for b in hrdf.bodies}
+    problems += _check_joints(hrdf, body_names)
+    problems += _check_actuators(hrdf)
+    problems += _check_geoms(hrdf, body_names, check_files)
+    problems += _check_sites_sensors(hrdf, body_names)
+    problems += _check_meta(hrdf, body_names)
+    return problems
+
+
+def validate_dir(path: str | Path) -> list[Problem]:
+    """Read and check an HRDF folder; return every problem (errors and warnings)."""
+    from robotwright.hrdf.io import collect_hrdf_dir
+
+    _, problems = collect_hrdf_dir(path)
+    return problems
