@@ -1,0 +1,65 @@
+#!/usr/bin/env python
+"""Fetch the real-robot test data that is not installed as a package.
+
+The ``test`` extra installs ``example-robot-data``, ``jvrc-description`` and
+``dm-control`` (pure data for our purposes). The mjlab wheel carries the Unitree G1 and
+Go1 MJCF models, but installing mjlab would pull torch, so its wheel is downloaded
+without dependencies and unpacked into ``.testdata/mjlab``.
+
+Idempotent: does nothing when the data is already there. Exits non-zero on failure.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+TESTDATA = ROOT / ".testdata"
+MJLAB_VERSION = "1.6.0"
+
+
+def fetch_mjlab() -> Path:
+    dest = TESTDATA / "mjlab"
+    marker = dest / f".mjlab-{MJLAB_VERSION}"
+    if marker.exists():
+        print(f"mjlab {MJLAB_VERSION} robots already in {dest}")
+        return dest
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = [
+            sys.executable, "-m", "pip", "download", "--no-deps", "--quiet",
+            "-d", tmp, f"mjlab=={MJLAB_VERSION}",
+        ]
+        print("fetching:", " ".join(cmd[2:]))
+        subprocess.run(cmd, check=True)
+        wheels = list(Path(tmp).glob("mjlab-*.whl"))
+        if not wheels:
+            raise SystemExit("pip download produced no mjlab wheel")
+        with zipfile.ZipFile(wheels[0]) as zf:
+            members = [m for m in zf.namelist() if m.startswith("mjlab/asset_zoo/")]
+            dest.mkdir(parents=True, exist_ok=True)
+            for m in members:
+                # Wheel members are plain relative paths; refuse anything that escapes.
+                target = (dest / m).resolve()
+                if not str(target).startswith(str(dest.resolve())):
+                    raise SystemExit(f"refusing to extract {m}: escapes {dest}")
+                if m.endswith("/"):
+                    continue
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(zf.read(m))
+    marker.write_text(MJLAB_VERSION)
+    print(f"mjlab {MJLAB_VERSION} robots unpacked into {dest}")
+    return dest
+
+
+def main() -> int:
+    TESTDATA.mkdir(exist_ok=True)
+    fetch_mjlab()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
