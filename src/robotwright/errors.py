@@ -63,5 +63,13 @@ class ConversionError(ProblemsError):
     """A conversion would lose or change meaning and ``strict=True`` was requested, or it failed."""
 
 
+class SensorError(RobotwrightError, ValueError):
+    """A sensor configuration does not fit its model (unknown body, empty pattern, bad range, ...)."""
+
+
+class GrammarError(ProblemsError):
+    """A grammar, component library or design is invalid (names file, rule/component, field)."""
+
+
 class ConversionWarning(UserWarning):
     """An element was dropped or approximated during a conversion (named in the message)."""

@@ -1,0 +1,420 @@
+"""Load a grammar and a component library from YAML, with validation.
+
+Every problem found is reported at once in a :class:`~robotwright.errors.GrammarError`
+whose entries name the file, the rule or component, and the field.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+import warnings
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from robotwright.errors import GrammarError, Problem
+from robotwright.grammar.library import (
+    COMPONENT_KINDS,
+    REQUIRED_PARAMS,
+    Component,
+    DofSpec,
+    Library,
+    ParamDomain,
+)
+from robotwright.grammar.rules import Grammar, Rule
+from robotwright.grammar.symbols import NodePattern, NodeState, Symbol, parse_chain
+
+class GrammarWarning(UserWarning):
+    """Something in a grammar is suspicious but not wrong (e.g. a symbol never produced)."""
+
+
+_GRAMMAR_KEYS = {"name", "start", "symbols", "rules", "link_symbols", "library", "description"}
+_RULE_KEYS = {"lhs", "rhs", "branching", "description"}
+_COMPONENT_KEYS = {
+    "symbol",
+    "kind",
+    "attach",
+    "offer",
+    "params",
+    "density",
+    "rgba",
+    "dofs",
+    "housing",
+    "actuator",
+    "description",
+}
+
+
+def default_grammar_path() -> Path:
+    """Path of the bundled SRL grammar."""
+    return Path(str(resources.files("robotwright.grammar") / "data" / "srl_grammar.yaml"))
+
+
+def default_library_path() -> Path:
+    """Path of the bundled SRL component library."""
+    return Path(str(resources.files("robotwright.grammar") / "data" / "srl_library.yaml"))
+
+
+def default_grammar() -> Grammar:
+    """The bundled SRL grammar (seed rules r1..r4, open ends marked) and library."""
+    return load_grammar(default_grammar_path(), default_library_path())
+
+
+def _read_yaml(path: Path, problems: list[Problem]) -> dict[str, Any] | None:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        problems.append(Problem(str(path), f"cannot read file: {exc.strerror or exc}"))
+        return None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        problems.append(Problem(str(path), f"invalid YAML: {exc}"))
+        return None
+    if not isinstance(data, dict):
+        problems.append(Problem(str(path), "expected a YAML mapping at top level"))
+        return None
+    return data
+
+
+def _num(value: Any) -> float | None:
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return float(value)
+    return None
+
+
+def load_library(path: str | Path) -> Library:
+    """Load and validate a component library file (raises :class:`GrammarError`)."""
+    path = Path(path)
+    problems: list[Problem] = []
+    data = _read_yaml(path, problems)
+    if data is None:
+        raise GrammarError(problems, f"cannot load component library {path}")
+    lib = _parse_library(path, data, problems)
+    if problems:
+        raise GrammarError(problems, f"component library {path} is invalid")
+    return lib
+
+
+def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) -> Library:
+    f = str(path)
+    ports = tuple(str(p) for p in (data.get("ports") or []))
+    comps: dict[str, Component] = {}
+    raw = data.get("components")
+    if not isinstance(raw, dict) or not raw:
+        problems.append(Problem(f, "expected a non-empty mapping of components", column="components"))
+        raw = {}
+    for cname, spec in raw.items():
+        where = f"component '{cname}'"
+
+        def err(msg: str, col: str | None = None, _w: str = where) -> None:
+            problems.append(Problem(f, msg, column=col, element=_w))
+
+        if not isinstance(spec, dict):
+            err("expected a mapping")
+            continue
+        for key in spec:
+            if key not in _COMPONENT_KEYS:
+                err(f"unknown field (expected one of {sorted(_COMPONENT_KEYS)})", key)
+        kind = spec.get("kind")
+        if kind not in COMPONENT_KINDS:
+            err(f"kind must be one of {list(COMPONENT_KINDS)}, got {kind!r}", "kind")
+            continue
+        symbol = spec.get("symbol")
+        if not isinstance(symbol, str) or not symbol:
+            err("needs the grammar symbol it realises", "symbol")
+            continue
+        port_lists: dict[str, tuple[str, ...]] = {}
+        for key in ("attach", "offer"):
+            vals = spec.get(key) or []
+            if not isinstance(vals, list):
+                err("expected a list of port types", key)
+                vals = []
+            for p in vals:
+                if ports and p not in ports:
+                    err(f"unknown port type {p!r} (library declares {list(ports)})", key)
+            port_lists[key] = tuple(str(p) for p in vals)
+        params: dict[str, ParamDomain] = {}
+        for pname, pspec in (spec.get("params") or {}).items():
+            col = f"params.{pname}"
+            if not isinstance(pspec, dict) or "range" not in pspec or "values" not in pspec:
+                err("expected {range: [low, high], values: [...]}", col)
+                continue
+            rng = pspec["range"]
+            if not (isinstance(rng, list) and len(rng) == 2 and all(_num(v) is not None for v in rng)):
+                err(f"range must be two numbers [low, high], got {rng!r}", col)
+                continue
+            low, high = float(rng[0]), float(rng[1])
+            if low > high:
+                err(f"range low {low} > high {high}", col)
+                continue
+            values = pspec["values"]
+            if not isinstance(values, list) or not values:
+                err("values must be a non-empty list of numbers", col)
+                continue
+            good = True
+            for v in values:
+                x = _num(v)
+                if x is None:
+                    err(f"value {v!r} is not a number", col)
+                    good = False
+                elif not low <= x <= high:
+                    err(f"value {x} is out of the domain [{low}, {high}]", col)
+                    good = False
+            if len(set(values)) != len(values):
+                err("values repeat (each design would be counted twice)", col)
+                good = False
+            if good:
+                params[pname] = ParamDomain(pname, low, high, tuple(float(v) for v in values))
+        for need, meaning in REQUIRED_PARAMS[kind].items():
+            if need not in params and need not in (spec.get("params") or {}):
+                err(f"kind '{kind}' needs parameter '{need}' ({meaning})", "params")
+        dofs: list[DofSpec] = []
+        if kind == "connector":
+            raw_dofs = spec.get("dofs")
+            if not isinstance(raw_dofs, list) or not raw_dofs:
+                err("a connector needs a non-empty list of dofs (one DoF each)", "dofs")
+                raw_dofs = []
+            for i, d in enumerate(raw_dofs):
+                col = f"dofs[{i}]"
+                if not isinstance(d, dict):
+                    err("expected {type, twist, range}", col)
+                    continue
+                twist = _num(d.get("twist", 0.0))
+                rng = d.get("range")
+                if twist is None:
+                    err(f"twist must be a number (rad), got {d.get('twist')!r}", col)
+                    continue
+                if not (isinstance(rng, list) and len(rng) == 2):
+                    err("range must be [lower, upper] (numbers or parameter names)", col)
+                    continue
+                items: list[float | str] = []
+                for item in rng:
+                    if isinstance(item, str):
+                        if item.lstrip("-") not in params:
+                            err(f"range refers to unknown parameter {item!r}", col)
+                        items.append(item)
+                    elif _num(item) is not None:
+                        items.append(float(item))
+                    else:
+                        err(f"range item {item!r} is neither a number nor a parameter", col)
+                try:
+                    dofs.append(DofSpec(d.get("type"), twist, (items[0], items[1])))
+                except (ValueError, IndexError) as exc:
+                    err(str(exc), col)
+            for key in ("housing", "actuator"):
+                val = spec.get(key)
+                if not isinstance(val, dict) or any(_num(v) is None or _num(v) <= 0 for v in val.values()):
+                    err("expected a mapping of positive numbers", key)
+            for need in ("diameter", "length"):
+                if need not in (spec.get("housing") or {}):
+                    err(f"housing needs '{need}' (m)", "housing")
+            for need in ("peak_torque", "peak_velocity"):
+                if need not in (spec.get("actuator") or {}):
+                    err(f"actuator needs '{need}'", "actuator")
+        density = _num(spec.get("density", 1000.0))
+        if density is None or density <= 0:
+            err(f"density must be a positive number (kg/m^3), got {spec.get('density')!r}", "density")
+            density = 1000.0
+        rgba = spec.get("rgba", [0.7, 0.7, 0.7, 1.0])
+        if not (isinstance(rgba, list) and len(rgba) == 4 and all(_num(v) is not None for v in rgba)):
+            err(f"rgba must be 4 numbers, got {rgba!r}", "rgba")
+            rgba = [0.7, 0.7, 0.7, 1.0]
+        try:
+            comps[cname] = Component(
+                name=str(cname),
+                symbol=symbol,
+                kind=kind,
+                attach=port_lists["attach"],
+                offer=port_lists["offer"],
+                params=params,
+                density=density,
+                rgba=tuple(float(v) for v in rgba),  # type: ignore[arg-type]
+                dofs=tuple(dofs),
+                housing={k: float(v) for k, v in (spec.get("housing") or {}).items() if _num(v)},
+                actuator={k: float(v) for k, v in (spec.get("actuator") or {}).items() if _num(v)},
+            )
+        except ValueError as exc:
+            err(str(exc))
+    return Library(name=str(data.get("name", path.stem)), components=comps, ports=ports, source=f)
+
+
+def load_grammar(path: str | Path, library: str | Path | Library | None = None) -> Grammar:
+    """Load and validate a grammar file and its component library.
+
+    Args:
+        path: grammar YAML file.
+        library: a library file or object; default: the file named by the grammar's
+            ``library`` key (relative to the grammar file), else the bundled library.
+
+    Raises:
+        GrammarError: listing every problem (file, rule or component, field).
+    """
+    path = Path(path)
+    problems: list[Problem] = []
+    data = _read_yaml(path, problems)
+    if data is None:
+        raise GrammarError(problems, f"cannot load grammar {path}")
+    if isinstance(library, Library):
+        lib = library
+    else:
+        if library is None:
+            lib_path = (
+                path.parent / str(data["library"]) if data.get("library") else default_library_path()
+            )
+        else:
+            lib_path = Path(library)
+        lib_data = _read_yaml(lib_path, problems)
+        lib = _parse_library(lib_path, lib_data, problems) if lib_data is not None else None
+    grammar = _parse_grammar(path, data, lib, problems) if lib is not None else None
+    if grammar is not None and not problems:
+        _check_grammar(grammar, problems)
+    errors = [p for p in problems if p.severity == "error"]
+    if errors or grammar is None:
+        raise GrammarError(problems, f"grammar {path} is invalid")
+    for p in problems:
+        warnings.warn(str(p), GrammarWarning, stacklevel=2)
+    return grammar
+
+
+def _parse_grammar(
+    path: Path, data: dict[str, Any], lib: Library, problems: list[Problem]
+) -> Grammar | None:
+    f = str(path)
+    for key in data:
+        if key not in _GRAMMAR_KEYS:
+            problems.append(Problem(f, f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})", column=key))
+    symbols: dict[str, Symbol] = {}
+    raw_syms = data.get("symbols")
+    if not isinstance(raw_syms, dict) or not raw_syms:
+        problems.append(Problem(f, "expected a non-empty mapping of symbols", column="symbols"))
+        raw_syms = {}
+    for sname, spec in raw_syms.items():
+        spec = spec if isinstance(spec, dict) else {"kind": spec}
+        try:
+            symbols[str(sname)] = Symbol(str(sname), spec.get("kind"), str(spec.get("description", "")))
+        except ValueError as exc:
+            problems.append(Problem(f, str(exc), column="kind", element=f"symbol '{sname}'"))
+    start = data.get("start")
+    if start not in symbols:
+        problems.append(Problem(f, f"start symbol {start!r} is not a declared symbol", column="start"))
+    elif symbols[start].kind != "nonterminal":
+        problems.append(Problem(f, f"start symbol {start!r} must be a nonterminal", column="start"))
+    link_symbols = tuple(str(s) for s in (data.get("link_symbols") or []))
+    for s in link_symbols:
+        if s not in symbols:
+            problems.append(Problem(f, f"unknown symbol {s!r}", column="link_symbols"))
+    rules: dict[str, Rule] = {}
+    raw_rules = data.get("rules")
+    if not isinstance(raw_rules, dict) or not raw_rules:
+        problems.append(Problem(f, "expected a non-empty mapping of rules", column="rules"))
+        raw_rules = {}
+    for rname, spec in raw_rules.items():
+        where = f"rule '{rname}'"
+        if not isinstance(spec, dict):
+            problems.append(Problem(f, "expected {lhs, rhs}", element=where))
+            continue
+        for key in spec:
+            if key not in _RULE_KEYS:
+                problems.append(Problem(f, f"unknown field (expected one of {sorted(_RULE_KEYS)})", column=key, element=where))
+        try:
+            lhs = NodePattern.parse(spec.get("lhs", ""))
+        except ValueError as exc:
+            problems.append(Problem(f, str(exc), column="lhs", element=where))
+            continue
+        try:
+            rhs = parse_chain(spec.get("rhs", ""))
+        except ValueError as exc:
+            problems.append(Problem(f, str(exc), column="rhs", element=where))
+            continue
+        ok = True
+        for col, node in [("lhs", lhs)] + [("rhs", n) for n in rhs]:
+            if node.symbol not in symbols:
+                problems.append(Problem(f, f"unknown symbol {node.symbol!r} (declared: {sorted(symbols)})", column=col, element=where))
+                ok = False
+        if not ok:
+            continue
+        if symbols[lhs.symbol].kind == "terminal":
+            problems.append(Problem(f, f"left side {lhs} is a terminal symbol, which is never rewritten", column="lhs", element=where))
+        if rhs[0].keep and rhs[0].symbol != lhs.symbol:
+            problems.append(Problem(f, f"'{rhs[0]}' keeps the matched node, so it must be the left side's symbol {lhs.symbol!r}", column="rhs", element=where))
+        for node in rhs:
+            if node.open and symbols[node.symbol].kind == "terminal":
+                problems.append(Problem(f, f"terminal {node.symbol!r} cannot be left open ('{node}')", column="rhs", element=where))
+        branching = spec.get("branching", False)
+        if not isinstance(branching, bool):
+            problems.append(Problem(f, f"branching must be true or false, got {branching!r}", column="branching", element=where))
+            branching = False
+        rules[str(rname)] = Rule(str(rname), lhs, rhs, branching, str(spec.get("description", "")))
+    for comp in lib.components.values():
+        if comp.symbol not in symbols:
+            problems.append(Problem(lib.source, f"symbol {comp.symbol!r} is not declared by grammar {f}", column="symbol", element=f"component '{comp.name}'"))
+    if start not in symbols:
+        return None
+    return Grammar(
+        name=str(data.get("name", path.stem)),
+        start=str(start),
+        symbols=symbols,
+        rules=rules,
+        library=lib,
+        link_symbols=link_symbols,
+        source=f,
+    )
+
+
+def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
+    """Whole-grammar checks: components, ports, open-end marks, matching, reachability, termination."""
+    f = g.source
+    closed_symbols = {n.symbol for r in g.rules.values() for n in r.rhs if not n.open}
+    for r in g.rules.values():
+        where = f"rule '{r.name}'"
+        for node in r.rhs:
+            if not node.open and not g.library.for_symbol(node.symbol):
+                problems.append(Problem(f, f"'{node}' is finished here but the library has no component for symbol {node.symbol!r} (mark it open or add a component)", column="rhs", element=where))
+        if not r.lhs.open and r.lhs.symbol in closed_symbols and not r.branching:
+            problems.append(Problem(f, f"left side '{r.lhs}' matches every {r.lhs.symbol} node, also interior ones, so it would grow extra branches; write '{r.lhs}*' to grow only the open end, or set 'branching: true'", column="lhs", element=where))
+        for a, b in zip(r.rhs, r.rhs[1:]):
+            for ca in g.library.for_symbol(a.symbol):
+                for cb in g.library.for_symbol(b.symbol):
+                    if not set(ca.offer) & set(cb.attach):
+                        problems.append(Problem(f, f"port mismatch on edge {a.symbol} -> {b.symbol}: component '{ca.name}' offers {list(ca.offer)} but '{cb.name}' attaches by {list(cb.attach)}", column="rhs", element=where))
+    if problems:
+        return
+    # States any rule (or the start) can create, ignoring whether they are reachable.
+    produced = {g.start_state}
+    for r in g.rules.values():
+        for has_edges in (False, True):
+            for open_ in (False, True):
+                st = NodeState(r.lhs.symbol, open_, has_edges)
+                if r.matches(st):
+                    kept, new = r.result_states(st)
+                    produced.update((kept, *new))
+    reachable = g.reachable_states()
+    for r in g.rules.values():
+        where = f"rule '{r.name}'"
+        if not any(r.matches(s) for s in produced):
+            shown = ", ".join(sorted(str(s) for s in produced if s.symbol == r.lhs.symbol)) or "none"
+            problems.append(Problem(f, f"left side '{r.lhs}' can never match: no rule creates such a node (nodes of {r.lhs.symbol!r} that occur: {shown})", column="lhs", element=where))
+        elif not any(r.matches(s) for s in reachable):
+            problems.append(Problem(f, f"rule is unreachable from the start symbol {g.start!r}", column="lhs", element=where))
+    # An open state terminates if some rule turns it into terminating states only.
+    done = {s for s in reachable if not s.open}
+    changed = True
+    while changed:
+        changed = False
+        for st in reachable - done:
+            for r in g.matching_rules(st):
+                kept, new = r.result_states(st)
+                if all(s in done for s in (kept, *new)):
+                    done.add(st)
+                    changed = True
+                    break
+    for st in sorted(reachable - done, key=str):
+        names = [r.name for r in g.matching_rules(st)] or ["none"]
+        problems.append(Problem(f, f"an open '{st}' node can never be finished: no derivation through rules {names} closes it", column="rules", element=f"symbol '{st.symbol}'"))
+    for sym in g.symbols.values():
+        if not any(s.symbol == sym.name for s in reachable):
+            problems.append(Problem(f, "symbol is declared but no derivation from the start produces it", column="symbols", element=f"symbol '{sym.name}'", severity="warning"))

@@ -1,0 +1,87 @@
+"""Grammar symbols and node patterns (``-L*``: a link node with edges, open end)."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Literal
+
+SymbolKind = Literal["terminal", "nonterminal"]
+
+_PATTERN = re.compile(r"^\s*(-?)\s*([A-Za-z_][A-Za-z0-9_]*)\s*(\*?)\s*$")
+
+
+@dataclass(frozen=True)
+class Symbol:
+    """A grammar symbol.
+
+    Attributes:
+        name: the symbol's name as written in rules (``"L"``).
+        kind: ``"terminal"`` symbols are never rewritten; ``"nonterminal"`` ones may be.
+        description: free text shown in docs and ``grammar check``.
+    """
+
+    name: str
+    kind: SymbolKind
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("terminal", "nonterminal"):
+            raise ValueError(
+                f"symbol {self.name!r}: kind must be 'terminal' or 'nonterminal', got {self.kind!r}"
+            )
+
+
+@dataclass(frozen=True)
+class NodePattern:
+    """One node of a rule side, parsed from the seed's notation.
+
+    ``-X`` (``keep=True``): on a left side, the node has at least one edge; on a right
+    side (first node only), the matched node is kept with its component, parameters and
+    edges. ``X*`` (``open=True``): on a left side, match only an open end; on a right
+    side, leave the node open so that later rules may grow it.
+    """
+
+    symbol: str
+    keep: bool = False
+    open: bool = False
+
+    @classmethod
+    def parse(cls, text: str) -> NodePattern:
+        """Parse ``"-L*"``-style text; raises ``ValueError`` naming the text."""
+        m = _PATTERN.match(str(text))
+        if m is None:
+            raise ValueError(
+                f"cannot parse node {text!r}: expected SYMBOL with optional leading '-' "
+                "and trailing '*', e.g. '-L*'"
+            )
+        return cls(symbol=m.group(2), keep=m.group(1) == "-", open=m.group(3) == "*")
+
+    def __str__(self) -> str:
+        return f"{'-' if self.keep else ''}{self.symbol}{'*' if self.open else ''}"
+
+
+@dataclass(frozen=True)
+class NodeState:
+    """What a rule's left side can see of a node: its symbol, open mark, and edges."""
+
+    symbol: str
+    open: bool
+    has_edges: bool
+
+    def __str__(self) -> str:
+        return f"{'-' if self.has_edges else ''}{self.symbol}{'*' if self.open else ''}"
+
+
+def parse_chain(text: str) -> tuple[NodePattern, ...]:
+    """Parse a right side ``"-B -> C -> L*"`` into node patterns (``ValueError`` if bad)."""
+    parts = [p for p in str(text).split("->")]
+    if any(not p.strip() for p in parts):
+        raise ValueError(f"cannot parse chain {text!r}: empty node between '->'")
+    nodes = tuple(NodePattern.parse(p) for p in parts)
+    for i, node in enumerate(nodes[1:], start=1):
+        if node.keep:
+            raise ValueError(
+                f"chain {text!r}: only the first node may be written '-X' (node {i} is {node})"
+            )
+    return nodes
