@@ -1,0 +1,158 @@
+"""Sensor configs: :class:`LidarCfg` and :class:`SemanticLidarCfg` (seed 004 names)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+from robotwright.errors import SensorError
+from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
+
+__all__ = ["LidarCfg", "SemanticLidarCfg", "DEFAULT_SEMANTIC_CLASS_MAPPING"]
+
+#: The seed's default mapping: class ids are 1..K in this order, 0 = miss/unknown.
+DEFAULT_SEMANTIC_CLASS_MAPPING: dict[str, list[str]] = {
+    "terrain": ["ground", "wall", "floor", "plane"],
+    "dynamic_obstacle": [
+        "cracker_box",
+        "sugar_box",
+        "tomato_soup_can",
+        "_03_cracker_box",
+        "_04_sugar_box",
+        "_05_tomato_soup_can",
+    ],
+    "valuable": [
+        "sofa",
+        "armchair",
+        "table",
+        "chair",
+        "desk",
+        "SM_Sofa",
+        "SM_Armchair",
+        "SM_Table",
+    ],
+}
+
+
+@dataclass(kw_only=True)
+class LidarCfg:
+    """Configuration of a :class:`~robotwright.sensors.LidarSensor` on a MuJoCo model.
+
+    Attributes:
+        prim_path: name of the MuJoCo body or site that carries the sensor.
+        pattern_cfg: the scan pattern (sensor frame: +x forward, +z up).
+        offset_pos: sensor position in the carrier's frame [m].
+        offset_rot: sensor orientation in the carrier's frame, quaternion (w, x, y, z).
+        ray_alignment: as Isaac Lab's RayCaster: ``"base"`` rays follow the full sensor
+            orientation; ``"yaw"`` only its heading (rays stay level when the robot
+            pitches or rolls); ``"world"`` rays keep their pattern directions in the
+            world frame. The origin always follows the sensor.
+        mesh_prim_paths: which geoms rays may hit: shell-style patterns (``fnmatch``,
+            case-sensitive) matched against geom names, body names and geom paths
+            (``/world/.../body/geom``); a body pattern selects all geoms of the bodies it
+            matches. Empty (default): every geom of the model.
+        exclude_robot: drop the geoms of the robot carrying the sensor (every body
+            under the same root body as the carrier) from the hittable set.
+        min_distance: hits closer than this are misses [m].
+        max_distance: hits further than this are misses [m].
+        range_noise_std: standard deviation of Gaussian range noise added to hits [m].
+        dropout_prob: probability that a ray returns nothing (becomes a miss).
+        seed: seed of the noise and dropout generator (``None``: fresh entropy).
+        miss_distance: distance reported for misses (default ``inf``); points of misses
+            are NaN and ``data.hit_mask`` is False for them whatever this value.
+        engine: ``"mujoco"`` (``mj_multiRay`` on CPU threads, the reference) or
+            ``"warp"`` (mujoco-warp batched rays with a BVH; needs ``robotwright[warp]``).
+        device: warp device (``"cpu"``, ``"cuda"``, ``"cuda:0"``); ``None`` picks CUDA
+            when present, else CPU. Ignored by the ``"mujoco"`` engine.
+        num_threads: CPU threads of the ``"mujoco"`` engine; ``None``: one per core.
+    """
+
+    prim_path: str
+    pattern_cfg: PatternCfg = field(default_factory=LivoxPatternCfg)
+    offset_pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    offset_rot: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    ray_alignment: Literal["base", "yaw", "world"] = "base"
+    mesh_prim_paths: list[str] = field(default_factory=list)
+    exclude_robot: bool = True
+    min_distance: float = 0.0
+    max_distance: float = 100.0
+    range_noise_std: float = 0.0
+    dropout_prob: float = 0.0
+    seed: int | None = 0
+    miss_distance: float = math.inf
+    engine: Literal["mujoco", "warp"] = "mujoco"
+    device: str | None = None
+    num_threads: int | None = None
+
+    def __post_init__(self) -> None:
+        name = type(self).__name__
+        if not isinstance(self.prim_path, str) or not self.prim_path:
+            raise SensorError(f"{name}.prim_path: expected the name of a body or site, got {self.prim_path!r}")
+        if not isinstance(self.pattern_cfg, PatternCfg):
+            raise SensorError(f"{name}.pattern_cfg: expected a PatternCfg, got {type(self.pattern_cfg).__name__}")
+        if self.pattern_cfg.num_rays < 1:
+            raise SensorError(f"{name}.pattern_cfg: empty pattern (0 rays)")
+        if len(self.offset_pos) != 3 or not all(math.isfinite(v) for v in self.offset_pos):
+            raise SensorError(f"{name}.offset_pos: expected 3 finite numbers [m], got {self.offset_pos}")
+        norm = math.sqrt(sum(v * v for v in self.offset_rot)) if len(self.offset_rot) == 4 else 0.0
+        if not norm > 1e-9 or not math.isfinite(norm):
+            raise SensorError(f"{name}.offset_rot: expected a non-zero quaternion (w, x, y, z), got {self.offset_rot}")
+        self.offset_rot = tuple(float(v) / norm for v in self.offset_rot)  # type: ignore[assignment]
+        if self.ray_alignment not in ("base", "yaw", "world"):
+            raise SensorError(f"{name}.ray_alignment: expected 'base', 'yaw' or 'world', got {self.ray_alignment!r}")
+        if isinstance(self.mesh_prim_paths, str):
+            raise SensorError(f"{name}.mesh_prim_paths: expected a list of names/patterns, got a string")
+        self.mesh_prim_paths = list(self.mesh_prim_paths)
+        for key in ("min_distance", "max_distance", "range_noise_std"):
+            value = getattr(self, key)
+            if not isinstance(value, (int, float)) or math.isnan(value) or value < 0:
+                raise SensorError(f"{name}.{key}: expected a non-negative number [m], got {value!r}")
+        if not math.isfinite(self.max_distance) or self.max_distance <= self.min_distance:
+            raise SensorError(
+                f"{name}: expected min_distance < max_distance < inf, got {self.min_distance}, {self.max_distance}"
+            )
+        if not (0.0 <= self.dropout_prob <= 1.0):
+            raise SensorError(f"{name}.dropout_prob: expected a probability in [0, 1], got {self.dropout_prob}")
+        if self.engine not in ("mujoco", "warp"):
+            raise SensorError(f"{name}.engine: expected 'mujoco' or 'warp', got {self.engine!r}")
+        if self.num_threads is not None and (not isinstance(self.num_threads, int) or self.num_threads < 1):
+            raise SensorError(f"{name}.num_threads: expected an integer >= 1 or None, got {self.num_threads!r}")
+
+
+@dataclass(kw_only=True)
+class SemanticLidarCfg(LidarCfg):
+    """:class:`LidarCfg` plus per-ray semantic classes (seed 004).
+
+    Attributes:
+        semantic_class_mapping: class name -> keywords. A geom's class is the first
+            class (in mapping order) one of whose keywords occurs, case-insensitively,
+            in the geom's path (``/world/<bodies>/<geom>`` plus ``/<mesh>`` for mesh
+            geoms). Class ids are 1..K in mapping order; 0 means miss or unknown.
+            ``None``: :data:`DEFAULT_SEMANTIC_CLASS_MAPPING`.
+        return_semantic_labels: compute ``data.semantic_labels``.
+        return_mesh_ids: fill ``data.mesh_ids`` (the hit geom id per ray, -1 on a miss).
+    """
+
+    semantic_class_mapping: dict[str, list[str]] | None = None
+    return_semantic_labels: bool = True
+    return_mesh_ids: bool = False
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        name = type(self).__name__
+        if self.semantic_class_mapping is None:
+            self.semantic_class_mapping = {k: list(v) for k, v in DEFAULT_SEMANTIC_CLASS_MAPPING.items()}
+        if not isinstance(self.semantic_class_mapping, dict):
+            raise SensorError(f"{name}.semantic_class_mapping: expected a dict of class name -> keywords")
+        for cls, keywords in self.semantic_class_mapping.items():
+            if not isinstance(cls, str) or not cls:
+                raise SensorError(f"{name}.semantic_class_mapping: class names must be non-empty strings, got {cls!r}")
+            if isinstance(keywords, str) or not isinstance(keywords, (list, tuple)):
+                raise SensorError(
+                    f"{name}.semantic_class_mapping[{cls!r}]: expected a list of keywords, got {keywords!r}"
+                )
+            if not keywords:
+                raise SensorError(f"{name}.semantic_class_mapping[{cls!r}]: empty keyword list (class can never match)")
+            if any(not isinstance(k, str) or not k for k in keywords):
+                raise SensorError(f"{name}.semantic_class_mapping[{cls!r}]: keywords must be non-empty strings")

@@ -1,0 +1,77 @@
+"""Pictures of a scan: point cloud coloured by semantic class, top and side views (PNG)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["plot_scan"]
+
+# Fixed colours so the same class looks the same in every picture (class 0 = unknown).
+_COLORS = ["#9e9e9e", "#8c6d31", "#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2"]
+
+
+def plot_scan(
+    points: np.ndarray,
+    labels: np.ndarray,
+    class_names: Sequence[str],
+    path: str | Path,
+    sensor_pos: np.ndarray | None = None,
+    title: str | None = None,
+) -> Path:
+    """Draw hit points (world frame [m]) coloured by class id into a PNG file.
+
+    Args:
+        points: ``(N, 3)`` points; rows with NaN (misses) are skipped.
+        labels: ``(N,)`` class ids indexing ``class_names`` (0 = unknown).
+        class_names: names by class id.
+        path: the PNG to write (written to a temporary file first, then renamed).
+        sensor_pos: sensor position, drawn as a black cross.
+        title: figure title.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    labels = np.asarray(labels).reshape(-1)
+    keep = np.isfinite(points).all(axis=1)
+    points, labels = points[keep], labels[keep]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1, 1]})
+    views = (("top view", 0, 1, "x [m]", "y [m]"), ("side view", 0, 2, "x [m]", "z [m]"))
+    for ax, (name, i, j, xl, yl) in zip(axes, views):
+        for cls_id, cls_name in enumerate(class_names):
+            sel = labels == cls_id
+            if not sel.any():
+                continue
+            color = _COLORS[cls_id % len(_COLORS)]
+            ax.scatter(points[sel, i], points[sel, j], s=1.5, c=color, linewidths=0,
+                       label=f"{cls_id} {cls_name} ({int(sel.sum())} pts)")  # fmt: skip
+        if sensor_pos is not None:
+            ax.plot(sensor_pos[i], sensor_pos[j], "kx", markersize=10, mew=2, label="sensor")
+        ax.set_title(name)
+        ax.set_xlabel(xl)
+        ax.set_ylabel(yl)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="lower center", ncol=min(len(names), 5), markerscale=6, frameon=False)
+    fig.suptitle(title or f"LiDAR scan: {len(points)} points")
+    fig.tight_layout(rect=(0, 0.07, 1, 0.97))
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent or ".")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fig.savefig(fh, format="png", dpi=110)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+    finally:
+        plt.close(fig)
+    return path

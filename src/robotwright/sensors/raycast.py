@@ -1,0 +1,246 @@
+"""Ray engines: cast world-frame rays against a MuJoCo scene, return distance and geom id.
+
+Both engines take the geom poses that MuJoCo computed (``MjData.geom_xpos`` /
+``geom_xmat``) for each environment and return, per ray, the distance along the unit
+direction [m] (``-1`` when nothing is hit) and the id of the hit geom (``-1`` on a miss).
+
+* :class:`MujocoRayEngine`: ``mujoco.mj_multiRay`` (float64, the reference), run on a
+  pool of threads over environments or ray chunks (MuJoCo releases the GIL).
+* :class:`WarpRayEngine`: ``mujoco_warp.rays`` with MuJoCo Warp's scene BVH, every
+  environment in one kernel launch, on warp's CPU device or on CUDA (float32).
+
+Which geoms are hittable is decided once, in :func:`make_ray_model`: the engines work on
+a private copy of the model where hittable geoms sit in group 0 and are opaque, and all
+others in group 1, so MuJoCo's own geom-group filter does the selection at no cost.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Sequence
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from robotwright.errors import SensorError
+
+__all__ = ["make_ray_model", "MujocoRayEngine", "WarpRayEngine", "warp_available"]
+
+#: mj_multiRay's geomgroup filter: only group 0 (the hittable geoms of the ray model).
+_GEOMGROUP = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
+
+
+def make_ray_model(model: mujoco.MjModel, hittable: np.ndarray) -> mujoco.MjModel:
+    """A copy of ``model`` in which exactly the geoms flagged in ``hittable`` can be hit.
+
+    MuJoCo's ray functions skip transparent geoms (alpha 0, from rgba or material) and
+    filter by geom group; the copy makes hittable geoms opaque and puts them in group 0,
+    everything else in group 1. The user's model is not touched.
+    """
+    hittable = np.asarray(hittable, dtype=bool)
+    if hittable.shape != (model.ngeom,):
+        raise SensorError(f"hittable mask: expected shape ({model.ngeom},), got {hittable.shape}")
+    ray_model = copy.deepcopy(model)
+    ray_model.geom_group[:] = np.where(hittable, 0, 1)
+    ray_model.geom_matid[hittable] = -1
+    ray_model.geom_rgba[hittable, 3] = 1.0
+    return ray_model
+
+
+def _split(n: int, parts: int) -> list[tuple[int, int]]:
+    bounds = np.linspace(0, n, parts + 1).round().astype(int)
+    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+
+
+class MujocoRayEngine:
+    """``mj_multiRay`` on CPU threads (reference engine, float64).
+
+    Each worker thread owns a scratch ``MjData`` of the ray model into which the geom
+    poses of the environment it works on are copied, so the user's ``MjData`` are only
+    read and threads never share MuJoCo's stack.
+    """
+
+    name = "mujoco"
+
+    def __init__(self, ray_model: mujoco.MjModel, num_threads: int | None = None) -> None:
+        self.model = ray_model
+        self.num_threads = max(1, int(num_threads or os.cpu_count() or 1))
+        self._scratch = [mujoco.MjData(ray_model) for _ in range(self.num_threads)]
+        # What mj_multiRay reads from MjData: geom poses, and body inertial frames for
+        # its per-body culling (measured: without xipos/ximat it culls wrongly).
+        self._pose_fields = ("geom_xpos", "geom_xmat", "xipos", "ximat")
+        if ray_model.nflex:
+            self._pose_fields += ("flexvert_xpos",)
+        self._pool = ThreadPoolExecutor(self.num_threads) if self.num_threads > 1 else None
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=False)
+            self._pool = None
+
+    def __del__(self) -> None:  # pragma: no cover - best effort at interpreter teardown
+        self.close()
+
+    def cast(
+        self,
+        datas: Sequence[mujoco.MjData],
+        origins: np.ndarray,
+        directions: np.ndarray,
+        cutoff: float,
+        single_origin: bool,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Cast rays for every environment.
+
+        Args:
+            datas: one ``MjData`` per environment holding the current poses (only read).
+            origins: ``(E, N, 3)`` ray origins, world frame [m].
+            directions: ``(E, N, 3)`` unit directions, world frame.
+            cutoff: geoms further than this are skipped [m] (a speed hint only).
+            single_origin: every ray of an environment starts at ``origins[e, 0]``
+                (lets ``mj_multiRay`` share its per-geom culling over all rays).
+
+        Returns:
+            distances ``(E, N)`` float64 (-1 on a miss) and geom ids ``(E, N)`` int32.
+        """
+        num_envs, num_rays = directions.shape[:2]
+        dist = np.empty((num_envs, num_rays), dtype=np.float64)
+        geomid = np.empty((num_envs, num_rays), dtype=np.int32)
+        directions = np.ascontiguousarray(directions, dtype=np.float64)
+        origins = np.ascontiguousarray(origins, dtype=np.float64)
+        # Enough chunks to keep every thread busy, whole environments when there are many.
+        per_env = max(1, -(-self.num_threads // num_envs))
+        tasks = [(e, a, b) for e in range(num_envs) for a, b in _split(num_rays, per_env)]
+        groups = [tasks[i :: self.num_threads] for i in range(self.num_threads)]
+
+        def run(worker: int) -> None:
+            scratch = self._scratch[worker]
+            last_env = -1
+            for e, a, b in groups[worker]:
+                if e != last_env:
+                    for name in self._pose_fields:
+                        getattr(scratch, name)[:] = getattr(datas[e], name)
+                    last_env = e
+                if single_origin:
+                    mujoco.mj_multiRay(
+                        self.model, scratch, origins[e, 0], directions[e, a:b].ravel(), _GEOMGROUP,
+                        1, -1, geomid[e, a:b], dist[e, a:b], None, b - a, cutoff,
+                    )  # fmt: skip
+                else:
+                    gid = np.empty(1, dtype=np.int32)
+                    for i in range(a, b):
+                        dist[e, i] = mujoco.mj_ray(
+                            self.model, scratch, origins[e, i], directions[e, i], _GEOMGROUP, 1, -1, gid
+                        )
+                        geomid[e, i] = gid[0]
+
+        busy = [w for w in range(self.num_threads) if groups[w]]
+        if self._pool is None or len(busy) == 1:
+            for w in busy:
+                run(w)
+        else:
+            list(self._pool.map(run, busy))
+        return dist, geomid
+
+
+def warp_available() -> bool:
+    """True when ``warp`` and ``mujoco_warp`` import (the ``robotwright[warp]`` extra)."""
+    try:
+        import mujoco_warp  # noqa: F401
+        import warp  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class WarpRayEngine:
+    """Batched rays for ``num_envs`` worlds with MuJoCo Warp (scene BVH, float32).
+
+    Runs on warp's CPU device or on CUDA. Only the hittable geoms (group 0 of the ray
+    model) enter the BVH. Geom poses are uploaded from the ``MjData`` of each
+    environment, the BVH is refit, and one kernel casts every ray of every world.
+    """
+
+    name = "warp"
+
+    def __init__(self, ray_model: mujoco.MjModel, num_envs: int, device: str | None = None) -> None:
+        try:
+            import warp as wp
+
+            wp.config.quiet = True  # before mujoco_warp initialises warp: no banner on stdout
+            import mujoco_warp as mjw
+            from mujoco_warp._src.types import vec6
+        except ImportError as exc:
+            raise SensorError(
+                "engine='warp' needs the optional warp extra: pip install 'robotwright[warp]' "
+                f"(import failed: {exc})"
+            ) from exc
+        self._wp = wp
+        self._mjw = mjw
+        wp.init()
+        if device is None:
+            device = "cuda" if wp.get_cuda_device_count() > 0 else "cpu"
+        try:
+            self.device = wp.get_device(device)
+        except Exception as exc:  # warp raises a bare RuntimeError for unknown devices
+            raise SensorError(f"warp device {device!r} is not available: {exc}") from exc
+        self.model = ray_model
+        self.num_envs = int(num_envs)
+        with wp.ScopedDevice(self.device):
+            self._m = mjw.put_model(ray_model)
+            self._d = mjw.make_data(ray_model, nworld=self.num_envs)
+            self._rc = mjw.create_render_context(
+                ray_model,
+                nworld=self.num_envs,
+                cam_res=(1, 1),
+                render_rgb=False,
+                render_depth=False,
+                use_textures=False,
+                enabled_geom_groups=[0],
+            )
+        self._geomgroup = vec6(1, 0, 0, 0, 0, 0)
+        self._buffers: dict[int, tuple[Any, ...]] = {}
+
+    def _alloc(self, num_rays: int) -> tuple[Any, ...]:
+        if num_rays not in self._buffers:
+            wp = self._wp
+            shape = (self.num_envs, num_rays)
+            with wp.ScopedDevice(self.device):
+                self._buffers = {
+                    num_rays: (
+                        wp.empty(shape, dtype=wp.vec3),
+                        wp.empty(shape, dtype=wp.vec3),
+                        wp.full(num_rays, -1, dtype=int),
+                        wp.empty(shape, dtype=float),
+                        wp.empty(shape, dtype=int),
+                        wp.empty(shape, dtype=wp.vec3),
+                    )
+                }
+        return self._buffers[num_rays]
+
+    def cast(
+        self,
+        datas: Sequence[mujoco.MjData],
+        origins: np.ndarray,
+        directions: np.ndarray,
+        cutoff: float,
+        single_origin: bool,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Same contract as :meth:`MujocoRayEngine.cast` (distances computed in float32)."""
+        wp, mjw = self._wp, self._mjw
+        num_envs, num_rays = directions.shape[:2]
+        geom_xpos = [d.geom_xpos for d in datas]
+        geom_xmat = [d.geom_xmat for d in datas]
+        if num_envs != self.num_envs:
+            raise SensorError(f"warp engine built for {self.num_envs} environments, got {num_envs}")
+        pnt, vec, bodyexclude, dist, geomid, normal = self._alloc(num_rays)
+        with wp.ScopedDevice(self.device):
+            self._d.geom_xpos.assign(np.asarray(geom_xpos, dtype=np.float32))
+            self._d.geom_xmat.assign(np.asarray(geom_xmat, dtype=np.float32).reshape(num_envs, -1, 3, 3))
+            pnt.assign(np.asarray(origins, dtype=np.float32))
+            vec.assign(np.asarray(directions, dtype=np.float32))
+            mjw.refit_bvh(self._m, self._d, self._rc)
+            mjw.rays(self._m, self._d, pnt, vec, self._geomgroup, True, bodyexclude, dist, geomid, normal, self._rc)
+            return dist.numpy().astype(np.float64), geomid.numpy().astype(np.int32)

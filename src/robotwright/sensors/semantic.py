@@ -1,0 +1,143 @@
+"""``SemanticLidarSensor``: a LiDAR whose every ray carries the class of what it hit.
+
+The ray engines return the id of the hit geom for each ray, so labels are exact per ray
+(the seed's "simplified version" is not needed): a geom's class is decided once, from
+its path, and a lookup table turns hit geom ids into class ids on every update.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from robotwright.errors import SensorError
+from robotwright.sensors.config import SemanticLidarCfg
+from robotwright.sensors.lidar import LidarSensor, LidarSensorData
+
+__all__ = ["SemanticLidarData", "SemanticLidarSensor"]
+
+
+@dataclass
+class SemanticLidarData(LidarSensorData):
+    """:class:`LidarSensorData` plus semantic fields (seed 004).
+
+    Attributes:
+        semantic_labels: ``(E, N)`` int32 class id per ray: 1..K in mapping order,
+            0 for a miss or a hit on a geom no keyword matches. ``None`` when
+            ``return_semantic_labels`` is False.
+        mesh_ids: ``(E, N)`` int32 id of the hit geom (MuJoCo geom id), -1 on a miss.
+            ``None`` unless ``return_mesh_ids`` is True.
+    """
+
+    semantic_labels: np.ndarray | None = None
+    mesh_ids: np.ndarray | None = None
+
+
+class SemanticLidarSensor(LidarSensor):
+    """LiDAR with per-ray semantic labels from keyword matching on geom paths.
+
+    Args:
+        cfg: a :class:`SemanticLidarCfg`.
+        model: the compiled MuJoCo model.
+        data: one ``MjData`` or a list of them (one per environment).
+
+    Attributes:
+        semantic_class_mapping: class name -> keywords (the config's, or the default).
+        class_names: ``("unknown", <class 1>, ..., <class K>)``, indexed by class id.
+        mesh_id_to_semantic_class: geom id -> class id, for every hittable geom.
+    """
+
+    cfg: SemanticLidarCfg
+
+    def __init__(
+        self, cfg: SemanticLidarCfg, model: mujoco.MjModel, data: mujoco.MjData | Sequence[mujoco.MjData]
+    ) -> None:
+        if not isinstance(cfg, SemanticLidarCfg):
+            raise SensorError(f"cfg: expected a SemanticLidarCfg, got {type(cfg).__name__}")
+        assert cfg.semantic_class_mapping is not None  # filled by SemanticLidarCfg.__post_init__
+        self.semantic_class_mapping: dict[str, list[str]] = {k: list(v) for k, v in cfg.semantic_class_mapping.items()}
+        self.class_names: tuple[str, ...] = ("unknown", *self.semantic_class_mapping)
+        self._keywords = [
+            (cls_id, [k.lower() for k in keywords])
+            for cls_id, keywords in enumerate(self.semantic_class_mapping.values(), start=1)
+        ]
+        super().__init__(cfg, model, data)
+        self.mesh_id_to_semantic_class: dict[int, int] = {}
+        self._initialize_warp_meshes()
+
+    @property
+    def return_semantic_labels(self) -> bool:
+        return bool(self.cfg.return_semantic_labels)
+
+    @property
+    def return_mesh_ids(self) -> bool:
+        return bool(self.cfg.return_mesh_ids)
+
+    @property
+    def data(self) -> SemanticLidarData:
+        return self._data  # type: ignore[return-value]
+
+    def _make_data(self) -> SemanticLidarData:
+        base = super()._make_data()
+        shape = (self.num_envs, self.num_rays)
+        return SemanticLidarData(
+            **vars(base),
+            semantic_labels=np.zeros(shape, dtype=np.int32) if self.cfg.return_semantic_labels else None,
+            mesh_ids=np.full(shape, -1, dtype=np.int32) if self.cfg.return_mesh_ids else None,
+        )
+
+    def _classify_mesh_path(self, mesh_prim_path: str) -> int:
+        """Class id of a path: first class (mapping order) with a keyword in it; 0 if none.
+
+        Matching is case-insensitive substring search, as in the seed.
+        """
+        path = mesh_prim_path.lower()
+        for cls_id, keywords in self._keywords:
+            if any(k in path for k in keywords):
+                return cls_id
+        return 0
+
+    def _initialize_warp_meshes(self) -> None:
+        """Classify every hittable geom once (seed name; the "meshes" here are MuJoCo geoms).
+
+        Builds ``mesh_id_to_semantic_class`` and a lookup table indexed by ``geom id + 1``
+        so that a miss (-1) maps to class 0.
+        """
+        self.geom_semantic_class = np.zeros(self.model.ngeom, dtype=np.int32)
+        for g in np.flatnonzero(self.hittable_geom_mask):
+            cls_id = self._classify_mesh_path(self._geom_paths[g])
+            self.geom_semantic_class[g] = cls_id
+            self.mesh_id_to_semantic_class[int(g)] = cls_id
+        self._label_lut = np.concatenate([[0], self.geom_semantic_class]).astype(np.int32)
+
+    def update(self) -> None:
+        super().update()
+        self._compute_semantic_labels(None)
+
+    def _compute_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
+        """Fill labels (and mesh ids) of ``env_ids`` (all when None) from the hit geom ids."""
+        rows = self._rows(env_ids)
+        ids = self._raw_geom_ids[rows]
+        if self._data.semantic_labels is not None:
+            self._data.semantic_labels[rows] = self._label_lut[ids + 1]
+        if self._data.mesh_ids is not None:
+            self._data.mesh_ids[rows] = ids
+
+    def get_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
+        """Class id per ray ``(num_envs, num_rays)`` int32 (0 = miss/unknown)."""
+        if self._data.semantic_labels is None:
+            raise SensorError("semantic labels are off: set SemanticLidarCfg.return_semantic_labels=True")
+        return self._data.semantic_labels[self._rows(env_ids)].copy()
+
+    def get_mesh_ids(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
+        """Hit geom id per ray ``(num_envs, num_rays)`` int32 (-1 = miss)."""
+        if self._data.mesh_ids is None:
+            raise SensorError("mesh ids are off: set SemanticLidarCfg.return_mesh_ids=True")
+        return self._data.mesh_ids[self._rows(env_ids)].copy()
+
+    def geom_path(self, geom_id: int) -> str:
+        """The classification path of a geom (``/world/<bodies>/<geom>[/<mesh>]``)."""
+        return self._geom_paths[int(geom_id)]
