@@ -6,8 +6,8 @@ whose entries name the file, the rule or component, and the field.
 
 from __future__ import annotations
 
-from importlib import resources
 import warnings
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +24,7 @@ from robotwright.grammar.library import (
 )
 from robotwright.grammar.rules import Grammar, Rule
 from robotwright.grammar.symbols import NodePattern, NodeState, Symbol, parse_chain
+
 
 class GrammarWarning(UserWarning):
     """Something in a grammar is suspicious but not wrong (e.g. a symbol never produced)."""
