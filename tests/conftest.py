@@ -27,7 +27,9 @@ def g1_hrdf_dir() -> Path:
 @pytest.fixture
 def synth_hrdf_dir() -> Path:
     """hurodes-written small synthetic hinge robot from ../shared/fixtures."""
-    return _need(HURODES_FIXTURES / "synth_baseline_hinge", "hurodes synthetic fixture not available")
+    return _need(
+        HURODES_FIXTURES / "synth_baseline_hinge", "hurodes synthetic fixture not available"
+    )
 
 
 @pytest.fixture

@@ -30,8 +30,15 @@ def fetch_mjlab() -> Path:
         return dest
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [
-            sys.executable, "-m", "pip", "download", "--no-deps", "--quiet",
-            "-d", tmp, f"mjlab=={MJLAB_VERSION}",
+            sys.executable,
+            "-m",
+            "pip",
+            "download",
+            "--no-deps",
+            "--quiet",
+            "-d",
+            tmp,
+            f"mjlab=={MJLAB_VERSION}",
         ]
         print("fetching:", " ".join(cmd[2:]))
         subprocess.run(cmd, check=True)

@@ -340,17 +340,17 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             out.append(
                 Problem("mesh.csv", f"scale {m.scale}: expected > 0", row=i, column="scale0")
             )
-        if m.file is not None and hrdf.root_dir is not None and not Path(m.file).is_absolute():
-            if not _inside(hrdf.root_dir, m.file):
-                out.append(
-                    Problem(
-                        "mesh.csv",
-                        f"mesh file '{m.file}' escapes the robot folder",
-                        row=i,
-                        column="file",
-                    )
+        relative = m.file is not None and not Path(m.file).is_absolute()
+        if relative and hrdf.root_dir is not None and not _inside(hrdf.root_dir, m.file):
+            out.append(
+                Problem(
+                    "mesh.csv",
+                    f"mesh file '{m.file}' escapes the robot folder",
+                    row=i,
+                    column="file",
                 )
-                continue
+            )
+            continue
         if check_files:
             path = hrdf.mesh_path(m)
             if not _is_file(path, listings):

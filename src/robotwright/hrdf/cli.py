@@ -1,0 +1,103 @@
+"""``robotwright validate`` and ``robotwright info``."""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+
+from robotwright.hrdf.assets import resolve_robot
+from robotwright.hrdf.io import HRDFWarning
+from robotwright.hrdf.model import HRDF
+from robotwright.hrdf.validate import validate_dir
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "validate",
+        help="check an HRDF folder and report every problem",
+        description="Check an HRDF folder; print every problem (file, row, column, what "
+        "was expected); exit 1 when any is an error.",
+    )
+    p.add_argument("path", help="HRDF folder or robot name")
+    p.set_defaults(func=_validate)
+
+    p = sub.add_parser(
+        "info",
+        help="summarise a robot (bodies, joints, actuators, mass, DoF)",
+        description="Print a readable summary of a robot given by HRDF folder or name.",
+    )
+    p.add_argument("robot", help="HRDF folder or robot name")
+    p.set_defaults(func=_info)
+
+
+def _validate(args: argparse.Namespace) -> int:
+    path = resolve_robot(args.path)
+    problems = validate_dir(path)
+    errors = [p for p in problems if p.severity == "error"]
+    for p in problems:
+        print(f"{p.severity}: {p}")
+    if errors:
+        print(f"{path}: {len(errors)} error(s), {len(problems) - len(errors)} warning(s)")
+        return 1
+    print(f"{path}: valid ({len(problems)} warning(s))")
+    return 0
+
+
+def _table(headers: list[str], rows: list[list[str]]) -> str:
+    widths = [
+        max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(headers)
+    ]
+    line = "  ".join(h.ljust(w) for h, w in zip(headers, widths, strict=True)).rstrip()
+    out = [line, "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows]
+    return "\n".join(out)
+
+
+def format_info(hrdf: HRDF) -> str:
+    """A readable multi-table summary of a robot."""
+    s = hrdf.summary()
+    head = (
+        f"robot {s['name']}: {s['bodies']} bodies, {s['joints']} joints, "
+        f"{s['actuators']} actuators, {s['dof']} DoF, total mass {s['total_mass']:.5f} kg, "
+        f"{'floating' if s['floating_base'] else 'fixed'} base"
+    )
+    bodies = [
+        [
+            b.name,
+            hrdf.bodies[b.parent].name if b.parent >= 0 else "-",
+            f"{b.mass:.4g}",
+            ", ".join(f"{j.name or '(free)'}:{j.type}" for j in hrdf.joints_of(b.name)) or "-",
+        ]
+        for b in hrdf.bodies
+    ]
+    joints = [
+        [
+            j.name or "(free)",
+            j.type,
+            j.body,
+            "-" if j.range is None else f"[{j.range[0]:.4g}, {j.range[1]:.4g}]",
+        ]
+        for j in hrdf.joints
+    ]
+    acts = [
+        [a.name or "-", a.type, a.joint, "-" if a.peak_torque is None else f"{a.peak_torque:g}"]
+        for a in hrdf.actuators
+    ]
+    parts = [
+        head,
+        "",
+        _table(["body", "parent", "mass [kg]", "joints"], bodies),
+        "",
+        _table(["joint", "type", "body", "range"], joints),
+    ]
+    if acts:
+        parts += ["", _table(["actuator", "type", "joint", "peak torque"], acts)]
+    return "\n".join(parts)
+
+
+def _info(args: argparse.Namespace) -> int:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HRDFWarning)
+        hrdf = HRDF.from_dir(resolve_robot(args.robot))
+    print(format_info(hrdf))
+    return 0

@@ -1,0 +1,48 @@
+"""``robotwright info`` and ``--help`` on every subcommand."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from robotwright.cli import build_parser
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "robotwright", *args], capture_output=True, text=True
+    )
+
+
+def test_info_table() -> None:
+    out = run("info", "arm6")
+    assert out.returncode == 0, out.stderr
+    assert (
+        "robot arm6: 7 bodies, 6 joints, 6 actuators, 6 DoF, total mass 7.70000 kg, fixed base"
+        in out.stdout
+    )
+    assert "shoulder_pan_servo   position  shoulder_pan_joint   60" in out.stdout
+
+
+def test_info_unknown_robot_is_clear_error() -> None:
+    out = run("info", "no_such_robot")
+    assert out.returncode == 2
+    assert "no robot named 'no_such_robot'" in out.stderr
+
+
+def test_every_subcommand_has_help() -> None:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    assert {"validate", "info", "demo"} <= set(sub.choices)
+    for name, p in sub.choices.items():
+        text = p.format_help()
+        assert text.startswith("usage: robotwright " + name), name
+        assert p.description, f"{name} has no description"
+
+
+@pytest.mark.parametrize("cmd", ["validate", "info", "demo"])
+def test_help_exits_zero(cmd: str) -> None:
+    out = run(cmd, "--help")
+    assert out.returncode == 0 and "usage:" in out.stdout
