@@ -14,7 +14,7 @@ import os
 import shutil
 import tempfile
 import warnings
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -133,7 +133,7 @@ def _read_table(
 
     plan = [(col, [index[h] for h in col.headers]) for col in schema if col.headers[0] in index]
     absent = {col.field: col.default for col in schema if col.headers[0] not in index}
-    data = [cells for cells in reader if cells and any(c.strip() for c in cells)]
+    data = [cells for cells in reader if cells and (len(cells) > 1 or cells[0].strip())]
     if all(len(cells) == len(header) for cells in data):
         fast = _convert_table_fast(data, plan, absent, empty_ok_here) if data else []
         if fast is not None:
@@ -469,12 +469,16 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
             records[stem] = []
             continue
         cls = _RECORD_TYPES[stem]
-        names = {f.name for f in fields(cls)}
-        fill = {"parent": -1} if stem == "body" else {}
-        records[stem] = [
-            cls(**fill, **{k: v for k, v in row.items() if k in names}) if row is not None else None
-            for row in table.rows
-        ]
+        if stem == "body":
+            # "id" is checked against the row position below; "parent" comes from meta.yaml.
+            records[stem] = [
+                None
+                if row is None
+                else cls(parent=-1, **{k: v for k, v in row.items() if k != "id"})
+                for row in table.rows
+            ]
+        else:
+            records[stem] = [None if row is None else cls(**row) for row in table.rows]
 
     # Body ids must match row order: hurodes silently uses row order, we refuse to guess.
     body_rows = tables["body"].rows
@@ -503,10 +507,11 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
                 )
             )
         else:
-            bodies = [
-                None if b is None else _replace(b, parent=p)  # type: ignore[list-item]
-                for b, p in zip(bodies, parent_ids, strict=True)
-            ]
+            for b, p in zip(bodies, parent_ids, strict=True):
+                if b is not None:
+                    # Records made a few lines above and not yet shared: set in place
+                    # (dataclasses.replace costs a third of the table reading time).
+                    object.__setattr__(b, "parent", p)
 
     joints: list[Joint] = [j for j in records["joint"] if j is not None]
     floating = ext.get("floating_base", True if hurodes_format else None)
@@ -551,12 +556,6 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
         return None, problems
     problems.extend(check_model(hrdf, check_files=True))
     return hrdf, problems
-
-
-def _replace(record: Any, **changes: Any) -> Any:
-    from dataclasses import replace
-
-    return replace(record, **changes)
 
 
 def read_hrdf_dir(path: str | Path) -> HRDF:

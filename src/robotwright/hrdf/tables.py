@@ -45,14 +45,15 @@ class Column:
     default: Any = NO_DEFAULT
     empty_ok: bool = False
 
-    @property
-    def headers(self) -> list[str]:
-        if self.size == 0:
-            return [self.csv]
-        return [f"{self.csv}{i}" for i in range(self.size)]
+    headers: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        # Computed once: the reader consults it for every cell.
+        names = (self.csv,) if self.size == 0 else tuple(f"{self.csv}{i}" for i in range(self.size))
+        object.__setattr__(self, "headers", names)
 
 
-def _geom_common(ext_defaults: bool = True) -> list[Column]:
+def _geom_common() -> list[Column]:
     return [
         Column("contact_type", "int", "contact_type"),
         Column("contact_affinity", "int", "contact_affinity"),

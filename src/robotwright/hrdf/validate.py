@@ -25,6 +25,7 @@ from robotwright.hrdf.model import (
     JOINT_TYPES,
     SIMPLE_GEOM_TYPES,
     SITE_TYPES,
+    MeshGeom,
 )
 
 QUAT_NORM_TOL = 1e-4
@@ -270,15 +271,22 @@ def _inside(root: Path, rel: str) -> bool:
     return True
 
 
-def _is_file(path: Path, listings: dict[str, set[str]]) -> bool:
+def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
+    # Plain strings: this runs for every mesh row on every load.
+    if mesh.file is None and hrdf.root_dir is not None:
+        return f"{hrdf.root_dir}{os.sep}meshes{os.sep}{mesh.name}.{hrdf.meta.mesh_file_type}"
+    return str(hrdf.mesh_path(mesh))
+
+
+def _is_file(path: str, listings: dict[str, set[str]]) -> bool:
     """Existence check through one directory listing per folder (meshes share a folder)."""
-    folder = str(path.parent)
+    folder, _, name = path.rpartition(os.sep)
     if folder not in listings:
         try:
             listings[folder] = {e.name for e in os.scandir(folder) if e.is_file()}
         except OSError:
             listings[folder] = set()
-    return path.name in listings[folder]
+    return name in listings[folder]
 
 
 def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Problem]:
@@ -352,7 +360,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             )
             continue
         if check_files:
-            path = hrdf.mesh_path(m)
+            path = _mesh_file(hrdf, m)
             if not _is_file(path, listings):
                 out.append(
                     Problem("mesh.csv", f"mesh file '{path}' does not exist", row=i, column="name")

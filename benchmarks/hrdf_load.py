@@ -1,0 +1,78 @@
+#!/usr/bin/env python
+"""Time ``HRDF.from_dir`` on the G1 fixture: robotwright vs hurodes, same folder, same run.
+
+    python benchmarks/hrdf_load.py [--hurodes-python /path/to/python-with-hurodes]
+
+hurodes only loads folders under ``~/.hurodes/robots``; the script copies the fixture
+there (to a temporary name it removes afterwards) for the peer's run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+import uuid
+import warnings
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _timing import median_seconds, report, run_peer  # noqa: E402
+
+from robotwright.hrdf import HRDF  # noqa: E402
+
+DEFAULT_FIXTURE = Path(__file__).resolve().parents[2] / "shared" / "fixtures" / "hurodes" / "g1_29"
+
+PEER_CODE = """
+import json, statistics, time, warnings
+warnings.simplefilter("ignore")
+from hurodes.hrdf.hrdf import HRDF
+path = {path!r}
+HRDF.from_dir(path)
+samples = []
+for _ in range({repeat}):
+    t0 = time.perf_counter()
+    for _ in range({number}):
+        HRDF.from_dir(path)
+    samples.append((time.perf_counter() - t0) / {number})
+print(json.dumps({{"median": statistics.median(samples)}}))
+"""
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--fixture", type=Path, default=DEFAULT_FIXTURE)
+    ap.add_argument("--hurodes-python", help="python interpreter that has hurodes installed")
+    ap.add_argument("--repeat", type=int, default=15)
+    ap.add_argument("--number", type=int, default=10)
+    args = ap.parse_args()
+    if not (args.fixture / "meta.yaml").is_file():
+        print(f"fixture not found: {args.fixture}", file=sys.stderr)
+        return 2
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        hrdf = HRDF.from_dir(args.fixture)
+        ours = median_seconds(
+            lambda: HRDF.from_dir(args.fixture), repeat=args.repeat, number=args.number
+        )
+    print(f"robot: {hrdf.name}, {len(hrdf.bodies)} bodies, {len(hrdf.meshes)} mesh rows")
+
+    peer = None
+    if args.hurodes_python:
+        robots = Path.home() / ".hurodes" / "robots"
+        name = f"bench_{uuid.uuid4().hex[:8]}"
+        shutil.copytree(args.fixture, robots / name)
+        try:
+            code = PEER_CODE.format(path=str(robots / name), repeat=args.repeat, number=args.number)
+            peer = run_peer(args.hurodes_python, code)["median"]
+        finally:
+            shutil.rmtree(robots / name, ignore_errors=True)
+    report([("HRDF.from_dir (G1, 30 bodies)", ours, peer)])
+    print(json.dumps({"ours_s": ours, "hurodes_s": peer}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
