@@ -37,6 +37,8 @@ from robotwright.hrdf.model import (
 # Gripper proportions relative to its finger length; a parallel-jaw hand, drawn simply.
 _PALM_FRACTION = 0.4
 _FINGER_WIDTH_FRACTION = 0.25
+# Gap (m) between the base's top face and a connector housing standing on it.
+_CLEARANCE = 0.002
 
 
 def trans(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
@@ -285,8 +287,15 @@ class _Builder:
         body = LimbBody(self.name("base"), -1, np.eye(4), root.id, comp.name)
         body.geoms.append(LimbGeom(f"{body.name}_geom", "cylinder", (r, t / 2, 0.0), (0.0, 0.0, t / 2), (1.0, 0.0, 0.0, 0.0), comp.rgba, comp.density))
         self.bodies.append(body)
-        base_frame = trans(z=t)
         for child in root.children:
+            # A connector stands on the base's top face: its joint frame is raised so
+            # that its housing and the first link clear the base (MuJoCo does not
+            # filter contacts between a fixed base and its children).
+            standoff = 0.0
+            if child.component is not None and self.comp(child).kind == "connector":
+                h = self.comp(child).housing
+                standoff = max(h["length"], h["diameter"]) / 2 + _CLEARANCE
+            base_frame = trans(z=t + standoff)
             self.visit(child, body_index=0, frame=base_frame, acc=(0.0, 0.0), pending=[], rows=[], base_frame=base_frame)
 
     def visit(

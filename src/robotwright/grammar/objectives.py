@@ -1,0 +1,234 @@
+"""Objectives and constraints for design search, evaluated on built limbs.
+
+An objective maps an :class:`EvalContext` to a number and says whether larger is
+better; a constraint returns ``None`` when satisfied or a message naming the
+violation. Both are small frozen dataclasses, so they pickle into worker processes.
+Units: metres, cubic metres, kilograms, radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Protocol, runtime_checkable
+
+import mujoco
+import numpy as np
+
+from robotwright.grammar.build import Limb, build
+from robotwright.grammar.design import Design
+from robotwright.grammar.rules import Grammar
+
+
+class EvalContext:
+    """Lazily built views of one design shared by all objectives and constraints."""
+
+    def __init__(self, grammar: Grammar, design: Design) -> None:
+        self.grammar = grammar
+        self.design = design
+
+    @cached_property
+    def limb(self) -> Limb:
+        return build(self.grammar, self.design)
+
+    @cached_property
+    def model(self) -> mujoco.MjModel:
+        return self.limb.to_spec().compile()
+
+    def tool_points(self, samples: int, seed: int) -> np.ndarray:
+        """Tool-point positions (m, mount frame) of every branch for ``samples`` joint
+        vectors drawn uniformly inside the joint ranges (seeded), plus the zero pose."""
+        key = (samples, seed)
+        cache = self.__dict__.setdefault("_points", {})
+        if key not in cache:
+            rng = np.random.default_rng(seed)
+            limb = self.limb
+            names = [j.name for j in limb.joints]
+            lo, hi = limb.joint_ranges().T if limb.joints else (np.zeros(0), np.zeros(0))
+            q = rng.uniform(lo, hi, size=(samples, len(names)))
+            q = np.vstack([np.clip(np.zeros(len(names)), lo, hi), q])
+            pts = []
+            for br in limb.branches:
+                cols = [names.index(n) for n in br.joints]
+                pts.append(br.tool_pose(q[:, cols])[..., :3, 3])
+            cache[key] = np.concatenate(pts) if pts else np.zeros((0, 3))
+        return cache[key]
+
+
+@runtime_checkable
+class Objective(Protocol):
+    name: str
+    maximize: bool
+
+    def __call__(self, ctx: EvalContext) -> float: ...
+
+
+@runtime_checkable
+class Constraint(Protocol):
+    name: str
+
+    def __call__(self, ctx: EvalContext) -> str | None: ...
+
+
+@dataclass(frozen=True)
+class Reach:
+    """Largest distance (m) of a tool point from the mount origin over sampled poses."""
+
+    samples: int = 256
+    seed: int = 0
+    name: str = "reach"
+    maximize: bool = True
+
+    def __call__(self, ctx: EvalContext) -> float:
+        pts = ctx.tool_points(self.samples, self.seed)
+        return float(np.linalg.norm(pts, axis=1).max()) if len(pts) else 0.0
+
+
+@dataclass(frozen=True)
+class WorkspaceVolume:
+    """Volume (m^3) of the voxels (edge ``voxel`` m) hit by sampled tool points."""
+
+    samples: int = 2048
+    voxel: float = 0.02
+    seed: int = 0
+    name: str = "workspace"
+    maximize: bool = True
+
+    def __post_init__(self) -> None:
+        if self.voxel <= 0 or self.samples < 1:
+            raise ValueError("WorkspaceVolume: voxel must be > 0 m and samples >= 1")
+
+    def __call__(self, ctx: EvalContext) -> float:
+        pts = ctx.tool_points(self.samples, self.seed)
+        cells = np.unique(np.floor(pts / self.voxel).astype(np.int64), axis=0)
+        return float(len(cells) * self.voxel**3)
+
+
+@dataclass(frozen=True)
+class Mass:
+    """Total limb mass (kg), from MuJoCo's inertia computation; smaller is better."""
+
+    name: str = "mass"
+    maximize: bool = False
+
+    def __call__(self, ctx: EvalContext) -> float:
+        return float(ctx.model.body_mass.sum())
+
+
+@dataclass(frozen=True)
+class DoFCount:
+    """Number of joint DoFs; larger is better unless ``maximize=False``."""
+
+    name: str = "dof"
+    maximize: bool = True
+
+    def __call__(self, ctx: EvalContext) -> float:
+        return float(ctx.limb.dof)
+
+
+@dataclass(frozen=True)
+class MaxMass:
+    limit: float
+    name: str = "max-mass"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        m = float(ctx.model.body_mass.sum())
+        return None if m <= self.limit else f"mass {m:.3f} kg > {self.limit} kg"
+
+
+@dataclass(frozen=True)
+class DoFRange:
+    low: int = 0
+    high: int = 1_000_000
+    name: str = "dof-range"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        n = ctx.limb.dof
+        return None if self.low <= n <= self.high else f"{n} DoF outside [{self.low}, {self.high}]"
+
+
+@dataclass(frozen=True)
+class JointLimitsFeasible:
+    """Every joint range is non-empty and contains the zero pose."""
+
+    name: str = "joint-limits"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        bad = [j.name for j in ctx.limb.joints if not (j.range[0] < j.range[1] and j.range[0] <= 0.0 <= j.range[1])]
+        return None if not bad else f"joint ranges empty or excluding 0: {bad}"
+
+
+@dataclass(frozen=True)
+class NoSelfCollision:
+    """No contact between limb geoms at the zero pose (MuJoCo collision detection;
+    parent-child body pairs are excluded, as MuJoCo does by default)."""
+
+    name: str = "no-self-collision"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        model = ctx.model
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        if data.ncon == 0:
+            return None
+        pairs = sorted(
+            {
+                tuple(sorted((model.geom(int(c.geom1)).name, model.geom(int(c.geom2)).name)))
+                for c in data.contact[: data.ncon]
+            }
+        )
+        return f"self-collision at zero pose: {pairs}"
+
+
+OBJECTIVES: dict[str, type] = {"reach": Reach, "workspace": WorkspaceVolume, "mass": Mass, "dof": DoFCount}
+
+
+def make_constraint(text: str) -> Constraint:
+    """Parse ``no-self-collision``, ``joint-limits``, ``max-mass=KG``, ``max-dof=N``, ``min-dof=N``."""
+    name, _, value = text.partition("=")
+    try:
+        if name == "no-self-collision":
+            return NoSelfCollision()
+        if name == "joint-limits":
+            return JointLimitsFeasible()
+        if name == "max-mass":
+            return MaxMass(float(value))
+        if name == "max-dof":
+            return DoFRange(high=int(value))
+        if name == "min-dof":
+            return DoFRange(low=int(value))
+    except ValueError:
+        raise ValueError(f"constraint {text!r}: {name} needs a number, e.g. {name}=2") from None
+    raise ValueError(
+        f"unknown constraint {text!r}: expected no-self-collision, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
+    )
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Result of evaluating one design: objective values, violations, and the score
+    (the first objective, negated when minimised; ``-inf`` when infeasible)."""
+
+    design: Design
+    values: dict[str, float] = field(default_factory=dict)
+    violations: tuple[str, ...] = ()
+    score: float = float("-inf")
+
+    @property
+    def feasible(self) -> bool:
+        return not self.violations
+
+
+def evaluate(
+    grammar: Grammar,
+    design: Design,
+    objectives: tuple[Objective, ...],
+    constraints: tuple[Constraint, ...] = (),
+) -> Evaluation:
+    """Evaluate a design: every objective and constraint on one shared context."""
+    ctx = EvalContext(grammar, design)
+    values = {o.name: float(o(ctx)) for o in objectives}
+    violations = tuple(v for c in constraints if (v := c(ctx)) is not None)
+    first = objectives[0]
+    score = values[first.name] if first.maximize else -values[first.name]
+    return Evaluation(design, values, violations, score if not violations else float("-inf"))
