@@ -19,6 +19,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.hrdf.cli",
     "robotwright.demo",
     "robotwright.sensors.cli",
+    "robotwright.grammar.cli",
 )
 
 
