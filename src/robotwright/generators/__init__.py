@@ -1,0 +1,20 @@
+"""Generators (seed 000): HRDF robots to MJCF and URDF, and multi-robot composites.
+
+>>> from robotwright.generators import MJCFHumanoidGenerator
+>>> gen = MJCFHumanoidGenerator.from_robot_name("mini_humanoid")  # doctest: +SKIP
+>>> gen.export("out/robot.xml")                                     # doctest: +SKIP
+"""
+
+from robotwright.generators.base import GeneratorBase
+from robotwright.generators.mixin import HRDFMixin
+from robotwright.generators.mjcf import MJCFHumanoidGenerator
+from robotwright.generators.mjcf_base import DEFAULT_SCENE, MJCFGeneratorBase, SceneDefaults
+
+__all__ = [
+    "DEFAULT_SCENE",
+    "GeneratorBase",
+    "HRDFMixin",
+    "MJCFGeneratorBase",
+    "MJCFHumanoidGenerator",
+    "SceneDefaults",
+]

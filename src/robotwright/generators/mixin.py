@@ -1,0 +1,82 @@
+"""``HRDFMixin``: loads an :class:`~robotwright.hrdf.HRDF` robot into a generator (seed 000).
+
+Generators themselves do not depend on HRDF (other producers can feed them); this mixin
+adds the HRDF input: ``load(hrdf)``, ``from_hrdf``, ``from_hrdf_path``, ``from_robot_name``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, TypeVar
+
+from robotwright.errors import GeneratorError, HRDFError
+from robotwright.generators.base import GeneratorBase
+from robotwright.hrdf.model import HRDF
+
+T = TypeVar("T", bound="HRDFMixin")
+
+
+class HRDFMixin:
+    """Adds an ``hrdf`` input to a :class:`GeneratorBase` subclass.
+
+    The HRDF is read, never modified: generation options such as a name prefix only
+    change the output.
+    """
+
+    hrdf: HRDF | None
+
+    def __init__(self, **kwargs: Any) -> None:
+        if not isinstance(self, GeneratorBase):
+            raise TypeError(f"{type(self).__name__}: HRDFMixin needs a GeneratorBase subclass")
+        super().__init__(**kwargs)
+        self.hrdf = None
+
+    def _load(self, hrdf: HRDF | None = None, **kwargs: Any) -> None:
+        """Take ``hrdf`` after checking it (every problem listed in one :class:`HRDFError`)."""
+        if kwargs:
+            raise GeneratorError(
+                f"{type(self).__name__}.load(): unexpected argument(s) {sorted(kwargs)}; "
+                "expected load(hrdf)"
+            )
+        if not isinstance(hrdf, HRDF):
+            raise GeneratorError(
+                f"{type(self).__name__}.load(): expected an HRDF robot, got {type(hrdf).__name__}"
+            )
+        from robotwright.hrdf.validate import check_model
+
+        errors = [p for p in check_model(hrdf, check_files=False) if p.severity == "error"]
+        if errors:
+            raise HRDFError(errors, f"robot '{hrdf.name}' cannot be generated")
+        self.hrdf = hrdf
+        self._on_hrdf_loaded(hrdf)
+
+    def _on_hrdf_loaded(self, hrdf: HRDF) -> None:
+        """Hook for generator bases that take settings from the robot (e.g. simulator)."""
+
+    def _clean(self) -> None:
+        self.hrdf = None
+
+    @property
+    def loaded_hrdf(self) -> HRDF:
+        """The loaded robot (:class:`GeneratorError` when nothing is loaded)."""
+        if self.hrdf is None:
+            raise GeneratorError(f"{type(self).__name__}: no HRDF loaded")
+        return self.hrdf
+
+    @classmethod
+    def from_hrdf(cls: type[T], hrdf: HRDF, **kwargs: Any) -> T:
+        """A generator loaded with ``hrdf`` (``kwargs`` go to the constructor)."""
+        instance = cls(**kwargs)
+        instance.load(hrdf)  # type: ignore[attr-defined]
+        return instance
+
+    @classmethod
+    def from_hrdf_path(cls: type[T], hrdf_path: str | Path, **kwargs: Any) -> T:
+        """A generator loaded with the HRDF folder at ``hrdf_path`` (anywhere on disk)."""
+        return cls.from_hrdf(HRDF.from_dir(hrdf_path), **kwargs)
+
+    @classmethod
+    def from_robot_name(cls: type[T], robot_name: str, **kwargs: Any) -> T:
+        """A generator loaded with robot ``robot_name``: ``$HURODES_ASSETS_PATH/robots/<name>``,
+        then the bundled robots."""
+        return cls.from_hrdf(HRDF.from_robot_name(robot_name), **kwargs)

@@ -1,0 +1,424 @@
+"""``MJCFHumanoidGenerator``: one HRDF robot (any tree: humanoid, arm, quadruped) to MJCF.
+
+Mapping (HRDF record -> MJCF element), all values written exactly (see ``xmlfmt``):
+
+- ``Body`` -> ``<body name pos quat>`` with ``<inertial pos quat mass diaginertia>``.
+- ``Joint`` -> ``<joint>`` (several per body, in table order); the root's ``free`` joint
+  -> ``<freejoint/>`` (unnamed when the HRDF has no name, like hurodes). ``range=None``
+  writes no range (unlimited). ``dynamic_friction`` -> ``frictionloss``,
+  ``viscous_friction`` -> ``damping``; ``armature``, ``stiffness``, ``springref``,
+  ``ref`` when non-zero.
+- ``Actuator`` -> ``<motor>``/``<position>``/``<velocity>`` in HRDF order. A motor's
+  control range is ``ctrl_range``, else ``[-peak_torque, peak_torque]`` (hurodes);
+  ``p_gain`` -> ``kp``, ``d_gain`` -> ``kv``; ``force_range`` -> ``forcerange`` (for
+  position/velocity actuators ``peak_torque`` gives the force range when none is set).
+- ``MeshGeom``/``SimpleGeom`` -> ``<geom>`` with contype/conaffinity, condim, group,
+  friction (static, torsional, rolling), rgba; meshes become ``<mesh>`` assets (with
+  scale). ``Site`` -> ``<site>``; ``Sensor`` -> its sensor element.
+- ``meta.imu_config_list`` -> a site per IMU plus ``framequat``/``gyro``/
+  ``accelerometer`` sensors named ``<imu>_quat``/``<imu>_angvel``/``<imu>_linacc``.
+- ``meta.simulator_config`` -> ``<option>`` and the scene; ``mjcf_extra`` sections
+  (tendon, equality, contact, keyframe, ...) are merged in, names prefixed.
+
+What MJCF cannot hold (restitution, a static friction that differs from the dynamic one,
+gains of torque motors, peak velocities) is reported in one :class:`ConversionWarning`,
+or raised as :class:`ConversionError` with ``strict=True``.
+"""
+
+from __future__ import annotations
+
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from robotwright.errors import ConversionError, ConversionWarning, GeneratorError, Problem
+from robotwright.generators.mixin import HRDFMixin
+from robotwright.generators.mjcf_base import MJCFGeneratorBase, prefix_tree
+from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
+from robotwright.hrdf.model import HRDF, Actuator, Geom, Joint, SimpleGeom
+
+#: IMU quantity -> (MuJoCo sensor, how it names its object).
+IMU_SENSORS: dict[str, str] = {"quat": "framequat", "angvel": "gyro", "linacc": "accelerometer"}
+#: Number of meaningful size values per primitive / site type.
+SIZE_COUNT: dict[str, int] = {
+    "sphere": 1, "capsule": 2, "cylinder": 2, "box": 3, "ellipsoid": 3,
+}  # fmt: skip
+_IDENTITY = (1.0, 0.0, 0.0, 0.0)
+
+
+def imu_names(hrdf: HRDF) -> list[str]:
+    """Site name of each IMU: its hurodes device name, else ``imu`` (``imu<i>`` when a
+    robot has several unnamed IMUs)."""
+    imus = hrdf.meta.imu_config_list or []
+    unnamed = sum(1 for imu in imus if imu.name is None)
+    out = []
+    for i, imu in enumerate(imus):
+        if imu.name is not None:
+            out.append(imu.name)
+        else:
+            out.append("imu" if unnamed == 1 else f"imu{i}")
+    return out
+
+
+def parse_mjcf_extra(hrdf: HRDF) -> ET.Element | None:
+    """The robot's ``mjcf_extra`` fragment parsed safely (no entity expansion)."""
+    if not hrdf.mjcf_extra or not hrdf.mjcf_extra.strip():
+        return None
+    from defusedxml import ElementTree as SafeET
+
+    try:
+        root = SafeET.fromstring(hrdf.mjcf_extra)
+    except Exception as exc:  # defusedxml raises several types; all mean "bad fragment"
+        raise GeneratorError(f"robot '{hrdf.name}': mjcf_extra is not valid XML: {exc}") from exc
+    if root.tag != "mujoco":
+        raise GeneratorError(
+            f"robot '{hrdf.name}': mjcf_extra: expected a <mujoco> element, got <{root.tag}>"
+        )
+    return root
+
+
+class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
+    """HRDF robot -> MJCF. Works for any tree robot, floating or fixed base.
+
+    Example::
+
+        gen = MJCFHumanoidGenerator.from_robot_name("mini_humanoid")
+        xml = gen.export("out/robot.xml", prefix="r1")
+        model = gen.to_model()
+    """
+
+    def _on_hrdf_loaded(self, hrdf: HRDF) -> None:
+        self.simulator_config = hrdf.meta.simulator_config
+
+    def _clean(self) -> None:
+        super()._clean()
+        self.simulator_config = None
+
+    def _model_name(self) -> str:
+        return self.hrdf.name if self.hrdf is not None else "robot"
+
+    def mesh_sources(self) -> list[tuple[str, Path]]:
+        hrdf = self.loaded_hrdf
+        seen: dict[Path, None] = {}
+        for m in hrdf.meshes:
+            seen.setdefault(hrdf.mesh_path(m).resolve(), None)
+        return [(hrdf.name, p) for p in seen]
+
+    # -- generation ---------------------------------------------------------------------
+    def _generate(
+        self,
+        prefix: str | None = None,
+        add_scene: bool = True,
+        relative_mesh_path: bool = True,
+        *,
+        skybox: bool = True,
+        strict: bool = False,
+    ) -> None:
+        """Build the MJCF tree.
+
+        Args:
+            prefix: prepended as ``<prefix>_`` to every name and name reference.
+            add_scene: add ground, light and sky (``add_scene()``).
+            relative_mesh_path: mesh paths relative to the output folder when exporting
+                to a file; absolute otherwise.
+            skybox: with ``add_scene``, also add the gradient skybox.
+            strict: raise :class:`ConversionError` instead of warning about values MJCF
+                cannot hold.
+        """
+        hrdf = self.loaded_hrdf
+        losses: list[Problem] = []
+        self.add_compiler()
+        self.add_option()
+        mesh_names = self._add_mesh_assets(hrdf, prefix)
+        self._add_bodies(hrdf, prefix, mesh_names, losses)
+        self._add_actuators(hrdf, prefix, losses)
+        self._add_sensors(hrdf, prefix)
+        extra = parse_mjcf_extra(hrdf)
+        if extra is not None:
+            prefix_tree(extra, prefix)
+            for section in extra:
+                self.get_elem(section.tag).extend(list(section))
+        if add_scene:
+            self.add_scene(skybox=skybox)
+        self._layout_meshes(relative_mesh_path)
+        self._order_sections()
+        _report(hrdf, "MJCF", losses, strict)
+
+    def _add_mesh_assets(self, hrdf: HRDF, prefix: str | None) -> list[str]:
+        """One ``<mesh>`` per distinct (file, scale); returns the asset name of each row."""
+        asset = self.get_elem("asset")
+        by_key: dict[tuple[Path, tuple[float, float, float]], str] = {}
+        used: set[str] = set()
+        names: list[str] = []
+        checked: set[Path] = set()
+        for row, m in enumerate(hrdf.meshes):
+            path = hrdf.mesh_path(m).resolve()
+            if path not in checked:
+                if not path.is_file():
+                    raise GeneratorError(
+                        f"robot '{hrdf.name}': mesh.csv row {row} (mesh '{m.name}'): "
+                        f"file '{path}' does not exist"
+                    )
+                checked.add(path)
+            key = (path, tuple(m.scale))
+            name = by_key.get(key)
+            if name is None:
+                name, n = m.name, 1
+                while name in used:
+                    name = f"{m.name}_{n}"
+                    n += 1
+                used.add(name)
+                by_key[key] = name
+                attrs = {"name": prefixed(prefix, name), "file": path.as_posix()}
+                if m.scale != (1.0, 1.0, 1.0):
+                    attrs["scale"] = fmt_vec(m.scale)
+                ET.SubElement(asset, "mesh", attrs)
+            names.append(prefixed(prefix, name))
+        return names
+
+    def _add_bodies(
+        self, hrdf: HRDF, prefix: str | None, mesh_names: list[str], losses: list[Problem]
+    ) -> None:
+        joints: dict[str, list[Joint]] = {}
+        for j in hrdf.joints:
+            joints.setdefault(j.body, []).append(j)
+        geoms: dict[str, list[ET.Element]] = {}
+        for row, m in enumerate(hrdf.meshes):
+            el = self._geom_elem(m, prefix, "mesh.csv", row, losses)
+            el.set("type", "mesh")
+            el.set("mesh", mesh_names[row])
+            geoms.setdefault(m.body, []).append(el)
+        for row, g in enumerate(hrdf.simple_geoms):
+            el = self._geom_elem(g, prefix, "simple_geom.csv", row, losses)
+            el.set("type", g.type)
+            el.set("size", fmt_vec(g.size[: SIZE_COUNT[g.type]]))
+            geoms.setdefault(g.body, []).append(el)
+        sites: dict[str, list[ET.Element]] = {}
+        for s in hrdf.sites:
+            el = ET.Element("site", {"name": prefixed(prefix, s.name), "pos": fmt_vec(s.pos)})
+            if s.quat != _IDENTITY:
+                el.set("quat", fmt_vec(s.quat))
+            el.set("type", s.type)
+            el.set("size", fmt_vec(s.size[: SIZE_COUNT.get(s.type, 3)]))
+            el.set("rgba", fmt_vec(s.rgba))
+            if s.group:
+                el.set("group", str(s.group))
+            sites.setdefault(s.body, []).append(el)
+        for imu, name in zip(hrdf.meta.imu_config_list or [], imu_names(hrdf), strict=True):
+            el = ET.Element("site", {"name": prefixed(prefix, name), "pos": fmt_vec(imu.position)})
+            if imu.orientation != _IDENTITY:
+                el.set("quat", fmt_vec(imu.orientation))
+            sites.setdefault(imu.body_name, []).append(el)
+
+        children: dict[int, list[int]] = {}
+        for i, b in enumerate(hrdf.bodies):
+            children.setdefault(b.parent, []).append(i)
+        worldbody = self.get_elem("worldbody")
+        stack: list[tuple[ET.Element, int]] = [
+            (worldbody, i) for i in reversed(children.get(-1, []))
+        ]
+        while stack:
+            parent_el, idx = stack.pop()
+            b = hrdf.bodies[idx]
+            el = ET.SubElement(
+                parent_el,
+                "body",
+                {"name": prefixed(prefix, b.name), "pos": fmt_vec(b.pos), "quat": fmt_vec(b.quat)},
+            )
+            ET.SubElement(
+                el,
+                "inertial",
+                {
+                    "pos": fmt_vec(b.inertial_pos),
+                    "quat": fmt_vec(b.inertial_quat),
+                    "mass": fmt_float(b.mass),
+                    "diaginertia": fmt_vec(b.diag_inertia),
+                },
+            )
+            for j in joints.get(b.name, ()):
+                el.append(self._joint_elem(j, prefix, losses))
+            el.extend(geoms.get(b.name, ()))
+            el.extend(sites.get(b.name, ()))
+            for c in reversed(children.get(idx, [])):
+                stack.append((el, c))
+
+    @staticmethod
+    def _geom_elem(
+        g: Geom, prefix: str | None, table: str, row: int, losses: list[Problem]
+    ) -> ET.Element:
+        name = g.geom_name
+        if name is None and isinstance(g, SimpleGeom):
+            name = g.name
+        el = ET.Element("geom")
+        if name:
+            el.set("name", prefixed(prefix, name))
+        el.set("pos", fmt_vec(g.pos))
+        el.set("quat", fmt_vec(g.quat))
+        el.set("contype", str(g.contact_type))
+        el.set("conaffinity", str(g.contact_affinity))
+        if g.condim != 3:
+            el.set("condim", str(g.condim))
+        if g.group:
+            el.set("group", str(g.group))
+        el.set("friction", fmt_vec((g.static_friction, g.torsional_friction, g.rolling_friction)))
+        el.set("rgba", fmt_vec(g.rgba))
+        if g.restitution is not None:
+            losses.append(
+                Problem(table, "restitution has no MuJoCo meaning: dropped", row, "restitution")
+            )
+        if g.dynamic_friction != g.static_friction:
+            losses.append(
+                Problem(
+                    table,
+                    f"dynamic_friction {g.dynamic_friction} differs from static_friction "
+                    f"{g.static_friction}; MuJoCo has one sliding friction (static written)",
+                    row,
+                    "dynamic_friction",
+                )
+            )
+        return el
+
+    @staticmethod
+    def _joint_elem(j: Joint, prefix: str | None, losses: list[Problem]) -> ET.Element:
+        dyn = {
+            "armature": j.armature,
+            "damping": j.viscous_friction,
+            "frictionloss": j.dynamic_friction,
+            "stiffness": j.stiffness,
+            "springref": j.springref,
+            "ref": j.ref,
+        }
+        if j.static_friction and j.static_friction != j.dynamic_friction:
+            losses.append(
+                Problem(
+                    "joint.csv",
+                    f"joint '{j.name}': static_friction {j.static_friction} differs from "
+                    f"dynamic_friction {j.dynamic_friction}; frictionloss = dynamic_friction",
+                    column="static_friction",
+                )
+            )
+        if j.type == "free" and not any(dyn.values()) and j.range is None:
+            el = ET.Element("freejoint")
+            if j.name:
+                el.set("name", prefixed(prefix, j.name))
+            return el
+        el = ET.Element("joint")
+        if j.name:
+            el.set("name", prefixed(prefix, j.name))
+        el.set("type", j.type)
+        if j.type != "free":
+            el.set("pos", fmt_vec(j.pos))
+        if j.type in ("hinge", "slide"):
+            el.set("axis", fmt_vec(j.axis))
+        if j.range is not None:
+            el.set("range", fmt_vec(j.range))
+            el.set("limited", "true")
+        for key, value in dyn.items():
+            if value:
+                el.set(key, fmt_float(value))
+        return el
+
+    def _add_actuators(self, hrdf: HRDF, prefix: str | None, losses: list[Problem]) -> None:
+        section = self.get_elem("actuator")
+        for row, a in enumerate(hrdf.actuators):
+            section.append(_actuator_elem(a, prefix, row, losses))
+
+    def _add_sensors(self, hrdf: HRDF, prefix: str | None) -> None:
+        section = self.get_elem("sensor")
+        for imu, name in zip(hrdf.meta.imu_config_list or [], imu_names(hrdf), strict=True):
+            site = prefixed(prefix, name)
+            for value in imu.value:
+                kind = IMU_SENSORS[value]
+                attrs = {"name": prefixed(prefix, f"{name}_{value}")}
+                if kind == "framequat":
+                    attrs |= {"objtype": "site", "objname": site}
+                else:
+                    attrs["site"] = site
+                ET.SubElement(section, kind, attrs)
+        for s in hrdf.sensors:
+            attrs = {"name": prefixed(prefix, s.name)}
+            if s.type.startswith("frame"):
+                attrs |= {"objtype": s.objtype, "objname": prefixed(prefix, s.objname)}
+                if s.reftype is not None and s.refname is not None:
+                    attrs |= {"reftype": s.reftype, "refname": prefixed(prefix, s.refname)}
+            else:
+                attrs[s.objtype] = prefixed(prefix, s.objname)
+            if s.noise:
+                attrs["noise"] = fmt_float(s.noise)
+            if s.cutoff:
+                attrs["cutoff"] = fmt_float(s.cutoff)
+            ET.SubElement(section, s.type, attrs)
+
+
+def _actuator_elem(a: Actuator, prefix: str | None, row: int, losses: list[Problem]) -> ET.Element:
+    el = ET.Element(a.type)
+    if a.name:
+        el.set("name", prefixed(prefix, a.name))
+    el.set("joint", prefixed(prefix, a.joint))
+    if a.gear != 1.0:
+        el.set("gear", fmt_float(a.gear))
+    ctrl = a.ctrl_range
+    force = a.force_range
+    if a.type == "motor":
+        if ctrl is None and a.peak_torque is not None:
+            ctrl = (-a.peak_torque, a.peak_torque)
+        if a.p_gain is not None or a.d_gain is not None:
+            losses.append(
+                Problem(
+                    "actuator.csv",
+                    f"motor on '{a.joint}': p_gain/d_gain are controller gains; a MuJoCo "
+                    "motor has none (use type position for servo gains)",
+                    row,
+                    "p_gain",
+                )
+            )
+    else:
+        if force is None and a.peak_torque is not None:
+            force = (-a.peak_torque, a.peak_torque)
+        if a.type == "position" and a.p_gain is not None:
+            el.set("kp", fmt_float(a.p_gain))
+        if a.d_gain is not None:
+            el.set("kv", fmt_float(a.d_gain))
+        if a.type == "velocity" and a.p_gain is not None:
+            losses.append(
+                Problem(
+                    "actuator.csv",
+                    f"velocity actuator on '{a.joint}': p_gain has no meaning",
+                    row,
+                    "p_gain",
+                )
+            )
+    if ctrl is not None:
+        el.set("ctrlrange", fmt_vec(ctrl))
+        el.set("ctrllimited", "true")
+    if force is not None:
+        el.set("forcerange", fmt_vec(force))
+        el.set("forcelimited", "true")
+    if a.peak_velocity is not None:
+        losses.append(
+            Problem(
+                "actuator.csv",
+                f"actuator on '{a.joint}': peak_velocity {a.peak_velocity} has no MJCF field",
+                row,
+                "peak_velocity",
+            )
+        )
+    return el
+
+
+def _report(hrdf: HRDF, fmt: str, losses: list[Problem], strict: bool) -> None:
+    """One warning (or, with ``strict``, one error) listing what the output cannot hold."""
+    if not losses:
+        return
+    if strict:
+        raise ConversionError(losses, f"robot '{hrdf.name}': {fmt} cannot hold every value")
+    shown = "; ".join(str(p) for p in losses[:6])
+    more = f" (+{len(losses) - 6} more)" if len(losses) > 6 else ""
+    warnings.warn(
+        f"robot '{hrdf.name}' to {fmt}: {len(losses)} value(s) not written: {shown}{more}",
+        ConversionWarning,
+        stacklevel=4,
+    )
+
+
+__all__ = ["MJCFHumanoidGenerator", "imu_names", "parse_mjcf_extra"]
