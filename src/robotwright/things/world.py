@@ -1,0 +1,304 @@
+"""World: the root of a Thing tree, its MJCF options, and the lazily built MuJoCo model."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from robotwright.things.attrs import Choice, Flag, Integer, Real, Vector
+from robotwright.things.base import BaseThing
+from robotwright.things.xml_writer import write_mjcf
+
+OPTION_ATTR: dict[str, Any] = {
+    "timestep": Real(nonneg=True),
+    "impratio": Real(nonneg=True),
+    "tolerance": Real(nonneg=True),
+    "ls_tolerance": Real(nonneg=True),
+    "noslip_tolerance": Real(nonneg=True),
+    "ccd_tolerance": Real(nonneg=True),
+    "gravity": Vector(3),
+    "wind": Vector(3),
+    "magnetic": Vector(3),
+    "density": Real(nonneg=True),
+    "viscosity": Real(nonneg=True),
+    "o_margin": Real(),
+    "o_solref": Vector(2),
+    "o_solimp": Vector(5),
+    "o_friction": Vector(5),
+    "integrator": Choice("Euler", "RK4", "implicit", "implicitfast"),
+    "cone": Choice("pyramidal", "elliptic"),
+    "jacobian": Choice("dense", "sparse", "auto"),
+    "solver": Choice("PGS", "CG", "Newton"),
+    "iterations": Integer(minimum=0),
+    "ls_iterations": Integer(minimum=0),
+    "noslip_iterations": Integer(minimum=0),
+    "ccd_iterations": Integer(minimum=0),
+    "sdf_iterations": Integer(minimum=0),
+    "sdf_initpoints": Integer(minimum=0),
+}
+_OPTION_DEFAULTS: dict[str, Any] = {
+    "timestep": 0.002,
+    "impratio": 1.0,
+    "tolerance": 1e-8,
+    "ls_tolerance": 0.01,
+    "noslip_tolerance": 1e-6,
+    "ccd_tolerance": 1e-6,
+    "gravity": np.array([0.0, 0, -9.81]),
+    "wind": np.zeros(3),
+    "magnetic": np.array([0.0, -0.5, 0]),
+    "density": 0.0,
+    "viscosity": 0.0,
+    "o_margin": 0.0,
+    "o_solref": np.array([0.02, 1.0]),
+    "o_solimp": np.array([0.9, 0.95, 0.001, 0.5, 2.0]),
+    "o_friction": np.array([1.0, 1, 0.005, 0.0001, 0.0001]),
+    "integrator": "Euler",
+    "cone": "pyramidal",
+    "jacobian": "auto",
+    "solver": "Newton",
+    "iterations": 100,
+    "ls_iterations": 50,
+    "noslip_iterations": 0,
+    "ccd_iterations": 35,
+    "sdf_iterations": 10,
+    "sdf_initpoints": 40,
+}
+_COMPILER_ATTR: dict[str, Any] = {
+    "autolimits": Flag(),
+    "inertiafromgeom": Choice("false", "true", "auto"),
+    "inertiagrouprange": Vector(2, integer=True),
+    "settotalmass": Real(),
+    "boundmass": Real(nonneg=True),
+    "boundinertia": Real(nonneg=True),
+    "balanceinertia": Flag(),
+    "fusestatic": Flag(),
+    "alignfree": Flag(),
+    "discardvisual": Flag(),
+}
+_COMPILER_DEFAULTS: dict[str, Any] = {
+    "autolimits": True,
+    "inertiafromgeom": "auto",
+    "inertiagrouprange": np.array([0, 5]),
+    "settotalmass": -1.0,
+    "boundmass": 0.0,
+    "boundinertia": 0.0,
+    "balanceinertia": False,
+    "fusestatic": False,
+    "alignfree": False,
+    "discardvisual": False,
+}
+
+
+class World(BaseThing):
+    """The root of a model: the worldbody's Things, physics options and assets.
+
+    ``world.model`` / ``world.data`` compile the tree through ``mujoco.MjSpec`` on first
+    use and again after any change in the tree (an attribute set, a Thing attached or
+    detached); a rebuild starts from a fresh ``MjData``. ``world.step()`` advances it.
+
+    Option attributes (``timestep`` in s, ``gravity`` in m/s^2, ``integrator``, ...) and
+    compiler attributes (``autolimits``, ``inertiafromgeom``, ``settotalmass``, ...) are
+    the MJCF ones. ``disabled``/``enabled`` are sets of MJCF ``<flag>`` names.
+    ``assets`` lists materials/textures to write even when nothing refers to them;
+    ``extra_xml`` holds MJCF sections the Things do not model (kept verbatim, see
+    :mod:`robotwright.things.xml_reader`).
+    """
+
+    _NAMESPACE = None
+    _TAG = "worldbody"
+    _CHILD_KINDS = frozenset({"body", "geom", "site", "camera", "light", "raw"})
+    _NEW_MUJOCO_ATTR = {**OPTION_ATTR, **_COMPILER_ATTR}
+    _NEW_BLUEPRINTS_ATTR = {**OPTION_ATTR, **_COMPILER_ATTR}
+    _NEW_DEFAULT_VALS = {**_OPTION_DEFAULTS, **_COMPILER_DEFAULTS}
+    _NEW_NO_COPY_VALS = {"assets"}
+
+    def __init__(self, name: str | None = None, parent: BaseThing | None = None, **kwargs: Any):
+        object.__setattr__(self, "assets", list(kwargs.pop("assets", [])))
+        object.__setattr__(self, "disabled", set(kwargs.pop("disabled", ())))
+        object.__setattr__(self, "enabled", set(kwargs.pop("enabled", ())))
+        object.__setattr__(self, "extra_xml", dict(kwargs.pop("extra_xml", {})))
+        object.__setattr__(self, "_built", None)
+        object.__setattr__(self, "_built_version", None)
+        super().__init__(name=name, parent=parent, **kwargs)
+
+    @property
+    def bodies(self) -> list[Any]:
+        return [c for c in self._children if c._NAMESPACE == "body"]
+
+    def all_joints(self) -> list[Any]:
+        return [t for t in self.walk() if t._NAMESPACE == "joint"]
+
+    def all_geoms(self) -> list[Any]:
+        return [t for t in self.walk() if t._NAMESPACE == "geom"]
+
+    def set_all(self, kind: str, **values: Any) -> int:
+        """Bulk edit over every Thing of namespace ``kind`` (see :meth:`Body.set_all`)."""
+        from robotwright.things.body import Body
+
+        return Body.set_all(self, kind, **values)  # type: ignore[arg-type]
+
+    def copy(self, **kwargs: Any) -> World:
+        new = super().copy(**kwargs)
+        object.__setattr__(new, "assets", list(self.assets))
+        object.__setattr__(new, "disabled", set(self.disabled))
+        object.__setattr__(new, "enabled", set(self.enabled))
+        object.__setattr__(new, "extra_xml", dict(self.extra_xml))
+        return new  # type: ignore[return-value]
+
+    # ------------------------------------------------------------------ MJCF
+    def _compiler_xml(self) -> str:
+        parts = ['angle="radian"']
+        for key, spec in _COMPILER_ATTR.items():
+            value = getattr(self, key)
+            if not spec.equal(value, _COMPILER_DEFAULTS[key]):
+                parts.append(f'{key}="{spec.format(value)}"')
+        return f"<compiler {' '.join(parts)}/>"
+
+    def _option_xml(self, writer: Any) -> str:
+        parts = []
+        for key, spec in OPTION_ATTR.items():
+            value = getattr(self, key)
+            if not spec.equal(value, _OPTION_DEFAULTS[key]):
+                parts.append(f'{key}="{spec.format(value)}"')
+        flags = [f'{f}="disable"' for f in sorted(self.disabled)]
+        flags += [f'{f}="enable"' for f in sorted(self.enabled)]
+        if not parts and not flags:
+            return ""
+        head = f"<option {' '.join(parts)}".rstrip()
+        if not flags:
+            return head + "/>"
+        return f"{head}>\n    <flag {' '.join(flags)}/>\n  </option>"
+
+    def _head_xml(self) -> list[str]:
+        return [
+            self.extra_xml[k]
+            for k in ("size", "visual", "statistic", "default")
+            if k in self.extra_xml
+        ]
+
+    def _tail_xml(self) -> list[str]:
+        return [
+            self.extra_xml[k]
+            for k in ("contact", "equality", "tendon", "keyframe")
+            if k in self.extra_xml
+        ]
+
+    def to_xml_string(self) -> str:
+        """The MJCF text of this World (files referenced by their paths as stored)."""
+        return write_mjcf(self)[0]
+
+    def export(self, path: str | os.PathLike[str], copy_assets: bool = True) -> Path:
+        """Write the MJCF to ``path`` atomically.
+
+        With ``copy_assets`` every mesh/texture file is copied to ``<dir>/assets/`` and
+        referenced relative to the written file, so the folder is self-contained.
+        Returns the written path.
+        """
+        path = Path(path)
+        out_dir = path.parent
+        out_dir.mkdir(parents=True, exist_ok=True)
+        copies: dict[str, str] = {}
+
+        def path_for(file: str) -> str:
+            src = os.path.abspath(file)
+            if not copy_assets:
+                return os.path.relpath(src, out_dir.resolve())
+            if src not in copies:
+                base = os.path.basename(src)
+                stem, ext = os.path.splitext(base)
+                candidate, k = base, 1
+                while candidate in copies.values():
+                    candidate = f"{stem}_{k}{ext}"
+                    k += 1
+                copies[src] = candidate
+            return f"assets/{copies[src]}"
+
+        text = write_mjcf(self, path_for)[0]
+        for src, rel in copies.items():
+            if not os.path.isfile(src):
+                raise FileNotFoundError(f"{self._label()}: asset file {src!r} does not exist")
+        if copies:
+            (out_dir / "assets").mkdir(exist_ok=True)
+            for src, rel in copies.items():
+                shutil.copyfile(src, out_dir / "assets" / rel)
+        fd, tmp = tempfile.mkstemp(dir=out_dir, prefix=f".{path.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        return path
+
+    # ------------------------------------------------------------------ reading
+    @classmethod
+    def from_xml_string(
+        cls, xml: str, base_dir: str | os.PathLike[str] | None = None, strict: bool = False
+    ) -> World:
+        """Build Things from MJCF text; relative file paths resolve against ``base_dir``
+        (default: the working directory). See :mod:`robotwright.things.xml_reader`."""
+        from robotwright.things.xml_reader import world_from_string
+
+        return world_from_string(xml, base_dir=base_dir, strict=strict)
+
+    @classmethod
+    def from_xml_path(cls, path: str | os.PathLike[str], strict: bool = False) -> World:
+        """Build Things from an MJCF file (``<include>`` and relative paths resolve from it)."""
+        from robotwright.things.xml_reader import world_from_path
+
+        return world_from_path(path, strict=strict)
+
+    # ------------------------------------------------------------------ simulation
+    def _ensure_built(self) -> tuple[mujoco.MjModel, mujoco.MjData, dict[int, int]]:
+        if self._built is None or self._built_version != self._version:
+            self.rebuild()
+        return self._built
+
+    def rebuild(self) -> None:
+        """Compile the tree now (normally done lazily by ``model``/``data``/``step``)."""
+        text, order = write_mjcf(self)
+        spec = mujoco.MjSpec.from_string(text)
+        model = spec.compile()
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        index: dict[int, int] = {}
+        for ids in order.values():
+            for i, thing_id in enumerate(ids):
+                index[thing_id] = i
+        object.__setattr__(self, "_built", (model, data, index))
+        object.__setattr__(self, "_built_version", self._version)
+        object.__setattr__(self, "_spec", spec)
+
+    @property
+    def model(self) -> mujoco.MjModel:
+        """The compiled ``MjModel`` (rebuilt when the tree changed)."""
+        return self._ensure_built()[0]
+
+    @property
+    def data(self) -> mujoco.MjData:
+        """The ``MjData`` of the current build (fresh after each rebuild)."""
+        return self._ensure_built()[1]
+
+    @property
+    def spec(self) -> mujoco.MjSpec:
+        """The ``MjSpec`` the current model was compiled from."""
+        self._ensure_built()
+        return self._spec
+
+    def step(self, n: int = 1) -> None:
+        """Advance the simulation by ``n`` steps of ``timestep`` seconds."""
+        model, data, _ = self._ensure_built()
+        for _ in range(n):
+            mujoco.mj_step(model, data)
+
+    def forward(self) -> None:
+        model, data, _ = self._ensure_built()
+        mujoco.mj_forward(model, data)

@@ -1,0 +1,698 @@
+"""Reading MJCF into Things.
+
+MuJoCo's own parser (``mujoco.MjSpec``) reads the file, so ``<include>``, default
+classes, ``childclass``, ``fromto``, Euler angles, ``<frame>`` and degree units are
+resolved exactly as MuJoCo resolves them. Each element becomes the Thing class whose
+derived attributes match it (``<geom type="sphere">`` -> :class:`Sphere`,
+``<joint type="slide">`` -> :class:`Slide`, a ``<general>`` whose gain/bias are a
+position servo's -> :class:`Position`). Values are stored resolved: the written MJCF has
+no default classes, uses radians and quaternions, and compiles to the same model.
+
+Sections the Things do not model (``visual``, ``statistic``, ``size``, ``contact``,
+``equality``, ``tendon``, ``keyframe``, and actuators/sensors on tendons or other
+unmodelled targets) are carried verbatim as MuJoCo writes them, with the default classes
+they use kept under a class of their own (``rw_carried``) so they cannot change the
+Things' values. Anything else that cannot be represented (height fields, skins, flexes,
+plugins, ...) is reported with a :class:`~robotwright.errors.ConversionWarning` naming it,
+or raises :class:`~robotwright.errors.ConversionError` with ``strict=True``.
+
+The input text is first checked with ``defusedxml`` (no entity expansion, no DTDs).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+import defusedxml.ElementTree as SafeET
+import mujoco
+import numpy as np
+
+from robotwright.errors import ConversionError, ConversionWarning, Problem, RobotwrightError
+from robotwright.things import actuators as A
+from robotwright.things import sensors as S
+from robotwright.things.assets import Material, Texture
+from robotwright.things.base import BaseThing
+from robotwright.things.body import Body
+from robotwright.things.cameras import Camera
+from robotwright.things.geoms import GEOM_CLASSES
+from robotwright.things.joints import JOINT_CLASSES
+from robotwright.things.lights import Light
+from robotwright.things.raw import RawElement
+from robotwright.things.sites import Site
+from robotwright.things.world import OPTION_ATTR, World
+
+CARRIED_CLASS = "rw_carried"
+
+
+class ThingXMLError(RobotwrightError, ValueError):
+    """MJCF text could not be read (malformed, unsafe, or rejected by MuJoCo)."""
+
+
+def _enum(value: Any, prefix: str) -> str:
+    return value.name[len(prefix) :].lower()
+
+
+def _f32(values: Any) -> list[float]:
+    """float32 spec fields back to the shortest decimal that MJCF text would give."""
+    return [float(np.format_float_positional(np.float32(v), unique=True)) for v in values]
+
+
+def _compose(pos_a: Any, quat_a: Any, pos_b: Any, quat_b: Any) -> tuple[np.ndarray, np.ndarray]:
+    pos = np.zeros(3)
+    quat = np.zeros(4)
+    mujoco.mju_mulPose(
+        pos,
+        quat,
+        np.asarray(pos_a, float),
+        np.asarray(quat_a, float),
+        np.asarray(pos_b, float),
+        np.asarray(quat_b, float),
+    )
+    return pos, quat
+
+
+class _Reader:
+    def __init__(self, spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) -> None:
+        self.spec = spec
+        self.base_dir = base_dir
+        self.source = source
+        self.strict = strict
+        self.degree = bool(spec.compiler.degree)
+        self.seq = spec.compiler.eulerseq
+        self.problems: list[Problem] = []
+        self.by_name: dict[tuple[str, str], BaseThing] = {}
+        self.materials: dict[str, Material] = {}
+        self.textures: dict[str, Texture] = {}
+
+    # ------------------------------------------------------------------ helpers
+    def lose(self, element: str, message: str) -> None:
+        self.problems.append(Problem(self.source, message, element=element, severity="warning"))
+
+    def quat(self, elem: Any, alt_name: str = "alt", quat_name: str = "quat") -> np.ndarray:
+        alt = getattr(elem, alt_name)
+        if alt.type == mujoco.mjtOrientation.mjORIENTATION_QUAT:
+            return np.array(getattr(elem, quat_name), dtype=float)
+        return np.array(self.spec.resolve_orientation(self.degree, self.seq, alt))
+
+    def pose(self, elem: Any) -> tuple[np.ndarray, np.ndarray]:
+        pos, quat = np.array(elem.pos, dtype=float), self.quat(elem)
+        fromto = getattr(elem, "fromto", None)
+        if fromto is not None and not np.isnan(fromto[0]):
+            start, end = np.array(fromto[:3]), np.array(fromto[3:])
+            pos = (start + end) / 2
+            quat = np.zeros(4)
+            mujoco.mju_quatZ2Vec(quat, end - start)
+        return self.in_frame(elem, pos, quat)
+
+    def in_frame(
+        self, elem: Any, pos: np.ndarray, quat: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        frame = elem.frame
+        while frame is not None:
+            pos, quat = _compose(frame.pos, self.quat(frame), pos, quat)
+            frame = frame.frame
+        return pos, quat
+
+    def name(self, elem: Any) -> str | None:
+        return elem.name or None
+
+    def path(self, file: str, subdir: str) -> str:
+        full = Path(subdir) / file if subdir else Path(file)
+        if not full.is_absolute():
+            full = self.base_dir / full
+        return os.path.normpath(str(full))
+
+    def angle(self, value: float) -> float:
+        return math.radians(value) if self.degree else float(value)
+
+    # ------------------------------------------------------------------ assets
+    def read_assets(self, world: World) -> None:
+        spec = self.spec
+        for tex in spec.textures:
+            where = f'<texture name="{tex.name}">'
+            if any(list(tex.cubefiles)) or len(tex.data):
+                self.lose(where, "cube-face files and embedded data of textures are not kept")
+            kw: dict[str, Any] = {
+                "type": {0: "2d", 1: "cube", 2: "skybox"}[int(tex.type)],
+                "builtin": _enum(tex.builtin, "mjBUILTIN_"),
+                "rgb1": tex.rgb1,
+                "rgb2": tex.rgb2,
+                "mark": _enum(tex.mark, "mjMARK_"),
+                "markrgb": tex.markrgb,
+                "random": tex.random,
+                "width": tex.width,
+                "height": tex.height,
+                "gridsize": tex.gridsize,
+            }
+            if tex.file:
+                kw["file"] = self.path(tex.file, spec.texturedir)
+            layout = "".join(tex.gridlayout)
+            if layout and tuple(tex.gridsize) != (1, 1):
+                kw["gridlayout"] = layout
+            thing = Texture(self.name(tex), **kw)
+            self.textures[tex.name] = thing
+            world.assets.append(thing)
+        for mat in spec.materials:
+            textures = list(mat.textures)
+            kw = {
+                "rgba": _f32(mat.rgba),
+                "emission": mat.emission,
+                "specular": mat.specular,
+                "shininess": mat.shininess,
+                "reflectance": mat.reflectance,
+                "metallic": mat.metallic,
+                "roughness": mat.roughness,
+                "texrepeat": _f32(mat.texrepeat),
+                "texuniform": mat.texuniform,
+            }
+            if len(textures) > 1 and textures[1]:
+                kw["texture"] = self.textures.get(textures[1], textures[1])
+            if any(t for i, t in enumerate(textures) if i != 1):
+                self.lose(
+                    f'<material name="{mat.name}">', "layered (non-RGB) textures are not kept"
+                )
+            thing = Material(self.name(mat), **kw)
+            self.materials[mat.name] = thing
+            world.assets.append(thing)
+        for kind in ("hfields", "skins", "flexes"):
+            for item in getattr(spec, kind):
+                self.lose(
+                    f'<{kind[:-1] if kind != "flexes" else "flex"} name="{item.name}">',
+                    f"{kind} are not supported by Things; dropped",
+                )
+
+    def material(self, name: str) -> Any:
+        if not name:
+            return None
+        return self.materials.get(name, name)
+
+    # ------------------------------------------------------------------ tree
+    def read_body_children(self, sbody: Any, node: BaseThing) -> None:
+        for sj in sbody.joints:
+            node.attach(self.joint(sj))
+        for sg in sbody.geoms:
+            geom = self.geom(sg)
+            if geom is not None:
+                node.attach(geom)
+        for ss in sbody.sites:
+            node.attach(self.site(ss))
+        for sc in sbody.cameras:
+            node.attach(self.camera(sc))
+        for sl in sbody.lights:
+            node.attach(self.light(sl))
+        for child in sbody.bodies:
+            node.attach(self.body(child))
+
+    def body(self, sb: Any) -> Body:
+        pos, quat = self.in_frame(sb, np.array(sb.pos, dtype=float), self.quat(sb))
+        kw: dict[str, Any] = {"pos": pos, "quat": quat, "mocap": sb.mocap, "gravcomp": sb.gravcomp}
+        if sb.explicitinertial:
+            kw["mass"] = sb.mass
+            kw["ipos"] = sb.ipos
+            kw["iquat"] = self.quat(sb, "ialt", "iquat")
+            if not np.isnan(sb.fullinertia[0]):
+                kw["fullinertia"] = sb.fullinertia
+            else:
+                kw["inertia"] = sb.inertia
+        body = Body(self.name(sb), **kw)
+        self.register("body", sb.name, body)
+        self.read_body_children(sb, body)
+        return body
+
+    def register(self, kind: str, name: str, thing: BaseThing) -> None:
+        if name:
+            self.by_name[(kind, name)] = thing
+
+    def joint(self, sj: Any) -> BaseThing:
+        jtype = _enum(sj.type, "mjJNT_")
+        cls = _pick(JOINT_CLASSES, type=jtype)
+        pos = np.array(sj.pos, dtype=float)
+        axis = np.array(sj.axis, dtype=float)
+        if sj.frame is not None:
+            _, fquat = self.in_frame(sj, np.zeros(3), np.array([1.0, 0, 0, 0]))
+            fpos, _ = self.in_frame(sj, pos, np.array([1.0, 0, 0, 0]))
+            pos = fpos
+            rotated = np.zeros(3)
+            mujoco.mju_rotVecQuat(rotated, axis, fquat)
+            axis = rotated
+        angular = jtype in ("hinge", "ball")
+        conv = self.angle if angular else float
+        kw: dict[str, Any] = {
+            "pos": pos,
+            "stiffness": sj.stiffness,
+            "damping": sj.damping,
+            "frictionloss": sj.frictionloss,
+            "armature": sj.armature,
+            "margin": sj.margin,
+            "group": sj.group,
+            "solreflimit": sj.solref_limit,
+            "solimplimit": sj.solimp_limit,
+            "solreffriction": sj.solref_friction,
+            "solimpfriction": sj.solimp_friction,
+            "springdamper": sj.springdamper,
+        }
+        if jtype != "free":
+            kw.update(
+                range=[conv(sj.range[0]), conv(sj.range[1])],
+                limited=_limited(sj.limited),
+                ref=conv(sj.ref),
+                springref=conv(sj.springref),
+                actuatorfrcrange=sj.actfrcrange,
+                actuatorfrclimited=_limited(sj.actfrclimited),
+            )
+        else:
+            kw["align"] = _limited(sj.align)
+        if jtype in ("hinge", "slide"):
+            kw["axis"] = axis
+        kw["actuatorgravcomp"] = bool(sj.actgravcomp)
+        if "actuatorgravcomp" not in cls._MUJOCO_ATTR:
+            kw.pop("actuatorgravcomp")
+        joint = cls(self.name(sj), **kw)
+        self.register("joint", sj.name, joint)
+        return joint
+
+    def geom(self, sg: Any) -> BaseThing | None:
+        gtype = _enum(sg.type, "mjGEOM_")
+        where = f'<geom name="{sg.name}" type="{gtype}">'
+        try:
+            cls = _pick(GEOM_CLASSES, type=gtype)
+        except KeyError:
+            self.lose(where, f"geom type {gtype!r} is not supported by Things; dropped")
+            return None
+        if sg.meshname and gtype != "mesh":
+            self.lose(
+                where,
+                "a primitive fitted to a mesh is kept as the primitive with its size as given",
+            )
+        pos, quat = self.pose(sg)
+        size = np.array(sg.size, dtype=float)
+        if not np.isnan(sg.fromto[0]):
+            half = float(np.linalg.norm(np.array(sg.fromto[3:]) - np.array(sg.fromto[:3]))) / 2
+            if gtype in ("capsule", "cylinder"):
+                size[1] = half
+            elif gtype in ("box", "ellipsoid"):
+                size[2] = half
+        kw: dict[str, Any] = {
+            "size": size,
+            "pos": pos,
+            "quat": quat,
+            "contype": sg.contype,
+            "conaffinity": sg.conaffinity,
+            "condim": sg.condim,
+            "group": sg.group,
+            "priority": sg.priority,
+            "friction": sg.friction,
+            "solmix": sg.solmix,
+            "solref": sg.solref,
+            "solimp": sg.solimp,
+            "margin": sg.margin,
+            "gap": sg.gap,
+            "density": sg.density,
+            "rgba": _f32(sg.rgba),
+            "shellinertia": "true" if int(sg.typeinertia) == 1 else "false",
+            "fluidshape": "ellipsoid" if sg.fluid_ellipsoid else "none",
+            "fluidcoef": sg.fluid_coefs,
+        }
+        if not np.isnan(sg.mass):
+            kw["mass"] = sg.mass
+        if sg.material:
+            kw["material"] = self.material(sg.material)
+        if gtype == "mesh":
+            kw.update(self.mesh_asset(sg.meshname, where))
+        geom = cls(self.name(sg), **kw)
+        self.register("geom", sg.name, geom)
+        return geom
+
+    def mesh_asset(self, meshname: str, where: str) -> dict[str, Any]:
+        sm = self.spec.mesh(meshname)
+        if sm is None:
+            raise ThingXMLError(
+                f"{self.source}: {where} refers to mesh {meshname!r}, which is not defined"
+            )
+        kw: dict[str, Any] = {
+            "mesh": meshname,
+            "scale": sm.scale,
+            "maxhullvert": sm.maxhullvert,
+            "meshinertia": _enum(sm.inertia, "mjMESH_INERTIA_"),
+            "refpos": sm.refpos,
+            "refquat": sm.refquat,
+        }
+        if sm.file:
+            kw["file"] = self.path(sm.file, self.spec.meshdir)
+        if len(sm.uservert):
+            kw["vertex"] = list(sm.uservert)
+        if len(sm.userface):
+            kw["face"] = list(sm.userface)
+        if len(sm.usernormal) or len(sm.usertexcoord) or sm.plugin.active or sm.content_type:
+            self.lose(
+                f'<mesh name="{meshname}">',
+                "mesh normals, texture coordinates, content type and plugins are not kept",
+            )
+        return kw
+
+    def site(self, ss: Any) -> Site:
+        pos, quat = self.pose(ss)
+        size = np.array(ss.size, dtype=float)
+        if not np.isnan(ss.fromto[0]):
+            size[1] = float(np.linalg.norm(np.array(ss.fromto[3:]) - np.array(ss.fromto[:3]))) / 2
+        site = Site(
+            self.name(ss),
+            type=_enum(ss.type, "mjGEOM_"),
+            size=size,
+            pos=pos,
+            quat=quat,
+            group=ss.group,
+            rgba=_f32(ss.rgba),
+            material=self.material(ss.material),
+        )
+        self.register("site", ss.name, site)
+        return site
+
+    def camera(self, sc: Any) -> Camera:
+        pos, quat = self.pose(sc)
+        if any(sc.sensor_size) or any(sc.intrinsic) or int(sc.proj) != 0:
+            self.lose(
+                f'<camera name="{sc.name}">',
+                "sensor size, intrinsics and projection type are not kept",
+            )
+        cam = Camera(
+            self.name(sc),
+            pos=pos,
+            quat=quat,
+            mode=_enum(sc.mode, "mjCAMLIGHT_"),
+            target=sc.targetbody or None,
+            fovy=sc.fovy,
+            ipd=sc.ipd,
+            resolution=sc.resolution,
+        )
+        self.register("camera", sc.name, cam)
+        return cam
+
+    def light(self, sl: Any) -> Light:
+        pos, quat = self.in_frame(sl, np.array(sl.pos, dtype=float), np.array([1.0, 0, 0, 0]))
+        direction = np.zeros(3)
+        mujoco.mju_rotVecQuat(direction, np.array(sl.dir, dtype=float), quat)
+        if sl.texture:
+            self.lose(f'<light name="{sl.name}">', "light textures are not kept")
+        light = Light(
+            self.name(sl),
+            pos=pos,
+            dir=direction,
+            mode=_enum(sl.mode, "mjCAMLIGHT_"),
+            target=sl.targetbody or None,
+            type=_enum(sl.type, "mjLIGHT_"),
+            castshadow=sl.castshadow,
+            active=sl.active,
+            attenuation=_f32(sl.attenuation),
+            cutoff=_f32([sl.cutoff])[0],
+            exponent=_f32([sl.exponent])[0],
+            ambient=_f32(sl.ambient),
+            diffuse=_f32(sl.diffuse),
+            specular=_f32(sl.specular),
+            bulbradius=_f32([sl.bulbradius])[0],
+            intensity=_f32([sl.intensity])[0],
+            range=_f32([sl.range])[0],
+        )
+        self.register("light", sl.name, light)
+        return light
+
+    # ------------------------------------------------------------------ sections
+    def actuator(self, sa: Any, world: World, carried: dict[str, list[ET.Element]]) -> None:
+        trn = _enum(sa.trntype, "mjTRN_")
+        target = self.by_name.get(({"joint": "joint", "site": "site"}.get(trn, ""), sa.target))
+        if target is None or sa.slidersite or sa.refsite and trn != "site":
+            self._carry(world, "actuator", sa, carried, f"actuator on a {trn}")
+            return
+        cls, extra = _actuator_class(sa)
+        kw: dict[str, Any] = {
+            "gear": sa.gear,
+            "ctrlrange": sa.ctrlrange,
+            "ctrllimited": _limited(sa.ctrllimited),
+            "forcerange": sa.forcerange,
+            "forcelimited": _limited(sa.forcelimited),
+            "actrange": sa.actrange,
+            "actlimited": _limited(sa.actlimited),
+            "group": sa.group,
+            **extra,
+        }
+        if sa.refsite:
+            kw["refsite"] = sa.refsite
+        if sa.inheritrange > 0 and trn == "joint":
+            jr = target.range
+            mid, half = (jr[0] + jr[1]) / 2, (jr[1] - jr[0]) / 2 * sa.inheritrange
+            kw["ctrlrange"] = [mid - half, mid + half]
+        lost = [f for f in ("armature", "cranklength", "delay") if getattr(sa, f)]
+        lost += [f for f in ("damping", "lengthrange") if np.any(getattr(sa, f))]
+        if lost:
+            self.lose(f'<actuator name="{sa.name}">', f"attributes {', '.join(lost)} are not kept")
+        act = cls(self.name(sa), **kw)
+        target.attach(act)
+        self.register("actuator", sa.name, act)
+
+    def sensor(self, ss: Any, world: World, carried: dict[str, list[ET.Element]]) -> None:
+        tag = _enum(ss.type, "mjSENS_")
+        cls = S.SENSOR_CLASSES.get(tag)
+        objtype = _enum(ss.objtype, "mjOBJ_")
+        target = self.by_name.get(("body" if objtype == "xbody" else objtype, ss.objname))
+        if (
+            cls is None
+            or target is None
+            or (cls._TARGET_KINDS and target._NAMESPACE not in cls._TARGET_KINDS)
+        ):
+            self._carry(world, "sensor", ss, carried, f"{tag} sensor on a {objtype}")
+            return
+        kw: dict[str, Any] = {"noise": ss.noise, "cutoff": ss.cutoff}
+        if issubclass(cls, S.FrameSensor):
+            if objtype == "xbody":
+                kw["objtype"] = "xbody"
+            if ss.refname:
+                kw["reftype"] = _enum(ss.reftype, "mjOBJ_")
+                kw["refname"] = ss.refname
+        if ss.delay or ss.nsample or any(ss.interval):
+            self.lose(f'<{tag} name="{ss.name}">', "sensor delay/sampling settings are not kept")
+        sensor = cls(self.name(ss), **kw)
+        target.attach(sensor)
+
+    def _carry(
+        self, world: World, section: str, elem: Any, carried: dict[str, list[ET.Element]], what: str
+    ) -> None:
+        queue = carried.get(section, [])
+        if not queue:
+            self.lose(f'<{section} name="{elem.name}">', f"{what} cannot be represented; dropped")
+            return
+        xml = queue.pop(0)
+        _carried_class(xml)
+        world.attach(RawElement(section=section, xml=ET.tostring(xml, encoding="unicode").strip()))
+
+
+def _limited(value: Any) -> str:
+    return {0: "false", 1: "true", 2: "auto"}[int(value)]
+
+
+def _pick(classes: tuple[type, ...], **derived: Any) -> Any:
+    for cls in classes:
+        if all(getattr(cls, k, None) == v for k, v in derived.items()):
+            return cls
+    raise KeyError(derived)
+
+
+def _actuator_class(sa: Any) -> tuple[type, dict[str, Any]]:
+    gain, bias, dyn = sa.gaintype, sa.biastype, sa.dyntype
+    gp, bp = np.array(sa.gainprm), np.array(sa.biasprm)
+    plain = int(gain) == 0 and int(dyn) == 0 and not gp[1:].any() and not sa.actearly
+    if plain and int(bias) == 0 and gp[0] == 1 and not bp.any():
+        return A.Motor, {}
+    if plain and int(bias) == 1 and bp[0] == 0 and not bp[3:].any():
+        if bp[1] == -gp[0] and bp[2] <= 0:
+            return A.Position, {"kp": gp[0], "kv": -bp[2]}
+        if bp[1] == 0 and bp[2] == -gp[0]:
+            return A.Velocity, {"kv": gp[0]}
+    return A.General, {
+        "dyntype": _enum(dyn, "mjDYN_"),
+        "gaintype": _enum(gain, "mjGAIN_"),
+        "biastype": _enum(bias, "mjBIAS_"),
+        "dynprm": sa.dynprm,
+        "gainprm": sa.gainprm,
+        "biasprm": sa.biasprm,
+        "actearly": sa.actearly,
+        "actdim": sa.actdim,
+    }
+
+
+def _carried_class(elem: ET.Element) -> None:
+    """Point a carried element without a class at the carried main defaults."""
+    if elem.tag in _CLASSABLE and "class" not in elem.attrib:
+        # MuJoCo writes class right after name; keep that order so output is stable.
+        attrs = dict(elem.attrib)
+        elem.attrib.clear()
+        if "name" in attrs:
+            elem.set("name", attrs.pop("name"))
+        elem.set("class", CARRIED_CLASS)
+        elem.attrib.update(attrs)
+
+
+# Carried elements that take default classes (sensors, keys and excludes take none).
+_CLASSABLE = frozenset(
+    {
+        "pair",
+        "connect",
+        "weld",
+        "joint",
+        "tendon",
+        "flex",
+        "spatial",
+        "fixed",
+        "general",
+        "motor",
+        "position",
+        "velocity",
+        "intvelocity",
+        "damper",
+        "cylinder",
+        "muscle",
+        "adhesion",
+    }
+)
+_CARRIED_SECTIONS = ("size", "visual", "statistic", "contact", "equality", "tendon", "keyframe")
+_OPTION_ENUMS = {
+    "integrator": ("Euler", "RK4", "implicit", "implicitfast"),
+    "cone": ("pyramidal", "elliptic"),
+    "jacobian": ("dense", "sparse", "auto"),
+    "solver": ("PGS", "CG", "Newton"),
+}
+
+
+def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) -> World:
+    reader = _Reader(spec, base_dir, source, strict)
+    n_keys = len(spec.keys)  # before to_xml(), which may add the keys <size nkey> asks for
+    world = World(spec.modelname or None)
+    opt = spec.option
+    for key in OPTION_ATTR:
+        if key in _OPTION_ENUMS:
+            setattr(world, key, _OPTION_ENUMS[key][int(getattr(opt, key))])
+        else:
+            setattr(world, key, getattr(opt, key))
+    comp = spec.compiler
+    world.autolimits = bool(comp.autolimits)
+    world.inertiafromgeom = {0: "false", 1: "true", 2: "auto"}[int(comp.inertiafromgeom)]
+    world.inertiagrouprange = comp.inertiagrouprange
+    world.settotalmass = comp.settotalmass
+    world.boundmass = comp.boundmass
+    world.boundinertia = comp.boundinertia
+    world.balanceinertia = bool(comp.balanceinertia)
+    world.fusestatic = bool(comp.fusestatic)
+    world.alignfree = bool(comp.alignfree)
+    world.discardvisual = bool(comp.discardvisual)
+    world.disabled.update(
+        m[len("mjDSBL_") :].lower()
+        for m, v in mujoco.mjtDisableBit.__members__.items()
+        if m != "mjNDISABLE" and opt.disableflags & int(v)
+    )
+    world.enabled.update(
+        m[len("mjENBL_") :].lower()
+        for m, v in mujoco.mjtEnableBit.__members__.items()
+        if m != "mjNENABLE" and opt.enableflags & int(v)
+    )
+    if opt.disableactuator:
+        reader.lose("<option>", "actuator group disabling (actuatorgroupdisable) is not kept")
+    if len(spec.plugins) or len(spec.numerics) or len(spec.texts) or len(spec.tuples):
+        reader.lose(
+            "<extension>/<custom>", "plugins and custom numeric/text/tuple data are not kept"
+        )
+
+    reader.read_assets(world)
+    reader.read_body_children(spec.worldbody, world)
+
+    carried_root = ET.fromstring(spec.to_xml())
+    carried: dict[str, list[ET.Element]] = {}
+    for section in ("actuator", "sensor"):
+        node = carried_root.find(section)
+        carried[section] = list(node) if node is not None else []
+    if len(carried["actuator"]) != len(spec.actuators) or len(carried["sensor"]) != len(
+        spec.sensors
+    ):
+        carried = {"actuator": [], "sensor": []}
+    acts, sens = carried["actuator"], carried["sensor"]
+    for i, sa in enumerate(spec.actuators):
+        carried["actuator"] = [acts[i]] if acts else []
+        reader.actuator(sa, world, carried)
+    for i, ss in enumerate(spec.sensors):
+        carried["sensor"] = [sens[i]] if sens else []
+        reader.sensor(ss, world, carried)
+    uses_classes = False
+    for section in _CARRIED_SECTIONS:
+        node = carried_root.find(section)
+        if node is None or (section != "visual" and len(node) == 0 and not node.attrib):
+            continue
+        if section in ("contact", "equality", "tendon", "keyframe"):
+            for child in node:
+                _carried_class(child)
+                uses_classes = True
+        world.extra_xml[section] = _indent(node)
+    if uses_classes or any(isinstance(t, RawElement) for t in world._children):
+        default = carried_root.find("default")
+        if default is not None and [c.get("class") for c in default] == [CARRIED_CLASS]:
+            world.extra_xml["default"] = _indent(default)
+        elif default is not None:
+            wrapper = ET.Element("default")
+            inner = ET.SubElement(wrapper, "default", {"class": CARRIED_CLASS})
+            inner.extend(list(default))
+            world.extra_xml["default"] = _indent(wrapper)
+        else:
+            world.extra_xml["default"] = (
+                f'  <default>\n    <default class="{CARRIED_CLASS}"/>\n  </default>'
+            )
+    if n_keys and "keyframe" not in world.extra_xml:
+        reader.lose("<keyframe>", "keyframes could not be carried")
+
+    if reader.problems:
+        if strict:
+            raise ConversionError(
+                reader.problems, f"{source}: MJCF elements cannot be represented as Things"
+            )
+        for problem in reader.problems:
+            warnings.warn(ConversionWarning(str(problem)), stacklevel=3)
+    return world
+
+
+def _indent(node: ET.Element) -> str:
+    ET.indent(node, space="  ", level=1)
+    return "  " + ET.tostring(node, encoding="unicode").strip()
+
+
+def _check_safe(text: str, source: str) -> None:
+    try:
+        SafeET.fromstring(text)
+    except Exception as exc:  # defusedxml raises several types; all mean "do not read"
+        raise ThingXMLError(f"{source}: not readable as safe XML: {exc}") from None
+
+
+def world_from_string(
+    xml: str, base_dir: str | os.PathLike[str] | None = None, strict: bool = False
+) -> World:
+    """Things from MJCF text; relative files resolve against ``base_dir`` (default: cwd)."""
+    _check_safe(xml, "<string>")
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    try:
+        spec = mujoco.MjSpec.from_string(xml)
+    except ValueError as exc:
+        raise ThingXMLError(f"<string>: MuJoCo rejected the MJCF: {exc}") from None
+    return _read_world(spec, base.resolve(), "<string>", strict)
+
+
+def world_from_path(path: str | os.PathLike[str], strict: bool = False) -> World:
+    """Things from an MJCF file (includes and relative paths resolve from its folder)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ThingXMLError(f"{path}: no such MJCF file")
+    _check_safe(path.read_text(encoding="utf-8"), str(path))
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError as exc:
+        raise ThingXMLError(f"{path}: MuJoCo rejected the MJCF: {exc}") from None
+    return _read_world(spec, path.parent.resolve(), str(path), strict)

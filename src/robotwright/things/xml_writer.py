@@ -1,0 +1,285 @@
+"""Writing a Thing tree as MJCF text.
+
+Attributes equal to MuJoCo's defaults (``_DEFAULT_VALS``) are omitted. Angles are
+written in radians (``<compiler angle="radian"/>``). Actuators and sensors are written in
+the order they were created (reading MJCF creates them in file order, so the order of
+``ctrl`` and ``sensordata`` survives a round trip).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from typing import Any
+from xml.sax.saxutils import escape
+
+from robotwright.things.base import BaseThing
+
+_QUOTE = {'"': "&quot;"}
+
+
+def _q(text: str) -> str:
+    return escape(text, _QUOTE)
+
+
+class _Writer:
+    def __init__(self, root: BaseThing, path_for: Callable[[str], str] | None) -> None:
+        self.root = root
+        self.names = root._resolved_names()
+        self.path_for = path_for or (lambda p: p)
+        self.out: list[str] = []
+        self.actuators: list[BaseThing] = []
+        self.sensors: list[BaseThing] = []
+        self.mesh_assets: dict[tuple, str] = {}
+        self.mesh_of_geom: dict[int, str] = {}
+        self.asset_names: dict[int, str] = {}
+        self.assets: list[BaseThing] = []
+        # model ids in compile order: namespace -> list of Thing IDs
+        self.order: dict[str, list[int]] = {}
+
+    # ------------------------------------------------------------------ helpers
+    def ref_name(self, value: Any) -> str:
+        if isinstance(value, str):
+            return value
+        if value._NAMESPACE is None:
+            return self.asset_names[value.ID]
+        return self.names[value.ID]
+
+    def attrs(self, thing: BaseThing, skip: frozenset[str] | set[str] = frozenset()) -> str:
+        parts: list[str] = []
+        name = self.names.get(thing.ID) if thing._NAMESPACE else self.asset_names.get(thing.ID)
+        if name:
+            parts.append(f'name="{_q(name)}"')
+        defaults = thing._DEFAULT_VALS
+        for key, spec in thing._MUJOCO_ATTR.items():
+            if key in skip:
+                continue
+            value = getattr(thing, key)
+            if value is None:
+                continue
+            if key in defaults and spec.equal(value, defaults[key]):
+                continue
+            if isinstance(value, BaseThing):
+                text = self.ref_name(value)
+            elif key == "file":
+                text = self.path_for(value)
+            else:
+                text = spec.format(value)
+            parts.append(f'{key}="{_q(text)}"')
+        return " ".join(parts)
+
+    # ------------------------------------------------------------------ assets
+    def collect_assets(self) -> None:
+        from robotwright.things.geoms import Mesh
+
+        requested: list[BaseThing] = list(getattr(self.root, "assets", []))
+        seen = {a.ID for a in requested}
+        mesh_keys: list[tuple[tuple, str]] = []
+        for thing in self.root.walk():
+            if isinstance(thing, Mesh):
+                key = tuple(
+                    (k, _hashable(getattr(thing, k))) for k in Mesh._ASSET_ATTR if k != "mesh"
+                )
+                base = thing.mesh or (
+                    os.path.splitext(os.path.basename(thing.file))[0] if thing.file else "mesh"
+                )
+                mesh_keys.append((key, base))
+                self.mesh_of_geom[thing.ID] = repr((key, base))
+            for key in ("material",):
+                value = thing.__dict__.get(key)
+                if isinstance(value, BaseThing) and value.ID not in seen:
+                    seen.add(value.ID)
+                    requested.append(value)
+        for asset in list(requested):
+            tex = asset.__dict__.get("texture")
+            if isinstance(tex, BaseThing) and tex.ID not in seen:
+                seen.add(tex.ID)
+                requested.insert(requested.index(asset), tex)
+        taken: set[tuple[str, str]] = set()
+        for asset in requested:
+            self.asset_names[asset.ID] = _unique(
+                taken, asset._TAG, asset.__dict__.get("_name") or asset._TAG
+            )
+        self.assets = requested
+        unique_meshes: dict[str, str] = {}
+        for key, base in mesh_keys:
+            ident = repr((key, base))
+            if ident not in unique_meshes:
+                unique_meshes[ident] = _unique(taken, "mesh", base)
+                self.mesh_assets[key] = unique_meshes[ident]
+        self.mesh_of_geom = {gid: unique_meshes[ident] for gid, ident in self.mesh_of_geom.items()}
+        self._mesh_geoms: dict[str, BaseThing] = {}
+        for thing in self.root.walk():
+            if isinstance(thing, Mesh):
+                self._mesh_geoms.setdefault(self.mesh_of_geom[thing.ID], thing)
+
+    def write_assets(self) -> None:
+        from robotwright.things.geoms import Mesh
+
+        if not self.assets and not self._mesh_geoms:
+            return
+        self.out.append("  <asset>")
+        for asset in self.assets:
+            self.out.append(f"    <{asset._TAG} {self.attrs(asset)}/>")
+        for name, geom in self._mesh_geoms.items():
+            parts = [f'name="{_q(name)}"']
+            for key in Mesh._ASSET_ATTR:
+                if key == "mesh":
+                    continue
+                value = getattr(geom, key)
+                if value is None or (
+                    key in Mesh._DEFAULT_VALS
+                    and Mesh._MUJOCO_ATTR[key].equal(value, Mesh._DEFAULT_VALS[key])
+                ):
+                    continue
+                text = (
+                    self.path_for(value) if key == "file" else Mesh._MUJOCO_ATTR[key].format(value)
+                )
+                parts.append(f'{"inertia" if key == "meshinertia" else key}="{_q(text)}"')
+            self.out.append(f"    <mesh {' '.join(parts)}/>")
+        self.out.append("  </asset>")
+
+    # ------------------------------------------------------------------ tree
+    def write_children(self, node: BaseThing, indent: str) -> None:
+        from robotwright.things.geoms import Mesh
+
+        out = self.out
+        order = self.order
+        for child in node._children:
+            ns = child._NAMESPACE
+            if ns == "actuator" or ns == "sensor" or ns == "raw":
+                self.collect_section(child)
+                continue
+            order.setdefault(ns, []).append(child.ID)
+            if ns == "body":
+                attrs = self.attrs(child, skip=child._INERTIAL)
+                inertial = self.inertial(child)
+                if inertial or child._children:
+                    out.append(f"{indent}<body {attrs}>" if attrs else f"{indent}<body>")
+                    if inertial:
+                        out.append(f"{indent}  {inertial}")
+                    self.write_children(child, indent + "  ")
+                    out.append(f"{indent}</body>")
+                else:
+                    out.append(f"{indent}<body {attrs}/>")
+                continue
+            if isinstance(child, Mesh):
+                attrs = self.attrs(child, skip=set(Mesh._ASSET_ATTR))
+                attrs += f' mesh="{_q(self.mesh_of_geom[child.ID])}"'
+            else:
+                attrs = self.attrs(child)
+            out.append(f"{indent}<{child._TAG} {attrs}/>")
+            for grandchild in child._children:
+                self.collect_section(grandchild)
+
+    def collect_section(self, thing: BaseThing) -> None:
+        section = thing.section if thing._NAMESPACE == "raw" else thing._NAMESPACE
+        (self.actuators if section == "actuator" else self.sensors).append(thing)
+        for child in thing._children:
+            self.collect_section(child)
+
+    def inertial(self, body: Any) -> str:
+        if body.mass is None:
+            return ""
+        parts = [f'mass="{_fmt(body.mass)}"']
+        if body.ipos is not None:
+            parts.append(f'pos="{_vec(body.ipos)}"')
+        if body.iquat is not None:
+            parts.append(f'quat="{_vec(body.iquat)}"')
+        if body.fullinertia is not None:
+            parts.append(f'fullinertia="{_vec(body.fullinertia)}"')
+        elif body.inertia is not None:
+            parts.append(f'diaginertia="{_vec(body.inertia)}"')
+        return f"<inertial {' '.join(parts)}/>"
+
+    def write_sections(self) -> None:
+        if self.actuators:
+            self.out.append("  <actuator>")
+            for act in sorted(self.actuators, key=lambda t: t.ID):
+                self.order.setdefault("actuator", []).append(act.ID)
+                if act._NAMESPACE == "raw":
+                    self.out.append(f"    {act.xml}")
+                    continue
+                target = act._parent._NAMESPACE
+                parts = [self.attrs(act), f'{target}="{_q(self.names[act._parent.ID])}"']
+                self.out.append(f"    <{act._TAG} {' '.join(p for p in parts if p)}/>")
+            self.out.append("  </actuator>")
+        if self.sensors:
+            self.out.append("  <sensor>")
+            for sensor in sorted(self.sensors, key=lambda t: t.ID):
+                self.order.setdefault("sensor", []).append(sensor.ID)
+                text = sensor.xml if sensor._NAMESPACE == "raw" else self.sensor_xml(sensor)
+                self.out.append(f"    {text}")
+            self.out.append("  </sensor>")
+
+    def sensor_xml(self, sensor: Any) -> str:
+        parent = sensor._parent
+        target = self.names[parent.ID]
+        if sensor._TARGET_ATTR == "objname":
+            attrs = self.attrs(sensor, skip={"objtype", "reftype", "refname"})
+            objtype = sensor.objtype or parent._NAMESPACE
+            extra = f'objtype="{objtype}" objname="{_q(target)}"'
+            if sensor.refname is not None:
+                ref = sensor.refname
+                reftype = sensor.reftype or (
+                    ref._NAMESPACE if isinstance(ref, BaseThing) else "body"
+                )
+                extra += f' reftype="{reftype}" refname="{_q(self.ref_name(ref))}"'
+        else:
+            attrs = self.attrs(sensor)
+            extra = f'{sensor._TARGET_ATTR}="{_q(target)}"'
+        return f"<{sensor._TAG} {' '.join(p for p in (attrs, extra) if p)}/>"
+
+
+def _hashable(value: Any) -> Any:
+    if hasattr(value, "tobytes"):
+        return (value.dtype.str, value.tobytes())
+    return value
+
+
+def _unique(taken: set[tuple[str, str]], kind: str, base: str) -> str:
+    name = base
+    k = 1
+    while (kind, name) in taken:
+        name = f"{base}_{k}"
+        k += 1
+    taken.add((kind, name))
+    return name
+
+
+def _fmt(value: float) -> str:
+    from robotwright.things.attrs import fmt_float
+
+    return fmt_float(value)
+
+
+def _vec(values: Any) -> str:
+    from robotwright.things.attrs import fmt_float
+
+    return " ".join(fmt_float(v) for v in values)
+
+
+def write_mjcf(
+    world: Any, path_for: Callable[[str], str] | None = None
+) -> tuple[str, dict[str, list[int]]]:
+    """MJCF text of a World and, per namespace, Thing IDs in model-id order."""
+    w = _Writer(world, path_for)
+    w.collect_assets()
+    model_name = world.name or "robotwright"
+    w.out.append(f'<mujoco model="{_q(model_name)}">')
+    w.out.append(f"  {world._compiler_xml()}")
+    option = world._option_xml(w)
+    if option:
+        w.out.append(f"  {option}")
+    for snippet in world._head_xml():
+        w.out.append(snippet)
+    w.write_assets()
+    w.out.append("  <worldbody>")
+    w.order["body"] = [world.ID]
+    w.write_children(world, "    ")
+    w.out.append("  </worldbody>")
+    w.write_sections()
+    for snippet in world._tail_xml():
+        w.out.append(snippet)
+    w.out.append("</mujoco>")
+    return "\n".join(w.out) + "\n", w.order
