@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -36,3 +37,18 @@ def synth_hrdf_dir() -> Path:
 def testdata_dir() -> Path:
     """Folder filled by tools/fetch_test_data.py (mjlab wheel contents, ...)."""
     return _need(TESTDATA, "test data not fetched (run python tools/fetch_test_data.py)")
+
+
+@pytest.fixture
+def hurodes_python() -> str:
+    """A python with hurodes 0.1.9: ``$HURODES_PYTHON``, else the venv fetch_test_data makes."""
+    env = os.environ.get("HURODES_PYTHON")
+    if env:
+        return env
+    candidate = TESTDATA / "hurodes-venv" / "bin" / "python"
+    if not candidate.exists():
+        pytest.skip(
+            "hurodes not available: run tools/fetch_test_data.py (makes .testdata/hurodes-venv) "
+            "or set HURODES_PYTHON to a python with hurodes 0.1.9"
+        )
+    return str(candidate)

@@ -6,6 +6,10 @@ The ``test`` extra installs ``example-robot-data``, ``jvrc-description`` and
 Go1 MJCF models, but installing mjlab would pull torch, so its wheel is downloaded
 without dependencies and unpacked into ``.testdata/mjlab``.
 
+hurodes 0.1.9, the peer tool whose folders we must read and which must read ours, is
+installed into its own virtual environment ``.testdata/hurodes-venv`` (it needs
+``numpy<2.4``); the compatibility tests find it there (or through ``$HURODES_PYTHON``).
+
 Idempotent: does nothing when the data is already there. Exits non-zero on failure.
 """
 
@@ -62,9 +66,28 @@ def fetch_mjlab() -> Path:
     return dest
 
 
+def make_hurodes_venv() -> Path:
+    """hurodes 0.1.9 (the peer) in its own venv: it needs numpy<2.4, we do not."""
+    venv = TESTDATA / "hurodes-venv"
+    python = venv / "bin" / "python"
+    marker = venv / ".hurodes-0.1.9"
+    if marker.exists():
+        print(f"hurodes already in {venv}")
+        return python
+    subprocess.run([sys.executable, "-m", "venv", "--clear", str(venv)], check=True)
+    print("installing hurodes==0.1.9 into", venv)
+    subprocess.run(
+        [str(python), "-m", "pip", "install", "--quiet", "hurodes==0.1.9", "numpy<2.4"],
+        check=True,
+    )
+    marker.write_text("0.1.9")
+    return python
+
+
 def main() -> int:
     TESTDATA.mkdir(exist_ok=True)
     fetch_mjlab()
+    make_hurodes_venv()
     return 0
 
 

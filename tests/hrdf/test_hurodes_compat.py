@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 import uuid
@@ -14,15 +13,8 @@ import pytest
 
 from robotwright.hrdf import HRDF
 
-HURODES_PYTHON = os.environ.get("HURODES_PYTHON")
-
 pytestmark = [
     pytest.mark.hurodes,
-    pytest.mark.skipif(
-        not HURODES_PYTHON,
-        reason="set HURODES_PYTHON to a python with hurodes 0.1.9 (it needs numpy<2.4, so it "
-        "lives in its own virtual environment)",
-    ),
     pytest.mark.filterwarnings("ignore::robotwright.hrdf.io.HRDFWarning"),
 ]
 
@@ -40,13 +32,13 @@ print(json.dumps({"xml": str(out)}))
 """
 
 
-def test_g1_written_by_us_loads_in_hurodes(g1_hrdf_dir: Path) -> None:
+def test_g1_written_by_us_loads_in_hurodes(g1_hrdf_dir: Path, hurodes_python: str) -> None:
     robots = Path.home() / ".hurodes" / "robots"
     name = f"rw_test_{uuid.uuid4().hex[:8]}"
     try:
         HRDF.from_dir(g1_hrdf_dir).save(robots / name)
         out = subprocess.run(
-            [HURODES_PYTHON, "-c", HURODES_EXPORT, str(robots / name)],
+            [hurodes_python, "-c", HURODES_EXPORT, str(robots / name)],
             capture_output=True,
             text=True,
             check=True,
