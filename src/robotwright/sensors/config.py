@@ -88,36 +88,56 @@ class LidarCfg:
     def __post_init__(self) -> None:
         name = type(self).__name__
         if not isinstance(self.prim_path, str) or not self.prim_path:
-            raise SensorError(f"{name}.prim_path: expected the name of a body or site, got {self.prim_path!r}")
+            raise SensorError(
+                f"{name}.prim_path: expected the name of a body or site, got {self.prim_path!r}"
+            )
         if not isinstance(self.pattern_cfg, PatternCfg):
-            raise SensorError(f"{name}.pattern_cfg: expected a PatternCfg, got {type(self.pattern_cfg).__name__}")
+            raise SensorError(
+                f"{name}.pattern_cfg: expected a PatternCfg, got {type(self.pattern_cfg).__name__}"
+            )
         if self.pattern_cfg.num_rays < 1:
             raise SensorError(f"{name}.pattern_cfg: empty pattern (0 rays)")
         if len(self.offset_pos) != 3 or not all(math.isfinite(v) for v in self.offset_pos):
-            raise SensorError(f"{name}.offset_pos: expected 3 finite numbers [m], got {self.offset_pos}")
+            raise SensorError(
+                f"{name}.offset_pos: expected 3 finite numbers [m], got {self.offset_pos}"
+            )
         norm = math.sqrt(sum(v * v for v in self.offset_rot)) if len(self.offset_rot) == 4 else 0.0
         if not norm > 1e-9 or not math.isfinite(norm):
-            raise SensorError(f"{name}.offset_rot: expected a non-zero quaternion (w, x, y, z), got {self.offset_rot}")
+            raise SensorError(
+                f"{name}.offset_rot: expected a non-zero quaternion (w, x, y, z), got {self.offset_rot}"
+            )
         self.offset_rot = tuple(float(v) / norm for v in self.offset_rot)  # type: ignore[assignment]
         if self.ray_alignment not in ("base", "yaw", "world"):
-            raise SensorError(f"{name}.ray_alignment: expected 'base', 'yaw' or 'world', got {self.ray_alignment!r}")
+            raise SensorError(
+                f"{name}.ray_alignment: expected 'base', 'yaw' or 'world', got {self.ray_alignment!r}"
+            )
         if isinstance(self.mesh_prim_paths, str):
-            raise SensorError(f"{name}.mesh_prim_paths: expected a list of names/patterns, got a string")
+            raise SensorError(
+                f"{name}.mesh_prim_paths: expected a list of names/patterns, got a string"
+            )
         self.mesh_prim_paths = list(self.mesh_prim_paths)
         for key in ("min_distance", "max_distance", "range_noise_std"):
             value = getattr(self, key)
             if not isinstance(value, (int, float)) or math.isnan(value) or value < 0:
-                raise SensorError(f"{name}.{key}: expected a non-negative number [m], got {value!r}")
+                raise SensorError(
+                    f"{name}.{key}: expected a non-negative number [m], got {value!r}"
+                )
         if not math.isfinite(self.max_distance) or self.max_distance <= self.min_distance:
             raise SensorError(
                 f"{name}: expected min_distance < max_distance < inf, got {self.min_distance}, {self.max_distance}"
             )
         if not (0.0 <= self.dropout_prob <= 1.0):
-            raise SensorError(f"{name}.dropout_prob: expected a probability in [0, 1], got {self.dropout_prob}")
+            raise SensorError(
+                f"{name}.dropout_prob: expected a probability in [0, 1], got {self.dropout_prob}"
+            )
         if self.engine not in ("mujoco", "warp"):
             raise SensorError(f"{name}.engine: expected 'mujoco' or 'warp', got {self.engine!r}")
-        if self.num_threads is not None and (not isinstance(self.num_threads, int) or self.num_threads < 1):
-            raise SensorError(f"{name}.num_threads: expected an integer >= 1 or None, got {self.num_threads!r}")
+        if self.num_threads is not None and (
+            not isinstance(self.num_threads, int) or self.num_threads < 1
+        ):
+            raise SensorError(
+                f"{name}.num_threads: expected an integer >= 1 or None, got {self.num_threads!r}"
+            )
 
 
 @dataclass(kw_only=True)
@@ -142,17 +162,27 @@ class SemanticLidarCfg(LidarCfg):
         super().__post_init__()
         name = type(self).__name__
         if self.semantic_class_mapping is None:
-            self.semantic_class_mapping = {k: list(v) for k, v in DEFAULT_SEMANTIC_CLASS_MAPPING.items()}
+            self.semantic_class_mapping = {
+                k: list(v) for k, v in DEFAULT_SEMANTIC_CLASS_MAPPING.items()
+            }
         if not isinstance(self.semantic_class_mapping, dict):
-            raise SensorError(f"{name}.semantic_class_mapping: expected a dict of class name -> keywords")
+            raise SensorError(
+                f"{name}.semantic_class_mapping: expected a dict of class name -> keywords"
+            )
         for cls, keywords in self.semantic_class_mapping.items():
             if not isinstance(cls, str) or not cls:
-                raise SensorError(f"{name}.semantic_class_mapping: class names must be non-empty strings, got {cls!r}")
+                raise SensorError(
+                    f"{name}.semantic_class_mapping: class names must be non-empty strings, got {cls!r}"
+                )
             if isinstance(keywords, str) or not isinstance(keywords, (list, tuple)):
                 raise SensorError(
                     f"{name}.semantic_class_mapping[{cls!r}]: expected a list of keywords, got {keywords!r}"
                 )
             if not keywords:
-                raise SensorError(f"{name}.semantic_class_mapping[{cls!r}]: empty keyword list (class can never match)")
+                raise SensorError(
+                    f"{name}.semantic_class_mapping[{cls!r}]: empty keyword list (class can never match)"
+                )
             if any(not isinstance(k, str) or not k for k in keywords):
-                raise SensorError(f"{name}.semantic_class_mapping[{cls!r}]: keywords must be non-empty strings")
+                raise SensorError(
+                    f"{name}.semantic_class_mapping[{cls!r}]: keywords must be non-empty strings"
+                )

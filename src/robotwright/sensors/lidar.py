@@ -74,9 +74,16 @@ def geom_paths(model: mujoco.MjModel, with_mesh: bool = True) -> list[str]:
     paths = []
     for g in range(model.ngeom):
         parts = ["", "world"]
-        parts += [_name(model, mujoco.mjtObj.mjOBJ_BODY, b, "body") for b in _body_chain(model, int(model.geom_bodyid[g]))]
+        parts += [
+            _name(model, mujoco.mjtObj.mjOBJ_BODY, b, "body")
+            for b in _body_chain(model, int(model.geom_bodyid[g]))
+        ]
         parts.append(_name(model, mujoco.mjtObj.mjOBJ_GEOM, g, "geom"))
-        if with_mesh and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH and model.geom_dataid[g] >= 0:
+        if (
+            with_mesh
+            and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH
+            and model.geom_dataid[g] >= 0
+        ):
             parts.append(_name(model, mujoco.mjtObj.mjOBJ_MESH, int(model.geom_dataid[g]), "mesh"))
         paths.append("/".join(parts))
     return paths
@@ -106,23 +113,37 @@ class LidarSensor:
 
     cfg: LidarCfg
 
-    def __init__(self, cfg: LidarCfg, model: mujoco.MjModel, data: mujoco.MjData | Sequence[mujoco.MjData]) -> None:
+    def __init__(
+        self, cfg: LidarCfg, model: mujoco.MjModel, data: mujoco.MjData | Sequence[mujoco.MjData]
+    ) -> None:
         if not isinstance(cfg, LidarCfg):
             raise SensorError(f"cfg: expected a LidarCfg, got {type(cfg).__name__}")
         self.cfg = cfg
         self.model = model
         self._datas: list[mujoco.MjData] = [data] if isinstance(data, mujoco.MjData) else list(data)
         if not self._datas:
-            raise SensorError("data: expected one MjData or a non-empty list of them (one per environment)")
+            raise SensorError(
+                "data: expected one MjData or a non-empty list of them (one per environment)"
+            )
         for i, d in enumerate(self._datas):
-            if not isinstance(d, mujoco.MjData) or d.xpos.shape[0] != model.nbody or d.geom_xpos.shape[0] != model.ngeom:
-                raise SensorError(f"data[{i}]: expected an MjData of this model ({model.nbody} bodies, {model.ngeom} geoms)")
-        self._carrier_kind, self._carrier_id, self._carrier_body = self._resolve_carrier(cfg.prim_path)
+            if (
+                not isinstance(d, mujoco.MjData)
+                or d.xpos.shape[0] != model.nbody
+                or d.geom_xpos.shape[0] != model.ngeom
+            ):
+                raise SensorError(
+                    f"data[{i}]: expected an MjData of this model ({model.nbody} bodies, {model.ngeom} geoms)"
+                )
+        self._carrier_kind, self._carrier_id, self._carrier_body = self._resolve_carrier(
+            cfg.prim_path
+        )
         self._geom_paths = geom_paths(model)
         self.hittable_geom_mask = self._select_geoms()
         self._ray_model = make_ray_model(model, self.hittable_geom_mask)
         if cfg.engine == "warp":
-            self._engine: MujocoRayEngine | WarpRayEngine = WarpRayEngine(self._ray_model, self.num_envs, cfg.device)
+            self._engine: MujocoRayEngine | WarpRayEngine = WarpRayEngine(
+                self._ray_model, self.num_envs, cfg.device
+            )
         else:
             self._engine = MujocoRayEngine(self._ray_model, cfg.num_threads)
         self._offset_mat = _quat_to_mat(cfg.offset_rot)
@@ -169,7 +190,9 @@ class LidarSensor:
         names += [_name(m, mujoco.mjtObj.mjOBJ_SITE, i, "") for i in range(m.nsite)]
         close = difflib.get_close_matches(name, [n for n in names if n], n=3)
         hint = f"; did you mean {', '.join(map(repr, close))}?" if close else ""
-        raise SensorError(f"{type(self.cfg).__name__}.prim_path: no body or site named {name!r} in the model{hint}")
+        raise SensorError(
+            f"{type(self.cfg).__name__}.prim_path: no body or site named {name!r} in the model{hint}"
+        )
 
     def robot_body_ids(self) -> np.ndarray:
         """Bodies of the robot that carries the sensor (same root body; none on the world)."""
@@ -199,7 +222,11 @@ class LidarSensor:
                     names.append("world")
                 candidates.append(names)
             for pattern in cfg.mesh_prim_paths:
-                hits = [g for g in range(m.ngeom) if any(fnmatch.fnmatchcase(c, pattern) for c in candidates[g])]
+                hits = [
+                    g
+                    for g in range(m.ngeom)
+                    if any(fnmatch.fnmatchcase(c, pattern) for c in candidates[g])
+                ]
                 if not hits:
                     raise SensorError(
                         f"{type(cfg).__name__}.mesh_prim_paths: {pattern!r} matches no geom or body of the model"
@@ -297,7 +324,9 @@ class LidarSensor:
         d.ray_directions_w[:] = dirs_w
         d.hit_mask[:] = hit
         d.distances[:] = np.where(hit, dist, cfg.miss_distance)
-        d.hit_points_w[:] = np.where(hit[..., None], origins_w + dirs_w * np.where(hit, dist, 0.0)[..., None], np.nan)
+        d.hit_points_w[:] = np.where(
+            hit[..., None], origins_w + dirs_w * np.where(hit, dist, 0.0)[..., None], np.nan
+        )
         self._raw_geom_ids[:] = np.where(hit, geom_ids, -1)
 
     # ------------------------------------------------------------------ getters
@@ -306,14 +335,18 @@ class LidarSensor:
             return slice(None)
         ids = np.asarray(env_ids, dtype=int).reshape(-1)
         if ids.size and (ids.min() < -self.num_envs or ids.max() >= self.num_envs):
-            raise SensorError(f"env_ids: expected indices in [0, {self.num_envs}), got {ids.tolist()}")
+            raise SensorError(
+                f"env_ids: expected indices in [0, {self.num_envs}), got {ids.tolist()}"
+            )
         return ids
 
     def get_distances(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
         """Ranges ``(num_envs, num_rays)`` [m]; misses are ``cfg.miss_distance`` (inf)."""
         return self._data.distances[self._rows(env_ids)].copy()
 
-    def get_pointcloud(self, env_ids: Sequence[int] | np.ndarray | None = None, frame: str = "world") -> np.ndarray:
+    def get_pointcloud(
+        self, env_ids: Sequence[int] | np.ndarray | None = None, frame: str = "world"
+    ) -> np.ndarray:
         """Hit points ``(num_envs, num_rays, 3)`` [m], NaN for misses.
 
         Args:
@@ -338,4 +371,3 @@ class LidarSensor:
             f"{type(self).__name__}(prim_path={self.cfg.prim_path!r}, num_envs={self.num_envs}, "
             f"num_rays={self.num_rays}, engine={self.engine_name!r}, max_distance={self.max_distance})"
         )
-

@@ -151,14 +151,18 @@ class LivoxPatternCfg(PatternCfg):
         for key in ("points_per_second", "horizontal_fov", "rotation_hz", "elevation_sweep_hz"):
             _check_positive(key, getattr(self, key), name)
         if self.horizontal_fov > 2.0 * math.pi + 1e-12:
-            raise SensorError(f"{name}.horizontal_fov: expected <= 2*pi rad, got {self.horizontal_fov}")
+            raise SensorError(
+                f"{name}.horizontal_fov: expected <= 2*pi rad, got {self.horizontal_fov}"
+            )
         lo, hi = self.vertical_fov_min, self.vertical_fov_max
         if not (-math.pi / 2 <= lo < hi <= math.pi / 2):
             raise SensorError(
                 f"{name}: expected -pi/2 <= vertical_fov_min < vertical_fov_max <= pi/2, got {lo}, {hi}"
             )
         if len(self.prism_rpm) != 2 or self.prism_rpm[0] == self.prism_rpm[1]:
-            raise SensorError(f"{name}.prism_rpm: expected two different rates, got {self.prism_rpm}")
+            raise SensorError(
+                f"{name}.prism_rpm: expected two different rates, got {self.prism_rpm}"
+            )
 
     def _directions(self, frame: int) -> np.ndarray:
         idx = np.arange(self.num_rays, dtype=np.float64) + float(frame) * self.num_rays
@@ -184,10 +188,39 @@ class LivoxPatternCfg(PatternCfg):
 
 # Published vertical angles (degrees) of common spinning sensors.
 _VLP32C_DEG = (
-    -25.0, -15.639, -11.31, -8.843, -7.254, -6.148, -5.333, -4.667, -4.0, -3.667, -3.333,
-    -3.0, -2.667, -2.333, -2.0, -1.667, -1.333, -1.0, -0.667, -0.333, 0.0, 0.333, 0.667,
-    1.0, 1.333, 1.667, 2.333, 3.333, 4.667, 7.0, 10.333, 15.0,
-)  # fmt: skip
+    -25.0,
+    -15.639,
+    -11.31,
+    -8.843,
+    -7.254,
+    -6.148,
+    -5.333,
+    -4.667,
+    -4.0,
+    -3.667,
+    -3.333,
+    -3.0,
+    -2.667,
+    -2.333,
+    -2.0,
+    -1.667,
+    -1.333,
+    -1.0,
+    -0.667,
+    -0.333,
+    0.0,
+    0.333,
+    0.667,
+    1.0,
+    1.333,
+    1.667,
+    2.333,
+    3.333,
+    4.667,
+    7.0,
+    10.333,
+    15.0,
+)
 
 
 @dataclass(kw_only=True)
@@ -213,7 +246,9 @@ class SpinningLidarPatternCfg(PatternCfg):
         name = type(self).__name__
         self.vertical_angles = tuple(float(a) for a in self.vertical_angles)
         if not self.vertical_angles:
-            raise SensorError(f"{name}.vertical_angles: empty pattern (expected at least one channel)")
+            raise SensorError(
+                f"{name}.vertical_angles: empty pattern (expected at least one channel)"
+            )
         if any(abs(a) > math.pi / 2 for a in self.vertical_angles):
             raise SensorError(f"{name}.vertical_angles: expected angles in [-pi/2, pi/2] rad")
         _check_positive("horizontal_resolution", self.horizontal_resolution, name)
@@ -271,10 +306,14 @@ class GridPatternCfg(PatternCfg):
         name = type(self).__name__
         _check_positive("resolution", self.resolution, name)
         if len(self.size) != 2 or any(not math.isfinite(s) or s < 0 for s in self.size):
-            raise SensorError(f"{name}.size: expected two non-negative lengths [m], got {self.size}")
+            raise SensorError(
+                f"{name}.size: expected two non-negative lengths [m], got {self.size}"
+            )
         norm = float(np.linalg.norm(self.direction))
         if len(self.direction) != 3 or not norm > 0:
-            raise SensorError(f"{name}.direction: expected a non-zero 3-vector, got {self.direction}")
+            raise SensorError(
+                f"{name}.direction: expected a non-zero 3-vector, got {self.direction}"
+            )
 
     def _grid(self) -> np.ndarray:
         xs = np.arange(-self.size[0] / 2, self.size[0] / 2 + 1e-9, self.resolution)
@@ -313,7 +352,9 @@ class PinholeCameraPatternCfg(PatternCfg):
         _check_count("height", self.height, name)
         _check_positive("horizontal_fov", self.horizontal_fov, name)
         if self.horizontal_fov >= math.pi:
-            raise SensorError(f"{name}.horizontal_fov: expected < pi rad, got {self.horizontal_fov}")
+            raise SensorError(
+                f"{name}.horizontal_fov: expected < pi rad, got {self.horizontal_fov}"
+            )
 
     def _directions(self, frame: int) -> np.ndarray:
         f = (self.width / 2.0) / math.tan(self.horizontal_fov / 2.0)  # focal length [px]
@@ -350,12 +391,16 @@ class FilePatternCfg(PatternCfg):
             angles = _read_angle_table(path)
         angles = np.asarray(angles, dtype=np.float64)
         if angles.ndim != 2 or angles.shape[1] != 2:
-            raise SensorError(f"{path}: expected N rows of (azimuth, elevation), got shape {angles.shape}")
+            raise SensorError(
+                f"{path}: expected N rows of (azimuth, elevation), got shape {angles.shape}"
+            )
         if angles.shape[0] == 0:
             raise SensorError(f"{path}: empty pattern (no rays)")
         if self.degrees:
             angles = np.radians(angles)
-        bad = np.flatnonzero(~np.isfinite(angles).all(axis=1) | (np.abs(angles[:, 1]) > math.pi / 2 + 1e-12))
+        bad = np.flatnonzero(
+            ~np.isfinite(angles).all(axis=1) | (np.abs(angles[:, 1]) > math.pi / 2 + 1e-12)
+        )
         if bad.size:
             raise SensorError(
                 f"{path}: row {int(bad[0])}: expected finite azimuth and elevation in [-pi/2, pi/2] rad"
@@ -384,7 +429,9 @@ def _read_angle_table(path: Path) -> np.ndarray:
                 continue
             raise SensorError(f"{path}: line {lineno}: expected two numbers, got {raw!r}") from None
         if len(values) != 2:
-            raise SensorError(f"{path}: line {lineno}: expected 2 columns (azimuth, elevation), got {len(values)}")
+            raise SensorError(
+                f"{path}: line {lineno}: expected 2 columns (azimuth, elevation), got {len(values)}"
+            )
         rows.append(values)
     return np.asarray(rows, dtype=np.float64).reshape(-1, 2)
 

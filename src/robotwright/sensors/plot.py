@@ -12,7 +12,17 @@ import numpy as np
 __all__ = ["plot_scan"]
 
 # Fixed colours so the same class looks the same in every picture (class 0 = unknown).
-_COLORS = ["#9e9e9e", "#8c6d31", "#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2"]
+_COLORS = [
+    "#9e9e9e",
+    "#8c6d31",
+    "#d62728",
+    "#1f77b4",
+    "#2ca02c",
+    "#9467bd",
+    "#ff7f0e",
+    "#17becf",
+    "#e377c2",
+]
 
 
 def plot_scan(
@@ -44,23 +54,35 @@ def plot_scan(
     points, labels = points[keep], labels[keep]
     fig, axes = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1, 1]})
     views = (("top view", 0, 1, "x [m]", "y [m]"), ("side view", 0, 2, "x [m]", "z [m]"))
-    for ax, (name, i, j, xl, yl) in zip(axes, views):
-        for cls_id, cls_name in enumerate(class_names):
+    for ax, (name, i, j, xl, yl) in zip(axes, views, strict=True):
+        for cls_id in range(len(class_names)):
             sel = labels == cls_id
             if not sel.any():
                 continue
             color = _COLORS[cls_id % len(_COLORS)]
-            ax.scatter(points[sel, i], points[sel, j], s=1.5, c=color, linewidths=0,
-                       label=f"{cls_id} {cls_name} ({int(sel.sum())} pts)")  # fmt: skip
+            ax.scatter(points[sel, i], points[sel, j], s=1.5, c=color, linewidths=0)
         if sensor_pos is not None:
-            ax.plot(sensor_pos[i], sensor_pos[j], "kx", markersize=10, mew=2, label="sensor")
+            ax.plot(sensor_pos[i], sensor_pos[j], "kx", markersize=10, mew=2)
         ax.set_title(name)
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, alpha=0.3)
-    handles, names = axes[0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="lower center", ncol=min(len(names), 5), markerscale=6, frameon=False)
+    from matplotlib.lines import Line2D
+
+    # Legend markers drawn at a readable size (the scatter dots themselves are tiny).
+    handles = []
+    for cls_id, cls_name in enumerate(class_names):
+        n = int((labels == cls_id).sum())
+        color = _COLORS[cls_id % len(_COLORS)]
+        handles.append(
+            Line2D(
+                [], [], ls="", marker="o", ms=7, color=color, label=f"{cls_id} {cls_name} ({n} pts)"
+            )
+        )
+    if sensor_pos is not None:
+        handles.append(Line2D([], [], ls="", marker="x", ms=9, mew=2, color="k", label="sensor"))
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 5), frameon=False)
     fig.suptitle(title or f"LiDAR scan: {len(points)} points")
     fig.tight_layout(rect=(0, 0.07, 1, 0.97))
     path = Path(path)

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import copy
 import os
-from concurrent.futures import ThreadPoolExecutor
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import mujoco
@@ -27,7 +27,13 @@ import numpy as np
 
 from robotwright.errors import SensorError
 
-__all__ = ["make_ray_model", "MujocoRayEngine", "WarpRayEngine", "warp_available"]
+__all__ = [
+    "make_ray_model",
+    "MujocoRayEngine",
+    "WarpRayEngine",
+    "refine_curved_hits",
+    "warp_available",
+]
 
 #: mj_multiRay's geomgroup filter: only group 0 (the hittable geoms of the ray model).
 _GEOMGROUP = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
@@ -52,7 +58,7 @@ def make_ray_model(model: mujoco.MjModel, hittable: np.ndarray) -> mujoco.MjMode
 
 def _split(n: int, parts: int) -> list[tuple[int, int]]:
     bounds = np.linspace(0, n, parts + 1).round().astype(int)
-    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
 
 
 class MujocoRayEngine:
@@ -125,14 +131,31 @@ class MujocoRayEngine:
                     last_env = e
                 if single_origin:
                     mujoco.mj_multiRay(
-                        self.model, scratch, origins[e, 0], directions[e, a:b].ravel(), _GEOMGROUP,
-                        1, -1, geomid[e, a:b], dist[e, a:b], None, b - a, cutoff,
-                    )  # fmt: skip
+                        self.model,
+                        scratch,
+                        origins[e, 0],
+                        directions[e, a:b].ravel(),
+                        _GEOMGROUP,
+                        1,
+                        -1,
+                        geomid[e, a:b],
+                        dist[e, a:b],
+                        None,
+                        b - a,
+                        cutoff,
+                    )
                 else:
                     gid = np.empty(1, dtype=np.int32)
                     for i in range(a, b):
                         dist[e, i] = mujoco.mj_ray(
-                            self.model, scratch, origins[e, i], directions[e, i], _GEOMGROUP, 1, -1, gid
+                            self.model,
+                            scratch,
+                            origins[e, i],
+                            directions[e, i],
+                            _GEOMGROUP,
+                            1,
+                            -1,
+                            gid,
                         )
                         geomid[e, i] = gid[0]
 
@@ -143,6 +166,101 @@ class MujocoRayEngine:
         else:
             list(self._pool.map(run, busy))
         return dist, geomid
+
+
+_SPHERE, _CAPSULE, _ELLIPSOID, _CYLINDER = (
+    int(mujoco.mjtGeom.mjGEOM_SPHERE),
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE),
+    int(mujoco.mjtGeom.mjGEOM_ELLIPSOID),
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER),
+)
+
+
+def _quadric_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Both roots of a t^2 + 2 b t + c = 0 (NaN where none), numerically stable."""
+    disc = b * b - a * c
+    ok = (disc >= 0) & (a > 0)
+    sq = np.sqrt(np.where(ok, disc, 0.0))
+    q = -(b + np.copysign(sq, b))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1 = np.where(ok, q / a, np.nan)
+        t2 = np.where(ok & (q != 0), c / q, np.where(ok, -b / np.where(a > 0, a, 1.0), np.nan))
+    return t1, t2
+
+
+def refine_curved_hits(
+    model: mujoco.MjModel,
+    geom_xpos: np.ndarray,
+    geom_xmat: np.ndarray,
+    origins: np.ndarray,
+    directions: np.ndarray,
+    dist: np.ndarray,
+    geomid: np.ndarray,
+) -> None:
+    """Recompute, in float64, the distance of hits on spheres, capsules, ellipsoids and cylinders.
+
+    A float32 quadratic solve loses about ``sqrt(eps32) * radius`` (up to ~1e-4 m)
+    on grazing rays; box, plane, mesh and heightfield hits only lose ``eps32 * t``.
+    The engine already found which geom each ray hits, so the exact float64 root is
+    the candidate surface intersection nearest to the float32 distance.
+
+    Args:
+        geom_xpos, geom_xmat: ``(E, ngeom, 3)`` and ``(E, ngeom, 9)`` geom poses.
+        origins, directions: ``(E, N, 3)`` world-frame rays (unit directions).
+        dist, geomid: ``(E, N)`` engine results, refined in place.
+    """
+    gtype = model.geom_type
+    curved = np.zeros(model.ngeom + 1, dtype=bool)
+    curved[1:] = np.isin(gtype, (_SPHERE, _CAPSULE, _ELLIPSOID, _CYLINDER))
+    e_idx, r_idx = np.nonzero(curved[geomid + 1])
+    if e_idx.size == 0:
+        return
+    g = geomid[e_idx, r_idx]
+    pos = geom_xpos[e_idx, g]
+    mat = geom_xmat[e_idx, g].reshape(-1, 3, 3)
+    # Ray in the geom frame: p = R^T (o - x), v = R^T d.
+    p = np.einsum("kji,kj->ki", mat, origins[e_idx, r_idx] - pos)
+    v = np.einsum("kji,kj->ki", mat, directions[e_idx, r_idx])
+    size = model.geom_size[g]
+    kind = gtype[g]
+    t0 = dist[e_idx, r_idx]
+    cands: list[np.ndarray] = []
+
+    def add(t: np.ndarray, valid: np.ndarray) -> None:
+        cands.append(np.where(valid & (t >= 0), t, np.nan))
+
+    # Ellipsoid and sphere: scaled unit sphere.
+    radii = np.where((kind == _ELLIPSOID)[:, None], size, size[:, :1])
+    ps, vs = p / radii, v / radii
+    is_ell = (kind == _SPHERE) | (kind == _ELLIPSOID)
+    t1, t2 = _quadric_roots((vs * vs).sum(1), (ps * vs).sum(1), (ps * ps).sum(1) - 1.0)
+    add(t1, is_ell)
+    add(t2, is_ell)
+    # Capsule and cylinder sides: infinite cylinder x^2 + y^2 = r^2, |z| <= half length.
+    r, h = size[:, 0], size[:, 1]
+    is_cyl = (kind == _CAPSULE) | (kind == _CYLINDER)
+    for t in _quadric_roots(
+        v[:, 0] ** 2 + v[:, 1] ** 2,
+        p[:, 0] * v[:, 0] + p[:, 1] * v[:, 1],
+        p[:, 0] ** 2 + p[:, 1] ** 2 - r * r,
+    ):
+        add(t, is_cyl & (np.abs(p[:, 2] + t * v[:, 2]) <= h))
+    for sign in (-1.0, 1.0):
+        # Capsule caps: spheres of radius r at z = +-h.
+        pc = p - np.stack([np.zeros_like(h), np.zeros_like(h), sign * h], axis=1)
+        for t in _quadric_roots((v * v).sum(1), (pc * v).sum(1), (pc * pc).sum(1) - r * r):
+            add(t, (kind == _CAPSULE) & (sign * (p[:, 2] + t * v[:, 2]) >= h))
+        # Cylinder caps: discs at z = +-h.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (sign * h - p[:, 2]) / v[:, 2]
+            x, y = p[:, 0] + t * v[:, 0], p[:, 1] + t * v[:, 1]
+            add(t, (kind == _CYLINDER) & (v[:, 2] != 0) & (x * x + y * y <= r * r))
+    stack = np.stack(cands, axis=1)
+    err = np.abs(stack - t0[:, None])
+    err[np.isnan(err)] = np.inf
+    best = np.argmin(err, axis=1)
+    found = np.isfinite(err[np.arange(best.size), best])
+    dist[e_idx[found], r_idx[found]] = stack[np.arange(best.size), best][found]
 
 
 def warp_available() -> bool:
@@ -161,11 +279,24 @@ class WarpRayEngine:
     Runs on warp's CPU device or on CUDA. Only the hittable geoms (group 0 of the ray
     model) enter the BVH. Geom poses are uploaded from the ``MjData`` of each
     environment, the BVH is refit, and one kernel casts every ray of every world.
+    With ``refine`` (default) hits on curved primitives get their distance recomputed
+    in float64 on the host (:func:`refine_curved_hits`).
+
+    Known difference from ``mj_multiRay`` (mujoco-warp 4.0): a heightfield is only its
+    top surface, so rays that MuJoCo stops on a heightfield's vertical sides pass
+    through here.
     """
 
     name = "warp"
 
-    def __init__(self, ray_model: mujoco.MjModel, num_envs: int, device: str | None = None) -> None:
+    def __init__(
+        self,
+        ray_model: mujoco.MjModel,
+        num_envs: int,
+        device: str | None = None,
+        refine: bool = True,
+    ) -> None:
+        self.refine = refine
         try:
             import warp as wp
 
@@ -238,9 +369,35 @@ class WarpRayEngine:
         pnt, vec, bodyexclude, dist, geomid, normal = self._alloc(num_rays)
         with wp.ScopedDevice(self.device):
             self._d.geom_xpos.assign(np.asarray(geom_xpos, dtype=np.float32))
-            self._d.geom_xmat.assign(np.asarray(geom_xmat, dtype=np.float32).reshape(num_envs, -1, 3, 3))
+            self._d.geom_xmat.assign(
+                np.asarray(geom_xmat, dtype=np.float32).reshape(num_envs, -1, 3, 3)
+            )
             pnt.assign(np.asarray(origins, dtype=np.float32))
             vec.assign(np.asarray(directions, dtype=np.float32))
             mjw.refit_bvh(self._m, self._d, self._rc)
-            mjw.rays(self._m, self._d, pnt, vec, self._geomgroup, True, bodyexclude, dist, geomid, normal, self._rc)
-            return dist.numpy().astype(np.float64), geomid.numpy().astype(np.int32)
+            mjw.rays(
+                self._m,
+                self._d,
+                pnt,
+                vec,
+                self._geomgroup,
+                True,
+                bodyexclude,
+                dist,
+                geomid,
+                normal,
+                self._rc,
+            )
+            out_dist = dist.numpy().astype(np.float64)
+            out_ids = geomid.numpy().astype(np.int32)
+        if self.refine:
+            refine_curved_hits(
+                self.model,
+                np.asarray(geom_xpos),
+                np.asarray(geom_xmat),
+                origins,
+                directions,
+                out_dist,
+                out_ids,
+            )
+        return out_dist, out_ids

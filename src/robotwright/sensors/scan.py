@@ -80,7 +80,10 @@ def scan_to_files(
     points = lidar.get_pointcloud()[0]
     labels = lidar.get_semantic_labels()[0]
     mesh_ids = lidar.get_mesh_ids()[0]
-    counts = {name: int((labels[lidar.get_hit_mask()[0]] == i).sum()) for i, name in enumerate(lidar.class_names)}
+    counts = {
+        name: int((labels[lidar.get_hit_mask()[0]] == i).sum())
+        for i, name in enumerate(lidar.class_names)
+    }
     if npz_path is not None:
         save_npz(
             npz_path,
@@ -101,7 +104,8 @@ def scan_to_files(
             lidar.class_names,
             png_path,
             sensor_pos=lidar.data.pos_w[0],
-            title=title or f"{pattern_name} scan from '{sensor}': {int(lidar.get_hit_mask().sum())} hits",
+            title=title
+            or f"{pattern_name} scan from '{sensor}': {int(lidar.get_hit_mask().sum())} hits",
         )
     return {
         "sensor": sensor,

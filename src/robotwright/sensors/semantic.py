@@ -53,12 +53,17 @@ class SemanticLidarSensor(LidarSensor):
     cfg: SemanticLidarCfg
 
     def __init__(
-        self, cfg: SemanticLidarCfg, model: mujoco.MjModel, data: mujoco.MjData | Sequence[mujoco.MjData]
+        self,
+        cfg: SemanticLidarCfg,
+        model: mujoco.MjModel,
+        data: mujoco.MjData | Sequence[mujoco.MjData],
     ) -> None:
         if not isinstance(cfg, SemanticLidarCfg):
             raise SensorError(f"cfg: expected a SemanticLidarCfg, got {type(cfg).__name__}")
         assert cfg.semantic_class_mapping is not None  # filled by SemanticLidarCfg.__post_init__
-        self.semantic_class_mapping: dict[str, list[str]] = {k: list(v) for k, v in cfg.semantic_class_mapping.items()}
+        self.semantic_class_mapping: dict[str, list[str]] = {
+            k: list(v) for k, v in cfg.semantic_class_mapping.items()
+        }
         self.class_names: tuple[str, ...] = ("unknown", *self.semantic_class_mapping)
         self._keywords = [
             (cls_id, [k.lower() for k in keywords])
@@ -85,7 +90,9 @@ class SemanticLidarSensor(LidarSensor):
         shape = (self.num_envs, self.num_rays)
         return SemanticLidarData(
             **vars(base),
-            semantic_labels=np.zeros(shape, dtype=np.int32) if self.cfg.return_semantic_labels else None,
+            semantic_labels=np.zeros(shape, dtype=np.int32)
+            if self.cfg.return_semantic_labels
+            else None,
             mesh_ids=np.full(shape, -1, dtype=np.int32) if self.cfg.return_mesh_ids else None,
         )
 
@@ -129,7 +136,9 @@ class SemanticLidarSensor(LidarSensor):
     def get_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
         """Class id per ray ``(num_envs, num_rays)`` int32 (0 = miss/unknown)."""
         if self._data.semantic_labels is None:
-            raise SensorError("semantic labels are off: set SemanticLidarCfg.return_semantic_labels=True")
+            raise SensorError(
+                "semantic labels are off: set SemanticLidarCfg.return_semantic_labels=True"
+            )
         return self._data.semantic_labels[self._rows(env_ids)].copy()
 
     def get_mesh_ids(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:

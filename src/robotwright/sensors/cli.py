@@ -1,0 +1,100 @@
+"""``robotwright lidar``: scan a MuJoCo scene with a semantic LiDAR, save data and a picture."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import mujoco
+
+from robotwright.errors import SensorError
+from robotwright.sensors.patterns import PATTERN_NAMES
+from robotwright.sensors.scan import scan_to_files
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "lidar",
+        help="scan an MJCF scene with a semantic LiDAR (saves .npz, draws .png)",
+        description=(
+            "Cast one frame of a LiDAR pattern from a body or site of an MJCF scene and save "
+            "distances [m], world-frame points [m], semantic labels and hit geom ids."
+        ),
+    )
+    p.add_argument("scene", type=Path, help="MJCF file of the scene")
+    p.add_argument("--sensor", required=True, help="name of the body or site carrying the sensor")
+    p.add_argument(
+        "--pattern", default="mid360", choices=PATTERN_NAMES, help="scan pattern (default mid360)"
+    )
+    p.add_argument("-o", "--output", type=Path, help="output .npz file")
+    p.add_argument("--png", type=Path, help="output picture (top and side views coloured by class)")
+    p.add_argument(
+        "--max-distance", type=float, default=40.0, help="maximum range [m] (default 40)"
+    )
+    p.add_argument(
+        "--offset",
+        type=float,
+        nargs=3,
+        default=(0.0, 0.0, 0.0),
+        metavar=("X", "Y", "Z"),
+        help="sensor position in the carrier's frame [m]",
+    )
+    p.add_argument(
+        "--mapping",
+        type=Path,
+        help="JSON file: {class name: [keywords]} (default: the seed's mapping)",
+    )
+    p.add_argument(
+        "--include-robot", action="store_true", help="let rays hit the robot carrying the sensor"
+    )
+    p.add_argument(
+        "--engine", choices=("mujoco", "warp"), default="mujoco", help="ray engine (default mujoco)"
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.output is None and args.png is None:
+        raise SensorError("nothing to write: give -o SCAN.npz and/or --png SCAN.png")
+    if not args.scene.is_file():
+        raise SensorError(f"{args.scene}: scene file not found")
+    mapping = None
+    if args.mapping is not None:
+        try:
+            mapping = json.loads(args.mapping.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise SensorError(
+                f"{args.mapping}: expected a JSON object {{class: [keywords]}}: {exc}"
+            ) from exc
+        if not isinstance(mapping, dict):
+            raise SensorError(f"{args.mapping}: expected a JSON object {{class: [keywords]}}")
+    try:
+        model = mujoco.MjModel.from_xml_path(str(args.scene))
+    except ValueError as exc:  # MuJoCo reports compile errors as ValueError
+        raise SensorError(f"{args.scene}: MuJoCo cannot load the scene: {exc}") from exc
+    data = mujoco.MjData(model)
+    if model.nkey:
+        mujoco.mj_resetDataKeyframe(model, data, 0)
+    mujoco.mj_forward(model, data)
+    summary = scan_to_files(
+        model,
+        data,
+        args.sensor,
+        args.pattern,
+        args.output,
+        args.png,
+        semantic_class_mapping=mapping,
+        max_distance=args.max_distance,
+        offset_pos=tuple(args.offset),
+        exclude_robot=not args.include_robot,
+        engine=args.engine,
+    )
+    counts = ", ".join(f"{k}={v}" for k, v in summary["class_counts"].items())
+    print(f"{summary['num_rays']} rays, {summary['num_hits']} hits ({counts})")
+    for key in ("npz", "png"):
+        if summary[key]:
+            print(f"wrote {summary[key]}")
+    return 0

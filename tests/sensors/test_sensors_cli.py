@@ -1,0 +1,97 @@
+"""``robotwright lidar`` and scan_to_files: files written, contents consistent, clean errors."""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import numpy as np
+from lidar_scenes import CLUTTER_XML
+
+from robotwright.cli import main
+from robotwright.sensors import scan_to_files
+
+
+def test_cli_writes_npz_and_png(tmp_path, capsys):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    npz, png = tmp_path / "scan.npz", tmp_path / "scan.png"
+    rc = main(
+        [
+            "lidar",
+            str(scene),
+            "--sensor",
+            "lidar",
+            "--pattern",
+            "mid360",
+            "-o",
+            str(npz),
+            "--png",
+            str(png),
+        ]
+    )
+    assert rc == 0
+    out = capsys.readouterr().out
+    assert "20000 rays" in out and str(npz) in out
+    with np.load(npz) as z:
+        assert z["distances"].shape == (20000,) and z["points"].shape == (20000, 3)
+        hit = np.isfinite(z["distances"])
+        np.testing.assert_array_equal(hit, z["mesh_ids"] >= 0)
+        np.testing.assert_array_equal(np.isnan(z["points"]).any(axis=1), ~hit)
+        assert list(z["class_names"]) == ["unknown", "terrain", "dynamic_obstacle", "valuable"]
+        # Points lie at distance along the ray from the sensor.
+        d = np.linalg.norm(z["points"][hit] - z["sensor_pos"], axis=1)
+        np.testing.assert_allclose(d, z["distances"][hit], atol=1e-9)
+        assert (z["labels"][~hit] == 0).all() and set(np.unique(z["labels"][hit])) >= {1, 2}
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_cli_bad_sensor_writes_nothing(tmp_path, capsys):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    rc = main(["lidar", str(scene), "--sensor", "lidr", "-o", str(tmp_path / "scan.npz")])
+    assert rc == 2
+    assert "no body or site named 'lidr'" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.xml"]
+
+
+def test_cli_custom_mapping(tmp_path):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    mapping = tmp_path / "mapping.json"
+    mapping.write_text(json.dumps({"light": ["lamp"], "terrain": ["ground"]}), encoding="utf-8")
+    npz = tmp_path / "scan.npz"
+    assert (
+        main(
+            [
+                "lidar",
+                str(scene),
+                "--sensor",
+                "lidar",
+                "--pattern",
+                "vlp16",
+                "--mapping",
+                str(mapping),
+                "-o",
+                str(npz),
+            ]
+        )
+        == 0
+    )
+    with np.load(npz) as z:
+        assert list(z["class_names"]) == ["unknown", "light", "terrain"]
+        paths = z["geom_paths"]
+        lamp = [i for i, p in enumerate(paths) if "lamp" in p]
+        sel = np.isin(z["mesh_ids"], lamp)
+        assert sel.any() and (z["labels"][sel] == 1).all()
+
+
+def test_scan_to_files_summary(tmp_path):
+    model = mujoco.MjModel.from_xml_string(CLUTTER_XML)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    summary = scan_to_files(model, data, "lidar", "vlp16", tmp_path / "a.npz", None)
+    assert summary["num_rays"] == 28800 and summary["png"] is None
+    assert sum(summary["class_counts"].values()) == summary["num_hits"] > 0
+    assert not (tmp_path / "a.png").exists()
