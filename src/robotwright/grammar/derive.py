@@ -140,6 +140,14 @@ def rule_choices(grammar: Grammar, rule: Rule) -> int:
 
 def choices_at(grammar: Grammar, rule: Rule, index: int) -> tuple[Choice, ...]:
     """The ``index``-th combination of choices for ``rule`` (mixed radix over new nodes)."""
+    key = ("choices", rule.name, index)
+    hit = grammar._cache.get(key)
+    if hit is None:
+        hit = grammar._cache[key] = _choices_at(grammar, rule, index)
+    return hit
+
+
+def _choices_at(grammar: Grammar, rule: Rule, index: int) -> tuple[Choice, ...]:
     out = []
     for s in new_symbols(rule):
         index, r = divmod(index, grammar.n_choices(s))
@@ -196,6 +204,25 @@ class Counter:
         first, rest = states[0], tuple(states[1:])
         return sum(self.g(first, k) * self.conv(rest, n - k) for k in range(n + 1))
 
+    def min_links(self, state: NodeState, limit: int = 64) -> int | None:
+        """Fewest links that finish a node in ``state`` (None if none within ``limit``)."""
+        key = ("min", state)
+        if key not in self._g:
+            self._g[key] = next((n for n in range(limit + 1) if self.g(state, n) > 0), None)  # type: ignore[index]
+        return self._g[key]  # type: ignore[index]
+
+    def feasible(self, partial: Partial, max_links: int) -> bool:
+        """Whether some completion of ``partial`` has at most ``max_links`` links."""
+        need = partial.links
+        for st in partial.pending_states():
+            m = self.min_links(st, max_links)
+            if m is None:
+                return False
+            need += m
+            if need > max_links:
+                return False
+        return True
+
     def completions(self, partial: Partial, max_links: int) -> int:
         """Complete designs reachable from ``partial`` with at most ``max_links`` links."""
         budget = max_links - partial.links
@@ -239,8 +266,10 @@ def enumerate_designs(grammar: Grammar, max_links: int) -> Iterator[Design]:
     counter = Counter(grammar)
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(max(limit, 10_000))
+    start = Partial.start(grammar)
     try:
-        yield from _enum(Partial.start(grammar), max_links, counter)
+        if counter.feasible(start, max_links):
+            yield from _enum(start, max_links, counter)
     finally:
         sys.setrecursionlimit(limit)
 
@@ -250,13 +279,16 @@ def _enum(p: Partial, max_links: int, counter: Counter) -> Iterator[Design]:
         if p.links <= max_links:
             yield p.design()
         return
-    if counter.completions(p, max_links) == 0:
-        return
     for rule, n in options(p):
         if rule is None:
             yield from _enum(p.stop(), max_links, counter)
             continue
-        for i in range(n):
+        first = p.apply(rule, choices_at(p.grammar, rule, 0))
+        # Feasibility does not depend on the component choices: test once per rule.
+        if not counter.feasible(first, max_links):
+            continue
+        yield from _enum(first, max_links, counter)
+        for i in range(1, n):
             yield from _enum(p.apply(rule, choices_at(p.grammar, rule, i)), max_links, counter)
 
 

@@ -385,17 +385,21 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
     if problems:
         return
     # States any rule (or the start) can create, ignoring whether they are reachable.
-    produced = {g.start_state}
+    produced_by: dict[str, set[NodeState]] = {}
     for r in g.rules.values():
+        out: set[NodeState] = set()
         for has_edges in (False, True):
             for open_ in (False, True):
                 st = NodeState(r.lhs.symbol, open_, has_edges)
                 if r.matches(st):
                     kept, new = r.result_states(st)
-                    produced.update((kept, *new))
+                    out.update((kept, *new))
+        produced_by[r.name] = out
     reachable = g.reachable_states()
     for r in g.rules.values():
         where = f"rule '{r.name}'"
+        # States the start or any *other* rule creates (a rule cannot feed itself first).
+        produced = {g.start_state}.union(*(v for k, v in produced_by.items() if k != r.name))
         if not any(r.matches(s) for s in produced):
             shown = ", ".join(sorted(str(s) for s in produced if s.symbol == r.lhs.symbol)) or "none"
             problems.append(Problem(f, f"left side '{r.lhs}' can never match: no rule creates such a node (nodes of {r.lhs.symbol!r} that occur: {shown})", column="lhs", element=where))

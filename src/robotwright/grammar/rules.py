@@ -90,7 +90,11 @@ class Grammar:
 
     def matching_rules(self, state: NodeState) -> list[Rule]:
         """Rules whose left side matches a node in ``state``, in file order."""
-        return [r for r in self.rules.values() if r.matches(state)]
+        key = ("match", state)
+        hit = self._cache.get(key)
+        if hit is None:
+            hit = self._cache[key] = [r for r in self.rules.values() if r.matches(state)]
+        return hit
 
     def n_choices(self, symbol: str) -> int:
         """(component, parameters) choices of a new ``symbol`` node (1 if it has no component)."""

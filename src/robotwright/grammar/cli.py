@@ -1,0 +1,171 @@
+"""``robotwright grammar check|count|sample|search|export``."""
+
+from __future__ import annotations
+
+import argparse
+import random
+import sys
+import time
+from pathlib import Path
+
+from robotwright.errors import GrammarError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "grammar",
+        help="generate robot limbs (SRLs) from a graph grammar",
+        description="Check grammars, count, enumerate, sample and search limb designs.",
+    )
+    gsub = p.add_subparsers(dest="grammar_command", metavar="ACTION", required=True)
+
+    def common(q: argparse.ArgumentParser) -> None:
+        q.add_argument("--grammar", type=Path, default=None, help="grammar YAML (default: bundled SRL grammar)")
+        q.add_argument("--library", type=Path, default=None, help="component library YAML")
+
+    q = gsub.add_parser("check", help="validate a grammar file and summarise it")
+    q.add_argument("file", type=Path, help="grammar YAML")
+    q.add_argument("--library", type=Path, default=None, help="component library YAML")
+    q.set_defaults(func=_check)
+
+    q = gsub.add_parser("count", help="exact number of designs up to a size")
+    common(q)
+    q.add_argument("--max-links", type=int, required=True, help="largest number of links")
+    q.add_argument("--enumerate", action="store_true", help="also enumerate them and report the rate")
+    q.set_defaults(func=_count)
+
+    q = gsub.add_parser("sample", help="draw designs uniformly and write their files")
+    common(q)
+    q.add_argument("--seed", type=int, default=0)
+    q.add_argument("-n", type=int, default=1, help="number of designs")
+    q.add_argument("--max-links", type=int, default=4)
+    q.add_argument("-o", "--out", type=Path, required=True, help="output folder")
+    q.add_argument("--no-picture", action="store_true", help="skip the PNG pictures")
+    q.set_defaults(func=_sample)
+
+    q = gsub.add_parser("search", help="search designs for an objective")
+    common(q)
+    q.add_argument("--objective", default="reach", choices=["reach", "workspace", "mass", "dof"])
+    q.add_argument("--constraint", action="append", default=None, help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable")
+    q.add_argument("--budget", type=int, default=100, help="designs to evaluate")
+    q.add_argument("--method", default="beam", choices=["beam", "random"])
+    q.add_argument("--beam-width", type=int, default=4)
+    q.add_argument("--max-links", type=int, default=4)
+    q.add_argument("--seed", type=int, default=0)
+    q.add_argument("--workers", type=int, default=None, help="worker processes (default: CPU count)")
+    q.add_argument("-o", "--out", type=Path, default=None, help="write the best design's files here")
+    q.set_defaults(func=_search)
+
+    q = gsub.add_parser("export", help="write the files of a design given as text or JSON")
+    common(q)
+    q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
+    q.add_argument("-o", "--out", type=Path, required=True)
+    q.set_defaults(func=_export)
+
+
+def _grammar(args: argparse.Namespace):
+    from robotwright.grammar.loader import default_grammar, default_grammar_path, load_grammar
+
+    if args.grammar is None and args.library is None:
+        return default_grammar()
+    return load_grammar(args.grammar or default_grammar_path(), args.library)
+
+
+def _check(args: argparse.Namespace) -> int:
+    from robotwright.grammar.derive import count_by_links
+    from robotwright.grammar.loader import load_grammar
+
+    try:
+        g = load_grammar(args.file, args.library)
+    except GrammarError as exc:
+        for p in exc.problems:
+            print(f"{p.severity}: {p}")
+        print(f"{args.file}: {sum(p.severity == 'error' for p in exc.problems)} error(s)")
+        return 1
+    print(f"grammar {g.name} ({g.source}), library {g.library.name} ({g.library.source})")
+    for s in g.symbols.values():
+        comps = [c.name for c in g.library.for_symbol(s.name)]
+        print(f"  symbol {s.name:3s} {s.kind:12s} {s.description}  components: {comps or '-'}")
+    for r in g.rules.values():
+        print(f"  {r}{'  (branching)' if r.branching else ''}")
+    try:
+        print(f"  designs by number of links 0..3: {count_by_links(g, 3)}")
+    except GrammarError as exc:
+        print(f"  counts: {exc}")
+    print(f"{args.file}: valid")
+    return 0
+
+
+def _count(args: argparse.Namespace) -> int:
+    from robotwright.grammar.derive import count, count_by_links, enumerate_designs
+
+    g = _grammar(args)
+    total = count(g, args.max_links)
+    print(f"designs with at most {args.max_links} link(s): {total}")
+    print(f"by number of links: {count_by_links(g, args.max_links)}")
+    if args.enumerate:
+        t0 = time.perf_counter()
+        n = sum(1 for _ in enumerate_designs(g, args.max_links))
+        dt = time.perf_counter() - t0
+        print(f"enumerated: {n} in {dt:.2f} s ({n / dt:.0f} designs/s); equal to count: {n == total}")
+        return 0 if n == total else 1
+    return 0
+
+
+def _sample(args: argparse.Namespace) -> int:
+    from robotwright.grammar.derive import Counter, sample
+    from robotwright.grammar.export import export_design
+
+    g = _grammar(args)
+    rng = random.Random(args.seed)
+    counter = Counter(g)
+    args.out.mkdir(parents=True, exist_ok=True)
+    for k in range(args.n):
+        d = sample(g, args.max_links, rng, counter)
+        folder = export_design(g, d, args.out / f"{k:03d}_{d.hash()}", picture=not args.no_picture, overwrite=True)
+        print(f"{folder}: {d}")
+    return 0
+
+
+def _search(args: argparse.Namespace) -> int:
+    from robotwright.grammar.export import export_design
+    from robotwright.grammar.objectives import OBJECTIVES, make_constraint
+    from robotwright.grammar.search import beam_search, random_search
+
+    g = _grammar(args)
+    try:
+        constraints = [make_constraint(c) for c in (args.constraint or ["no-self-collision"])]
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    objective = OBJECTIVES[args.objective]()
+    kw = dict(budget=args.budget, max_links=args.max_links, seed=args.seed, workers=args.workers)
+    t0 = time.perf_counter()
+    if args.method == "beam":
+        res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
+    else:
+        res = random_search(g, [objective], constraints, **kw)
+    dt = time.perf_counter() - t0
+    print(f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s")
+    if res.best is None:
+        print("no feasible design found")
+        return 1
+    print(f"best {objective.name} = {res.best.values[objective.name]:.4f} (design {res.best.design.hash()})")
+    print(res.best.design.to_text(), end="")
+    if args.out:
+        export_design(g, res.best.design, args.out, overwrite=True)
+        print(f"written to {args.out}")
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from robotwright.grammar.design import Design
+    from robotwright.grammar.export import export_design
+
+    g = _grammar(args)
+    text = args.design.read_text(encoding="utf-8")
+    src = str(args.design)
+    d = Design.from_json(text, src) if text.lstrip().startswith("{") else Design.from_text(text, src)
+    export_design(g, d, args.out, overwrite=True)
+    print(f"{args.out}: {d.hash()}")
+    return 0

@@ -1,0 +1,70 @@
+"""Write a design's files: MJCF and URDF (through the generators), design text and JSON,
+design tree as Graphviz DOT, and a PNG picture. All or nothing: files are written into
+a temporary folder that is renamed into place."""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+
+from robotwright.grammar.build import Limb, build
+from robotwright.grammar.derive import replay
+from robotwright.grammar.design import Design, to_dot
+from robotwright.grammar.draw import draw_limb
+from robotwright.grammar.rules import Grammar
+from robotwright.hrdf.model import HRDF
+
+
+def export_mjcf(hrdf: HRDF, path: Path) -> None:
+    """MJCF of a robot through :class:`robotwright.generators.MJCFHumanoidGenerator`."""
+    from robotwright.generators import MJCFHumanoidGenerator
+
+    MJCFHumanoidGenerator.from_hrdf(hrdf).export(path)
+
+
+def export_urdf(hrdf: HRDF, path: Path) -> None:
+    """URDF of a robot through :class:`robotwright.generators.URDFHumanoidGenerator`."""
+    from robotwright.generators import URDFHumanoidGenerator
+
+    URDFHumanoidGenerator.from_hrdf(hrdf).export(path)
+
+
+def export_design(
+    grammar: Grammar,
+    design: Design,
+    out_dir: str | Path,
+    *,
+    name: str = "srl",
+    picture: bool = True,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``out_dir`` with ``<name>.xml`` (MJCF), ``<name>.urdf``, ``design.txt``,
+    ``design.json``, ``tree.dot`` and ``picture.png`` (if ``picture``).
+
+    Returns:
+        ``out_dir``. Raises ``FileExistsError`` when it exists and not ``overwrite``.
+    """
+    out = Path(out_dir)
+    if out.exists() and not overwrite:
+        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
+    tree = replay(grammar, design)
+    limb: Limb = build(grammar, design, name=name)
+    hrdf = limb.to_hrdf()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        export_mjcf(hrdf, tmp / f"{name}.xml")
+        export_urdf(hrdf, tmp / f"{name}.urdf")
+        (tmp / "design.txt").write_text(design.to_text(), encoding="utf-8")
+        (tmp / "design.json").write_text(design.to_json() + "\n", encoding="utf-8")
+        (tmp / "tree.dot").write_text(to_dot(tree, design.hash()), encoding="utf-8")
+        if picture:
+            draw_limb(limb, tmp / "picture.png")
+        if out.exists():
+            shutil.rmtree(out)
+        tmp.rename(out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
