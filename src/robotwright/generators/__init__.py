@@ -9,6 +9,8 @@ from robotwright.generators.base import GeneratorBase
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf import MJCFHumanoidGenerator
 from robotwright.generators.mjcf_base import DEFAULT_SCENE, MJCFGeneratorBase, SceneDefaults
+from robotwright.generators.urdf import URDFHumanoidGenerator
+from robotwright.generators.urdf_base import URDFGeneratorBase
 
 __all__ = [
     "DEFAULT_SCENE",
@@ -17,4 +19,6 @@ __all__ = [
     "MJCFGeneratorBase",
     "MJCFHumanoidGenerator",
     "SceneDefaults",
+    "URDFGeneratorBase",
+    "URDFHumanoidGenerator",
 ]

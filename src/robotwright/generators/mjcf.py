@@ -33,7 +33,7 @@ from pathlib import Path
 
 from robotwright.errors import ConversionError, ConversionWarning, GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
-from robotwright.generators.mjcf_base import MJCFGeneratorBase, prefix_tree
+from robotwright.generators.mjcf_base import MJCFGeneratorBase, name_clashes, prefix_tree
 from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
 from robotwright.hrdf.model import HRDF, Actuator, Geom, Joint, SimpleGeom
 
@@ -46,17 +46,39 @@ SIZE_COUNT: dict[str, int] = {
 _IDENTITY = (1.0, 0.0, 0.0, 0.0)
 
 
-def imu_names(hrdf: HRDF) -> list[str]:
-    """Site name of each IMU: its hurodes device name, else ``imu`` (``imu<i>`` when a
-    robot has several unnamed IMUs)."""
+def imu_sites(hrdf: HRDF) -> list[tuple[str, bool]]:
+    """``(site name, new)`` for each IMU of ``meta.imu_config_list``.
+
+    An IMU placed exactly at an HRDF site (same body, position and orientation) uses that
+    site (``new`` is false). Otherwise it gets a new site named after its hurodes device
+    name, else ``imu`` (``imu<i>`` when there are several unnamed IMUs), with ``_<n>``
+    appended when the name is already a site.
+    """
     imus = hrdf.meta.imu_config_list or []
     unnamed = sum(1 for imu in imus if imu.name is None)
-    out = []
+    taken = {s.name for s in hrdf.sites}
+    out: list[tuple[str, bool]] = []
     for i, imu in enumerate(imus):
-        if imu.name is not None:
-            out.append(imu.name)
-        else:
-            out.append("imu" if unnamed == 1 else f"imu{i}")
+        match = next(
+            (
+                s.name
+                for s in hrdf.sites
+                if s.body == imu.body_name
+                and tuple(s.pos) == tuple(imu.position)
+                and tuple(s.quat) == tuple(imu.orientation)
+            ),
+            None,
+        )
+        if match is not None:
+            out.append((match, False))
+            continue
+        base = imu.name if imu.name is not None else ("imu" if unnamed == 1 else f"imu{i}")
+        name, n = base, 1
+        while name in taken:
+            name = f"{base}_{n}"
+            n += 1
+        taken.add(name)
+        out.append((name, True))
     return out
 
 
@@ -142,6 +164,9 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             self.add_scene(skybox=skybox)
         self._layout_meshes(relative_mesh_path)
         self._order_sections()
+        clashes = name_clashes(self.xml_root)
+        if clashes:
+            raise GeneratorError(f"robot '{hrdf.name}': names used twice in the MJCF: {clashes}")
         _report(hrdf, "MJCF", losses, strict)
 
     def _add_mesh_assets(self, hrdf: HRDF, prefix: str | None) -> list[str]:
@@ -204,7 +229,9 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             if s.group:
                 el.set("group", str(s.group))
             sites.setdefault(s.body, []).append(el)
-        for imu, name in zip(hrdf.meta.imu_config_list or [], imu_names(hrdf), strict=True):
+        for imu, (name, new) in zip(hrdf.meta.imu_config_list or [], imu_sites(hrdf), strict=True):
+            if not new:
+                continue
             el = ET.Element("site", {"name": prefixed(prefix, name), "pos": fmt_vec(imu.position)})
             if imu.orientation != _IDENTITY:
                 el.set("quat", fmt_vec(imu.orientation))
@@ -325,7 +352,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
 
     def _add_sensors(self, hrdf: HRDF, prefix: str | None) -> None:
         section = self.get_elem("sensor")
-        for imu, name in zip(hrdf.meta.imu_config_list or [], imu_names(hrdf), strict=True):
+        for imu, (name, _) in zip(hrdf.meta.imu_config_list or [], imu_sites(hrdf), strict=True):
             site = prefixed(prefix, name)
             for value in imu.value:
                 kind = IMU_SENSORS[value]
@@ -421,4 +448,4 @@ def _report(hrdf: HRDF, fmt: str, losses: list[Problem], strict: bool) -> None:
     )
 
 
-__all__ = ["MJCFHumanoidGenerator", "imu_names", "parse_mjcf_extra"]
+__all__ = ["MJCFHumanoidGenerator", "imu_sites", "parse_mjcf_extra"]

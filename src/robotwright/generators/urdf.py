@@ -1,0 +1,593 @@
+"""``URDFHumanoidGenerator``: one HRDF robot (any tree) to URDF.
+
+Mapping:
+
+- A ``world`` link, joined to the root link by a ``floating`` joint (floating base; named
+  after the HRDF free joint, else ``floating_base``) or a ``fixed`` joint (fixed base),
+  whose origin is the root body's pose.
+- Each body -> a link with ``<inertial>`` (mass, centre of mass, the full inertia tensor
+  ``R diag R^T`` from ``diag_inertia`` and ``inertial_quat``), ``<visual>`` for geoms
+  that do not collide (contype = conaffinity = 0) and ``<collision>`` for the others.
+- Each joint -> ``revolute`` (hinge with range), ``continuous`` (hinge without range),
+  ``prismatic`` (slide); a ball joint -> three revolute/continuous joints about x, y, z
+  (a change of meaning: reported). ``<limit>`` carries the range and, from the joint's
+  actuator, ``effort`` (peak torque or force range) and ``velocity`` (peak velocity);
+  ``<dynamics damping friction>`` from viscous/dynamic friction.
+- A body with several joints becomes a chain of links ``<body>_dummy<k>`` (no mass, or
+  1e-9 kg with ``add_mujoco_tag`` because MuJoCo rejects massless moving bodies), one per
+  joint; joint anchors (``Joint.pos``) become the joint origins, so the kinematics are
+  those of the MJCF model.
+- Sites and IMUs -> massless links on fixed joints (tool and sensor frames).
+- Capsules have no URDF form: each is written as a cylinder plus two end spheres (the
+  same shape) and reported; ellipsoids are dropped and reported.
+
+Everything URDF cannot hold (armature, stiffness, springref/ref, actuator types and gains,
+geom friction/contact bits/condim/groups, collision colours, restitution, sensors,
+``mjcf_extra``) is listed in one :class:`ConversionWarning` (``strict=True``: raised as
+:class:`ConversionError`).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import replace
+from pathlib import Path
+
+from robotwright.errors import GeneratorError, Problem
+from robotwright.generators.mixin import HRDFMixin
+from robotwright.generators.mjcf import _report, imu_sites
+from robotwright.generators.urdf_base import (
+    WORLD_LINK,
+    URDFGeneratorBase,
+    inertia_tensor,
+    quat_to_rpy,
+    rotate,
+)
+from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
+from robotwright.hrdf.model import HRDF, Actuator, Body, Geom, Joint, MeshGeom, SimpleGeom
+
+#: Mass (kg) and inertia (kg m^2) of the links that split a multi-joint body, when the
+#: URDF is meant for MuJoCo (which rejects massless moving bodies).
+DUMMY_LINK_MASS = 1e-9
+DUMMY_LINK_INERTIA = 1e-12
+_IDENTITY = (1.0, 0.0, 0.0, 0.0)
+_ZERO = (0.0, 0.0, 0.0)
+_DEFAULT_FRICTION = (1.0, 0.005, 0.0001)
+
+
+def _sub(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float]:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _origin(parent: ET.Element, xyz: tuple[float, ...], q: tuple[float, ...] = _IDENTITY) -> None:
+    attrs = {"xyz": fmt_vec(xyz), "rpy": fmt_vec(quat_to_rpy(q))}  # type: ignore[arg-type]
+    ET.SubElement(parent, "origin", attrs)
+
+
+class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
+    """HRDF robot -> URDF. Works for any tree robot, floating or fixed base.
+
+    Example::
+
+        gen = URDFHumanoidGenerator.from_robot_name("arm6")
+        gen.export("out/arm6.urdf", add_mujoco_tag=True)
+    """
+
+    def _robot_name(self) -> str:
+        return self.hrdf.name if self.hrdf is not None else "robot"
+
+    def mesh_sources(self) -> list[tuple[str, Path]]:
+        hrdf = self.loaded_hrdf
+        seen: dict[Path, None] = {}
+        for m in hrdf.meshes:
+            seen.setdefault(hrdf.mesh_path(m).resolve(), None)
+        return [(hrdf.name, p) for p in seen]
+
+    def _generate(
+        self,
+        add_mujoco_tag: bool = False,
+        relative_mesh_path: bool = True,
+        *,
+        prefix: str | None = None,
+        world_link: bool = True,
+        strict: bool = False,
+    ) -> None:
+        """Build the URDF tree.
+
+        Args:
+            add_mujoco_tag: add ``<mujoco><compiler .../></mujoco>`` so MuJoCo loads the
+                file with its meshes, visual geoms and every link.
+            relative_mesh_path: mesh paths relative to the output folder when exporting to
+                a file; absolute otherwise.
+            prefix: prepended as ``<prefix>_`` to every link, joint and material name
+                (not to ``world``).
+            world_link: write the ``world`` link (a composite writes it once itself).
+            strict: raise :class:`ConversionError` instead of warning about lost values.
+        """
+        hrdf = self.loaded_hrdf
+        losses: list[Problem] = []
+        root = self.xml_root
+        if add_mujoco_tag:
+            mj = ET.SubElement(root, "mujoco")
+            ET.SubElement(mj, "compiler", self.mujoco_compiler_attrs())
+        if world_link:
+            ET.SubElement(root, "link", {"name": WORLD_LINK})
+        _RobotWriter(self, hrdf, prefix, add_mujoco_tag, relative_mesh_path, losses).write(root)
+        _report(hrdf, "URDF", losses, strict)
+
+
+class _RobotWriter:
+    """Writes one robot's links and joints (shared by the single and composite URDF)."""
+
+    def __init__(
+        self,
+        gen: URDFHumanoidGenerator | URDFGeneratorBase,
+        hrdf: HRDF,
+        prefix: str | None,
+        for_mujoco: bool,
+        relative: bool,
+        losses: list[Problem],
+    ) -> None:
+        self.gen, self.hrdf, self.prefix = gen, hrdf, prefix
+        self.for_mujoco, self.relative, self.losses = for_mujoco, relative, losses
+        self.materials: dict[tuple[float, ...], str] = {}
+
+    def p(self, name: str) -> str:
+        return prefixed(self.prefix, name)
+
+    def write(
+        self,
+        root: ET.Element,
+        parent_link: str = WORLD_LINK,
+        placement: tuple[tuple[float, float, float], tuple[float, float, float, float]]
+        | None = None,
+    ) -> None:
+        """Append the robot's links and joints to ``root``; the root body hangs from
+        ``parent_link`` at its own pose composed with ``placement`` (pos, quat)."""
+        hrdf = self.hrdf
+        self._check_names()
+        joints: dict[str, list[Joint]] = {}
+        for j in hrdf.joints:
+            joints.setdefault(j.body, []).append(j)
+        actuators: dict[str, Actuator] = {}
+        for row, a in enumerate(hrdf.actuators):
+            actuators.setdefault(a.joint, a)
+            self._actuator_losses(a, row)
+        geoms: dict[str, list[tuple[Geom, str, int]]] = {}
+        for row, m in enumerate(hrdf.meshes):
+            geoms.setdefault(m.body, []).append((m, "mesh.csv", row))
+        for row, g in enumerate(hrdf.simple_geoms):
+            geoms.setdefault(g.body, []).append((g, "simple_geom.csv", row))
+        frames: dict[str, list[tuple[str, tuple[float, ...], tuple[float, ...]]]] = {}
+        for s in hrdf.sites:
+            frames.setdefault(s.body, []).append((s.name, s.pos, s.quat))
+        for imu, (name, new) in zip(hrdf.meta.imu_config_list or [], imu_sites(hrdf), strict=True):
+            if new:
+                frames.setdefault(imu.body_name, []).append((name, imu.position, imu.orientation))
+            self.losses.append(
+                Problem(
+                    "meta.yaml",
+                    f"IMU '{name}': written as a frame link; its sensors have no URDF form",
+                    column="imu_config_list",
+                )
+            )
+        for s in hrdf.sensors:
+            self.losses.append(
+                Problem("sensor.csv", f"sensor '{s.name}' ({s.type}) has no URDF form")
+            )
+        if hrdf.mjcf_extra and hrdf.mjcf_extra.strip():
+            self.losses.append(
+                Problem("mjcf_extra", "tendons/equality/contact/keyframes have no URDF form")
+            )
+        links: list[ET.Element] = []
+        jnts: list[ET.Element] = []
+        offset: dict[int, tuple[float, float, float]] = {}
+        for idx in _dfs(hrdf):
+            b = hrdf.bodies[idx]
+            own = [j for j in joints.get(b.name, ()) if j.type != "free"]
+            if b.parent == -1:
+                placed = b
+                if placement is not None:
+                    ppos = rotate(placement[1], b.pos)
+                    placed = replace(
+                        b,
+                        pos=(
+                            ppos[0] + placement[0][0],
+                            ppos[1] + placement[0][1],
+                            ppos[2] + placement[0][2],
+                        ),
+                        quat=_qmul(placement[1], b.quat),
+                    )
+                free = [j for j in joints.get(b.name, ()) if j.type == "free"]
+                if free or not own:
+                    name = free[0].name if free and free[0].name else None
+                    if name is None:
+                        name = "floating_base" if free else f"{b.name}_world_joint"
+                    if free:
+                        self._joint_losses(free[0])
+                    el = ET.Element(
+                        "joint", {"name": self.p(name), "type": "floating" if free else "fixed"}
+                    )
+                    _origin(el, placed.pos, placed.quat)
+                    ET.SubElement(el, "parent", {"link": parent_link})
+                    ET.SubElement(el, "child", {"link": self.p(b.name)})
+                    jnts.append(el)
+                    offset[idx] = _ZERO
+                else:
+                    offset[idx] = self._body_joints(
+                        placed, own, parent_link, _ZERO, actuators, links, jnts
+                    )
+            else:
+                parent_off = offset[b.parent]
+                parent_name = self.p(hrdf.bodies[b.parent].name)
+                offset[idx] = self._body_joints(
+                    b, own, parent_name, parent_off, actuators, links, jnts
+                )
+            links.append(self._link(b, offset[idx], geoms.get(b.name, [])))
+            for name, fpos, fquat in frames.get(b.name, ()):
+                links.append(ET.Element("link", {"name": self.p(name)}))
+                el = ET.Element("joint", {"name": self.p(f"{name}_joint"), "type": "fixed"})
+                _origin(el, _sub(fpos, offset[idx]), fquat)
+                ET.SubElement(el, "parent", {"link": self.p(b.name)})
+                ET.SubElement(el, "child", {"link": self.p(name)})
+                jnts.append(el)
+        for mat_rgba, mat_name in self.materials.items():
+            m = ET.SubElement(root, "material", {"name": mat_name})
+            ET.SubElement(m, "color", {"rgba": fmt_vec(mat_rgba)})
+        root.extend(links)
+        root.extend(jnts)
+
+    # -- names ----------------------------------------------------------------------------
+    def _check_names(self) -> None:
+        hrdf = self.hrdf
+        bodies = {b.name for b in hrdf.bodies}
+        frame_names = [s.name for s in hrdf.sites] + [n for n, new in imu_sites(hrdf) if new]
+        clash = sorted((bodies | {WORLD_LINK}) & set(frame_names))
+        if clash:
+            raise GeneratorError(
+                f"robot '{hrdf.name}': site/IMU name(s) {clash} equal a body name; URDF "
+                "writes sites as links, so their names must differ"
+            )
+        if WORLD_LINK in bodies:
+            raise GeneratorError(
+                f"robot '{hrdf.name}': a body is named '{WORLD_LINK}', which URDF reserves"
+            )
+
+    # -- joints ---------------------------------------------------------------------------
+    def _body_joints(
+        self,
+        b: Body,
+        own: list[Joint],
+        parent_link: str,
+        parent_off: tuple[float, float, float],
+        actuators: dict[str, Actuator],
+        links: list[ET.Element],
+        jnts: list[ET.Element],
+    ) -> tuple[float, float, float]:
+        """Write the joints of body ``b`` (a chain through dummy links when several);
+        return the offset of ``b``'s link frame from its body frame."""
+        body_xyz = _sub(b.pos, parent_off)
+        if not own:
+            el = ET.Element("joint", {"name": self.p(f"{b.name}_fixed_joint"), "type": "fixed"})
+            _origin(el, body_xyz, b.quat)
+            ET.SubElement(el, "parent", {"link": parent_link})
+            ET.SubElement(el, "child", {"link": self.p(b.name)})
+            jnts.append(el)
+            return _ZERO
+        chain = self._expand(own)
+        prev_link, prev_anchor = parent_link, None
+        for k, (j, jname, jtype, axis, rng) in enumerate(chain):
+            last = k == len(chain) - 1
+            child = self.p(b.name) if last else self.p(f"{b.name}_dummy{k + 1}")
+            el = ET.Element("joint", {"name": self.p(jname), "type": jtype})
+            if prev_anchor is None:
+                xyz = tuple(x + y for x, y in zip(body_xyz, rotate(b.quat, j.pos), strict=True))
+                _origin(el, xyz, b.quat)
+            else:
+                _origin(el, _sub(j.pos, prev_anchor))
+            ET.SubElement(el, "parent", {"link": prev_link})
+            ET.SubElement(el, "child", {"link": child})
+            ET.SubElement(el, "axis", {"xyz": fmt_vec(axis)})
+            self._limit(el, j, jtype, rng, actuators.get(j.name or ""))
+            dyn = {}
+            if j.viscous_friction:
+                dyn["damping"] = fmt_float(j.viscous_friction)
+            if j.dynamic_friction:
+                dyn["friction"] = fmt_float(j.dynamic_friction)
+            if dyn:
+                ET.SubElement(el, "dynamics", dyn)
+            jnts.append(el)
+            if not last:
+                links.append(self._dummy_link(child))
+            prev_link, prev_anchor = child, j.pos
+        for j in own:
+            self._joint_losses(j)
+        return (float(own[-1].pos[0]), float(own[-1].pos[1]), float(own[-1].pos[2]))
+
+    def _expand(
+        self, own: list[Joint]
+    ) -> list[tuple[Joint, str, str, tuple[float, ...], tuple[float, float] | None]]:
+        out: list[tuple[Joint, str, str, tuple[float, ...], tuple[float, float] | None]] = []
+        for j in own:
+            name = j.name or ""
+            if j.type == "ball":
+                self.losses.append(
+                    Problem(
+                        "joint.csv",
+                        f"ball joint '{name}': URDF has none; written as revolute joints "
+                        f"'{name}_x', '{name}_y', '{name}_z' (each limited to the cone angle)",
+                        column="type",
+                    )
+                )
+                rng = (-j.range[1], j.range[1]) if j.range is not None else None
+                for axis_name, axis in (
+                    ("x", (1.0, 0.0, 0.0)),
+                    ("y", (0.0, 1.0, 0.0)),
+                    ("z", (0.0, 0.0, 1.0)),
+                ):
+                    out.append(
+                        (j, f"{name}_{axis_name}", "revolute" if rng else "continuous", axis, rng)
+                    )
+            elif j.type == "slide":
+                out.append((j, name, "prismatic", j.axis, j.range))
+            else:
+                out.append(
+                    (j, name, "revolute" if j.range is not None else "continuous", j.axis, j.range)
+                )
+        return out
+
+    def _limit(
+        self,
+        el: ET.Element,
+        j: Joint,
+        jtype: str,
+        rng: tuple[float, float] | None,
+        act: Actuator | None,
+    ) -> None:
+        attrs: dict[str, str] = {}
+        if rng is not None:
+            attrs["lower"] = fmt_float(rng[0])
+            attrs["upper"] = fmt_float(rng[1])
+        elif jtype == "prismatic":
+            self.losses.append(
+                Problem(
+                    "joint.csv",
+                    f"slide joint '{j.name}' is unlimited; URDF readers may take the missing "
+                    "lower/upper as 0",
+                    column="range0",
+                )
+            )
+        effort, velocity = _effort_velocity(act)
+        if effort is not None:
+            attrs["effort"] = fmt_float(effort)
+        if velocity is not None:
+            attrs["velocity"] = fmt_float(velocity)
+        if attrs or jtype in ("revolute", "prismatic"):
+            ET.SubElement(el, "limit", attrs)
+
+    def _joint_losses(self, j: Joint) -> None:
+        for field_name, value in (
+            ("armature", j.armature),
+            ("stiffness", j.stiffness),
+            ("springref", j.springref),
+            ("ref", j.ref),
+        ):
+            if value:
+                self.losses.append(
+                    Problem(
+                        "joint.csv",
+                        f"joint '{j.name}': {field_name} {value} has no URDF form",
+                        column=field_name,
+                    )
+                )
+        if j.static_friction and j.static_friction != j.dynamic_friction:
+            self.losses.append(
+                Problem(
+                    "joint.csv",
+                    f"joint '{j.name}': static_friction {j.static_friction} (friction = dynamic)",
+                    column="static_friction",
+                )
+            )
+        if j.type == "free" and (j.viscous_friction or j.dynamic_friction):
+            self.losses.append(
+                Problem("joint.csv", "free joint damping/friction has no URDF form", column="type")
+            )
+
+    def _actuator_losses(self, a: Actuator, row: int) -> None:
+        lost = []
+        if a.type != "motor":
+            lost.append(f"type {a.type}")
+        if a.p_gain is not None:
+            lost.append("p_gain")
+        if a.d_gain is not None:
+            lost.append("d_gain")
+        if a.gear != 1.0:
+            lost.append("gear")
+        if a.ctrl_range is not None:
+            lost.append("ctrl_range")
+        if lost:
+            self.losses.append(
+                Problem(
+                    "actuator.csv",
+                    f"actuator on '{a.joint}': {', '.join(lost)} not written (URDF keeps "
+                    "effort and velocity limits only)",
+                    row,
+                )
+            )
+
+    # -- links ----------------------------------------------------------------------------
+    def _dummy_link(self, name: str) -> ET.Element:
+        link = ET.Element("link", {"name": name})
+        if self.for_mujoco:
+            inertial = ET.SubElement(link, "inertial")
+            _origin(inertial, _ZERO)
+            ET.SubElement(inertial, "mass", {"value": fmt_float(DUMMY_LINK_MASS)})
+            d = fmt_float(DUMMY_LINK_INERTIA)
+            ET.SubElement(
+                inertial,
+                "inertia",
+                {"ixx": d, "ixy": "0", "ixz": "0", "iyy": d, "iyz": "0", "izz": d},
+            )
+        return link
+
+    def _link(
+        self, b: Body, off: tuple[float, float, float], geoms: list[tuple[Geom, str, int]]
+    ) -> ET.Element:
+        link = ET.Element("link", {"name": self.p(b.name)})
+        inertial = ET.SubElement(link, "inertial")
+        _origin(inertial, _sub(b.inertial_pos, off))
+        ET.SubElement(inertial, "mass", {"value": fmt_float(b.mass)})
+        t = inertia_tensor(b.diag_inertia, b.inertial_quat)
+        ET.SubElement(
+            inertial,
+            "inertia",
+            {
+                "ixx": fmt_float(t[0][0]),
+                "ixy": fmt_float(t[0][1]),
+                "ixz": fmt_float(t[0][2]),
+                "iyy": fmt_float(t[1][1]),
+                "iyz": fmt_float(t[1][2]),
+                "izz": fmt_float(t[2][2]),
+            },
+        )
+        for g, table, row in geoms:
+            self._geom(link, g, off, table, row)
+        return link
+
+    def _geom(
+        self, link: ET.Element, g: Geom, off: tuple[float, float, float], table: str, row: int
+    ) -> None:
+        collide = bool(g.contact_type or g.contact_affinity)
+        tag = "collision" if collide else "visual"
+        self._geom_losses(g, collide, table, row)
+        pos = _sub(g.pos, off)
+        name = g.geom_name
+        if isinstance(g, MeshGeom):
+            path = self.gen._mesh_file(self.hrdf.mesh_path(g).resolve())
+            attrs = {"filename": self.gen._reference(path, self.relative)}
+            if g.scale != (1.0, 1.0, 1.0):
+                attrs["scale"] = fmt_vec(g.scale)
+            self._shape(link, tag, name, pos, g.quat, "mesh", attrs, g.rgba)
+            return
+        assert isinstance(g, SimpleGeom)
+        name = name or g.name
+        s = g.size
+        if g.type == "box":
+            self._shape(
+                link, tag, name, pos, g.quat, "box", {"size": fmt_vec(2 * v for v in s)}, g.rgba
+            )
+        elif g.type == "sphere":
+            self._shape(link, tag, name, pos, g.quat, "sphere", {"radius": fmt_float(s[0])}, g.rgba)
+        elif g.type == "cylinder":
+            attrs = {"radius": fmt_float(s[0]), "length": fmt_float(2 * s[1])}
+            self._shape(link, tag, name, pos, g.quat, "cylinder", attrs, g.rgba)
+        elif g.type == "capsule":
+            self.losses.append(
+                Problem(
+                    table,
+                    f"capsule '{name}': URDF has no capsule; written as a cylinder plus two "
+                    "end spheres (same shape, three elements)",
+                    row,
+                    "type",
+                )
+            )
+            attrs = {"radius": fmt_float(s[0]), "length": fmt_float(2 * s[1])}
+            self._shape(link, tag, name, pos, g.quat, "cylinder", attrs, g.rgba)
+            for k, sign in ((1, 1.0), (2, -1.0)):
+                end = rotate(g.quat, (0.0, 0.0, sign * s[1]))
+                end_pos = (pos[0] + end[0], pos[1] + end[1], pos[2] + end[2])
+                self._shape(
+                    link, tag, f"{name}_end{k}" if name else None, end_pos, _IDENTITY,
+                    "sphere", {"radius": fmt_float(s[0])}, g.rgba,
+                )  # fmt: skip
+        else:
+            self.losses.append(
+                Problem(table, f"{g.type} '{name}': URDF has no {g.type}; dropped", row, "type")
+            )
+
+    def _shape(
+        self,
+        link: ET.Element,
+        tag: str,
+        name: str | None,
+        pos: tuple[float, ...],
+        quat: tuple[float, ...],
+        shape: str,
+        attrs: dict[str, str],
+        rgba: tuple[float, ...],
+    ) -> None:
+        el = ET.SubElement(link, tag)
+        if name:
+            el.set("name", self.p(name))
+        _origin(el, pos, quat)
+        geometry = ET.SubElement(el, "geometry")
+        ET.SubElement(geometry, shape, attrs)
+        if tag == "visual":
+            key = tuple(float(v) for v in rgba)
+            mat = self.materials.get(key)
+            if mat is None:
+                mat = self.p(f"material_{len(self.materials)}")
+                self.materials[key] = mat
+            ET.SubElement(el, "material", {"name": mat})
+
+    def _geom_losses(self, g: Geom, collide: bool, table: str, row: int) -> None:
+        lost = []
+        if collide and (g.contact_type, g.contact_affinity) != (1, 1):
+            lost.append(f"contype/conaffinity {g.contact_type}/{g.contact_affinity}")
+        if (
+            collide
+            and (g.static_friction, g.torsional_friction, g.rolling_friction) != _DEFAULT_FRICTION
+        ):
+            lost.append("friction")
+        if g.condim != 3:
+            lost.append(f"condim {g.condim}")
+        if g.group:
+            lost.append(f"group {g.group}")
+        if collide and tuple(g.rgba) != (0.5, 0.5, 0.5, 1.0):
+            lost.append("colour (URDF collisions have none)")
+        if g.restitution is not None:
+            lost.append("restitution")
+        if lost:
+            self.losses.append(
+                Problem(table, f"geom on '{g.body}': {', '.join(lost)} not written", row)
+            )
+
+
+def _effort_velocity(act: Actuator | None) -> tuple[float | None, float | None]:
+    """URDF ``effort`` and ``velocity`` of a joint from its actuator (``None`` = unknown)."""
+    if act is None:
+        return None, None
+    effort = act.peak_torque
+    if effort is None and act.force_range is not None:
+        effort = max(abs(v) for v in act.force_range)
+    if effort is None and act.type == "motor" and act.ctrl_range is not None:
+        effort = max(abs(v) for v in act.ctrl_range) * abs(act.gear)
+    return effort, act.peak_velocity
+
+
+def _qmul(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+
+
+def _dfs(hrdf: HRDF) -> list[int]:
+    """Body indices parents-first (depth first, children in table order)."""
+    children: dict[int, list[int]] = {}
+    for i, b in enumerate(hrdf.bodies):
+        children.setdefault(b.parent, []).append(i)
+    out: list[int] = []
+    stack = list(reversed(children.get(-1, [])))
+    while stack:
+        i = stack.pop()
+        out.append(i)
+        stack.extend(reversed(children.get(i, [])))
+    return out
+
+
+__all__ = ["DUMMY_LINK_MASS", "URDFHumanoidGenerator"]
