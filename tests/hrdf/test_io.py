@@ -202,3 +202,18 @@ def test_unknown_file_warns(synth_hrdf_dir: Path, tmp_path: Path) -> None:
     (src / "notes.txt").write_text("hi")
     with pytest.warns(HRDFWarning, match="notes.txt"):
         HRDF.from_dir(src)
+
+
+def test_schemas_cover_every_record_field() -> None:
+    # The reader builds records from schema rows without calling __init__.
+    import dataclasses
+
+    from robotwright.hrdf.io import _RECORD_TYPES
+    from robotwright.hrdf.tables import TABLES
+
+    for stem, cls in _RECORD_TYPES.items():
+        fields = {f.name for f in dataclasses.fields(cls)}
+        schema = {c.field for c in TABLES[stem]}
+        if stem == "body":
+            fields, schema = fields - {"parent"}, schema - {"id"}
+        assert fields == schema, stem
