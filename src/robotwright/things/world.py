@@ -11,6 +11,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright.errors import RobotwrightError
 from robotwright.things.attrs import Choice, Flag, Integer, Real, Vector
 from robotwright.things.base import BaseThing
 from robotwright.things.xml_writer import write_mjcf
@@ -69,6 +70,12 @@ _OPTION_DEFAULTS: dict[str, Any] = {
     "sdf_iterations": 10,
     "sdf_initpoints": 40,
 }
+
+
+class ThingBuildError(RobotwrightError, ValueError):
+    """MuJoCo rejected the model a World's Things describe."""
+
+
 _COMPILER_ATTR: dict[str, Any] = {
     "autolimits": Flag(),
     "inertiafromgeom": Choice("false", "true", "auto"),
@@ -220,7 +227,7 @@ class World(BaseThing):
             return f"assets/{copies[src]}"
 
         text = write_mjcf(self, path_for)[0]
-        for src, rel in copies.items():
+        for src in copies:
             if not os.path.isfile(src):
                 raise FileNotFoundError(f"{self._label()}: asset file {src!r} does not exist")
         if copies:
@@ -265,8 +272,14 @@ class World(BaseThing):
     def rebuild(self) -> None:
         """Compile the tree now (normally done lazily by ``model``/``data``/``step``)."""
         text, order = write_mjcf(self)
-        spec = mujoco.MjSpec.from_string(text)
-        model = spec.compile()
+        try:
+            spec = mujoco.MjSpec.from_string(text)
+            model = spec.compile()
+        except ValueError as exc:
+            raise ThingBuildError(
+                f"{self._label()}: MuJoCo could not compile the Things: {exc} "
+                "(see world.to_xml_string() for the MJCF that was compiled)"
+            ) from None
         data = mujoco.MjData(model)
         mujoco.mj_forward(model, data)
         index: dict[int, int] = {}

@@ -214,10 +214,10 @@ class _Reader:
         if sb.explicitinertial:
             kw["mass"] = sb.mass
             kw["ipos"] = sb.ipos
-            kw["iquat"] = self.quat(sb, "ialt", "iquat")
             if not np.isnan(sb.fullinertia[0]):
                 kw["fullinertia"] = sb.fullinertia
             else:
+                kw["iquat"] = self.quat(sb, "ialt", "iquat")
                 kw["inertia"] = sb.inertia
         body = Body(self.name(sb), **kw)
         self.register("body", sb.name, body)
@@ -608,7 +608,10 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
     reader.read_assets(world)
     reader.read_body_children(spec.worldbody, world)
 
-    carried_root = ET.fromstring(spec.to_xml())
+    try:
+        carried_root = ET.fromstring(spec.to_xml())
+    except ValueError as exc:
+        raise ThingXMLError(f"{source}: MuJoCo rejected the MJCF: {exc}") from None
     carried: dict[str, list[ET.Element]] = {}
     for section in ("actuator", "sensor"):
         node = carried_root.find(section)
@@ -682,6 +685,7 @@ def world_from_string(
         spec = mujoco.MjSpec.from_string(xml)
     except ValueError as exc:
         raise ThingXMLError(f"<string>: MuJoCo rejected the MJCF: {exc}") from None
+    spec.modelfiledir = str(base.resolve())
     return _read_world(spec, base.resolve(), "<string>", strict)
 
 

@@ -36,6 +36,7 @@ class _Writer:
         self.assets: list[BaseThing] = []
         # model ids in compile order: namespace -> list of Thing IDs
         self.order: dict[str, list[int]] = {}
+        self.by_body: dict[str, list[tuple[int, int]]] = {}
 
     # ------------------------------------------------------------------ helpers
     def ref_name(self, value: Any) -> str:
@@ -140,7 +141,7 @@ class _Writer:
         self.out.append("  </asset>")
 
     # ------------------------------------------------------------------ tree
-    def write_children(self, node: BaseThing, indent: str) -> None:
+    def write_children(self, node: BaseThing, indent: str, body_idx: int = 0) -> None:
         from robotwright.things.geoms import Mesh
 
         out = self.out
@@ -150,19 +151,22 @@ class _Writer:
             if ns == "actuator" or ns == "sensor" or ns == "raw":
                 self.collect_section(child)
                 continue
-            order.setdefault(ns, []).append(child.ID)
             if ns == "body":
+                order["body"].append(child.ID)
+                child_idx = len(order["body"]) - 1
                 attrs = self.attrs(child, skip=child._INERTIAL)
                 inertial = self.inertial(child)
                 if inertial or child._children:
                     out.append(f"{indent}<body {attrs}>" if attrs else f"{indent}<body>")
                     if inertial:
                         out.append(f"{indent}  {inertial}")
-                    self.write_children(child, indent + "  ")
+                    self.write_children(child, indent + "  ", child_idx)
                     out.append(f"{indent}</body>")
                 else:
                     out.append(f"{indent}<body {attrs}/>")
                 continue
+            # MuJoCo numbers geoms, joints, sites, ... body by body (body id order).
+            self.by_body.setdefault(ns, []).append((body_idx, child.ID))
             if isinstance(child, Mesh):
                 attrs = self.attrs(child, skip=set(Mesh._ASSET_ATTR))
                 attrs += f' mesh="{_q(self.mesh_of_geom[child.ID])}"'
@@ -184,7 +188,8 @@ class _Writer:
         parts = [f'mass="{_fmt(body.mass)}"']
         if body.ipos is not None:
             parts.append(f'pos="{_vec(body.ipos)}"')
-        if body.iquat is not None:
+        if body.iquat is not None and body.fullinertia is None:
+            # MJCF forbids an orientation next to fullinertia (the tensor carries it).
             parts.append(f'quat="{_vec(body.iquat)}"')
         if body.fullinertia is not None:
             parts.append(f'fullinertia="{_vec(body.fullinertia)}"')
@@ -278,6 +283,8 @@ def write_mjcf(
     w.order["body"] = [world.ID]
     w.write_children(world, "    ")
     w.out.append("  </worldbody>")
+    for ns, pairs in w.by_body.items():
+        w.order[ns] = [thing_id for _, thing_id in sorted(pairs, key=lambda p: p[0])]
     w.write_sections()
     for snippet in world._tail_xml():
         w.out.append(snippet)
