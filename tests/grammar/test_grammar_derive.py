@@ -111,12 +111,19 @@ def test_replay_rejects_bad_designs_with_step_and_field():
     d = derive.sample(g, 2, random.Random(1))
     link = d.steps[1].choices[1]
     assert link.component == "link"
-    bad = dataclasses.replace(link, params=tuple((k, 5.0 if k == "length" else v) for k, v in link.params))
+    bad = dataclasses.replace(
+        link, params=tuple((k, 5.0 if k == "length" else v) for k, v in link.params)
+    )
     with pytest.raises(GrammarError, match="step 1.*out of the domain") as exc:
         derive.replay(g, _edit(d, 1, choices=(d.steps[1].choices[0], bad)))
     assert exc.value.problems[0].column == "choices"
     with pytest.raises(GrammarError, match="unknown component 'wheel'"):
-        derive.replay(g, _edit(d, 1, choices=(dataclasses.replace(d.steps[1].choices[0], component="wheel"), link)))
+        derive.replay(
+            g,
+            _edit(
+                d, 1, choices=(dataclasses.replace(d.steps[1].choices[0], component="wheel"), link)
+            ),
+        )
     with pytest.raises(GrammarError, match="not the next node to grow"):
         derive.replay(g, _edit(d, 1, at=1))
     with pytest.raises(GrammarError, match="unknown rule"):

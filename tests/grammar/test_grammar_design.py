@@ -28,7 +28,10 @@ def test_hash_changes_with_a_parameter():
     d = derive.sample(default_grammar(), 2, random.Random(0))
     c = d.steps[0].choices[0]
     changed = dataclasses.replace(c, params=tuple((k, v + 0.001) for k, v in c.params))
-    steps = (dataclasses.replace(d.steps[0], choices=(changed, *d.steps[0].choices[1:])), *d.steps[1:])
+    steps = (
+        dataclasses.replace(d.steps[0], choices=(changed, *d.steps[0].choices[1:])),
+        *d.steps[1:],
+    )
     assert Design(d.grammar, steps).hash() != d.hash()
 
 

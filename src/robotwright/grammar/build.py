@@ -170,7 +170,9 @@ class Limb:
                 if j.body == b.name:
                     body.add_joint(
                         name=j.name,
-                        type=mujoco.mjtJoint.mjJNT_HINGE if j.type == "hinge" else mujoco.mjtJoint.mjJNT_SLIDE,
+                        type=mujoco.mjtJoint.mjJNT_HINGE
+                        if j.type == "hinge"
+                        else mujoco.mjtJoint.mjJNT_SLIDE,
                         pos=j.pos,
                         axis=j.axis,
                         range=j.range,
@@ -244,7 +246,9 @@ class Limb:
             for g in b.geoms
         ]
         meta = Meta()
-        meta.extra = {"grammar_design": self.design.to_dict(), "design_hash": self.design.hash()}
+        meta.extra = {
+            "grammar": {"design_hash": self.design.hash(), "design": self.design.to_dict()}
+        }
         return HRDF(
             name=self.name,
             bodies=bodies,
@@ -269,23 +273,50 @@ class _Builder:
     def name(self, stem: str) -> str:
         k = self.counts.get(stem, 0)
         self.counts[stem] = k + 1
-        return f"{self.prefix}{stem}{k + 1}" if stem not in ("base", "mount") else (
-            f"{self.prefix}{stem}" if k == 0 else f"{self.prefix}{stem}{k + 1}"
+        return (
+            f"{self.prefix}{stem}{k + 1}"
+            if stem not in ("base", "mount")
+            else (f"{self.prefix}{stem}" if k == 0 else f"{self.prefix}{stem}{k + 1}")
         )
 
     def comp(self, node: DesignNode) -> Component:
         if node.component is None:
-            raise GrammarError([Problem(self.g.source, f"node {node.id} ({node.symbol}) has no component; the design is not complete")])
+            raise GrammarError(
+                [
+                    Problem(
+                        self.g.source,
+                        f"node {node.id} ({node.symbol}) has no component; the design is not complete",
+                    )
+                ]
+            )
         return self.g.library.components[node.component]
 
     def build(self, root: DesignNode) -> None:
         comp = self.comp(root)
         if comp.kind != "base":
-            raise GrammarError([Problem(self.g.library.source, f"the design's root must be a 'base' component, got '{comp.name}' (kind {comp.kind})", element=f"component '{comp.name}'")])
+            raise GrammarError(
+                [
+                    Problem(
+                        self.g.library.source,
+                        f"the design's root must be a 'base' component, got '{comp.name}' (kind {comp.kind})",
+                        element=f"component '{comp.name}'",
+                    )
+                ]
+            )
         p = root.params
         r, t = p["diameter"] / 2, p["thickness"]
         body = LimbBody(self.name("base"), -1, np.eye(4), root.id, comp.name)
-        body.geoms.append(LimbGeom(f"{body.name}_geom", "cylinder", (r, t / 2, 0.0), (0.0, 0.0, t / 2), (1.0, 0.0, 0.0, 0.0), comp.rgba, comp.density))
+        body.geoms.append(
+            LimbGeom(
+                f"{body.name}_geom",
+                "cylinder",
+                (r, t / 2, 0.0),
+                (0.0, 0.0, t / 2),
+                (1.0, 0.0, 0.0, 0.0),
+                comp.rgba,
+                comp.density,
+            )
+        )
         self.bodies.append(body)
         for child in root.children:
             # A connector stands on the base's top face: its joint frame is raised so
@@ -296,7 +327,15 @@ class _Builder:
                 h = self.comp(child).housing
                 standoff = max(h["length"], h["diameter"]) / 2 + _CLEARANCE
             base_frame = trans(z=t + standoff)
-            self.visit(child, body_index=0, frame=base_frame, acc=(0.0, 0.0), pending=[], rows=[], base_frame=base_frame)
+            self.visit(
+                child,
+                body_index=0,
+                frame=base_frame,
+                acc=(0.0, 0.0),
+                pending=[],
+                rows=[],
+                base_frame=base_frame,
+            )
 
     def visit(
         self,
@@ -315,7 +354,15 @@ class _Builder:
         if kind == "mount":
             body = self.bodies[body_index]
             rel = np.linalg.inv(body.frame) @ frame if body_index else np.eye(4)
-            self.sites.append(Site(name=self.name("mount"), body=body.name, pos=_vec(rel[:3, 3]), quat=mat2quat(rel[:3, :3]), size=(0.01, 0.0, 0.0)))
+            self.sites.append(
+                Site(
+                    name=self.name("mount"),
+                    body=body.name,
+                    pos=_vec(rel[:3, 3]),
+                    quat=mat2quat(rel[:3, :3]),
+                    size=(0.01, 0.0, 0.0),
+                )
+            )
             return
         if kind == "connector":
             pending = list(pending)
@@ -342,51 +389,142 @@ class _Builder:
             rel = inv @ jframe
             lo, hi = jcomp.dofs[k].resolve_range(jnode.params)
             jname = self.name("joint")
-            rows[len(rows) - len(pending) + i] = DHRow(row.a, row.alpha, row.d, row.theta, row.type, jname)
+            rows[len(rows) - len(pending) + i] = DHRow(
+                row.a, row.alpha, row.d, row.theta, row.type, jname
+            )
             self.joints.append(
-                LimbJoint(jname, body.name, jcomp.dofs[k].type, _vec(rel[:3, 3]), _vec(rel[:3, 2]), (lo, hi), jcomp.actuator["peak_torque"], jcomp.actuator["peak_velocity"], jnode.id)
+                LimbJoint(
+                    jname,
+                    body.name,
+                    jcomp.dofs[k].type,
+                    _vec(rel[:3, 3]),
+                    _vec(rel[:3, 2]),
+                    (lo, hi),
+                    jcomp.actuator["peak_torque"],
+                    jcomp.actuator["peak_velocity"],
+                    jnode.id,
+                )
             )
             h = jcomp.housing
-            body.geoms.append(LimbGeom(f"{jname}_housing", "cylinder", (h["diameter"] / 2, h["length"] / 2, 0.0), _vec(rel[:3, 3]), mat2quat(rel[:3, :3]), jcomp.rgba, jcomp.density))
+            body.geoms.append(
+                LimbGeom(
+                    f"{jname}_housing",
+                    "cylinder",
+                    (h["diameter"] / 2, h["length"] / 2, 0.0),
+                    _vec(rel[:3, 3]),
+                    mat2quat(rel[:3, :3]),
+                    jcomp.rgba,
+                    jcomp.density,
+                )
+            )
         p = node.params
         if kind == "link":
             length, r = p["length"], p["diameter"] / 2
-            body.geoms.append(LimbGeom(f"{body.name}_geom", "cylinder", (r, length / 2, 0.0), (length / 2, 0.0, 0.0), _Z_TO_X, comp.rgba, comp.density))
+            body.geoms.append(
+                LimbGeom(
+                    f"{body.name}_geom",
+                    "cylinder",
+                    (r, length / 2, 0.0),
+                    (length / 2, 0.0, 0.0),
+                    _Z_TO_X,
+                    comp.rgba,
+                    comp.density,
+                )
+            )
             self.bodies.append(body)
             idx = len(self.bodies) - 1
             out_acc = (length, p["rotation"])
             for child in node.children:
                 self.visit(child, idx, frame, out_acc, [], rows, base_frame)
             if not node.children:
-                self._branch(rows, frame, frame @ rot_x(out_acc[1]) @ trans(x=out_acc[0]), base_frame, body.name)
+                # A link that ends a branch without an end part still gets a tool point.
+                tip = frame @ rot_x(out_acc[1]) @ trans(x=out_acc[0])
+                rel = inv @ tip
+                site = Site(
+                    name=self.name("tip"),
+                    body=body.name,
+                    pos=_vec(rel[:3, 3]),
+                    quat=mat2quat(rel[:3, :3]),
+                    size=(0.008, 0.0, 0.0),
+                    rgba=(1.0, 0.1, 0.1, 1.0),
+                )
+                self.sites.append(site)
+                self._branch(rows, frame, tip, base_frame, site.name)
             return
         if kind == "gripper":
             f = p["finger_length"]
             palm = _PALM_FRACTION * f
             w = _FINGER_WIDTH_FRACTION * f
-            body.geoms.append(LimbGeom(f"{body.name}_palm", "box", (palm / 2, 1.5 * w, w / 2), (palm / 2, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), comp.rgba, comp.density))
+            body.geoms.append(
+                LimbGeom(
+                    f"{body.name}_palm",
+                    "box",
+                    (palm / 2, 1.5 * w, w / 2),
+                    (palm / 2, 0.0, 0.0),
+                    (1.0, 0.0, 0.0, 0.0),
+                    comp.rgba,
+                    comp.density,
+                )
+            )
             for side, y in (("l", 1.0), ("r", -1.0)):
-                body.geoms.append(LimbGeom(f"{body.name}_finger_{side}", "box", (f / 2, w / 4, w / 2), (palm + f / 2, y * 1.25 * w, 0.0), (1.0, 0.0, 0.0, 0.0), comp.rgba, comp.density))
+                body.geoms.append(
+                    LimbGeom(
+                        f"{body.name}_finger_{side}",
+                        "box",
+                        (f / 2, w / 4, w / 2),
+                        (palm + f / 2, y * 1.25 * w, 0.0),
+                        (1.0, 0.0, 0.0, 0.0),
+                        comp.rgba,
+                        comp.density,
+                    )
+                )
             tip = palm + f
         else:
             length = p["length"]
-            body.geoms.append(LimbGeom(f"{body.name}_geom", "cylinder", (0.01, length / 2, 0.0), (length / 2, 0.0, 0.0), _Z_TO_X, comp.rgba, comp.density))
+            body.geoms.append(
+                LimbGeom(
+                    f"{body.name}_geom",
+                    "cylinder",
+                    (0.01, length / 2, 0.0),
+                    (length / 2, 0.0, 0.0),
+                    _Z_TO_X,
+                    comp.rgba,
+                    comp.density,
+                )
+            )
             tip = length
         self.bodies.append(body)
-        site = Site(name=self.name("tcp"), body=body.name, pos=(tip, 0.0, 0.0), size=(0.008, 0.0, 0.0), rgba=(1.0, 0.1, 0.1, 1.0))
+        site = Site(
+            name=self.name("tcp"),
+            body=body.name,
+            pos=(tip, 0.0, 0.0),
+            size=(0.008, 0.0, 0.0),
+            rgba=(1.0, 0.1, 0.1, 1.0),
+        )
         self.sites.append(site)
         self._branch(rows, frame, frame @ trans(x=tip), base_frame, site.name)
 
-    def _branch(self, rows: list[DHRow], last_frame: np.ndarray, tip: np.ndarray, base_frame: np.ndarray, site: str) -> None:
+    def _branch(
+        self,
+        rows: list[DHRow],
+        last_frame: np.ndarray,
+        tip: np.ndarray,
+        base_frame: np.ndarray,
+        site: str,
+    ) -> None:
         # last_frame is the last joint frame when the body directly follows joints;
         # the tool transform is taken from the frame fk() ends in.
         n = len(rows)
         end = base_frame @ fk(rows, np.zeros(n)) if n else base_frame
         tool = np.linalg.inv(end) @ tip
-        self.branches.append(Branch(list(rows), [r.name for r in rows], base_frame, _clean(tool), site))
+        self.branches.append(
+            Branch(list(rows), [r.name for r in rows], base_frame, _clean(tool), site)
+        )
 
 
-def build(grammar: Grammar, design: Design | DesignNode, *, name: str = "srl", prefix: str = "") -> Limb:
+def build(
+    grammar: Grammar, design: Design | DesignNode, *, name: str = "srl", prefix: str = ""
+) -> Limb:
     """Build a design (checked against the grammar) into a :class:`Limb`.
 
     Args:

@@ -20,7 +20,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     gsub = p.add_subparsers(dest="grammar_command", metavar="ACTION", required=True)
 
     def common(q: argparse.ArgumentParser) -> None:
-        q.add_argument("--grammar", type=Path, default=None, help="grammar YAML (default: bundled SRL grammar)")
+        q.add_argument(
+            "--grammar", type=Path, default=None, help="grammar YAML (default: bundled SRL grammar)"
+        )
         q.add_argument("--library", type=Path, default=None, help="component library YAML")
 
     q = gsub.add_parser("check", help="validate a grammar file and summarise it")
@@ -31,7 +33,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = gsub.add_parser("count", help="exact number of designs up to a size")
     common(q)
     q.add_argument("--max-links", type=int, required=True, help="largest number of links")
-    q.add_argument("--enumerate", action="store_true", help="also enumerate them and report the rate")
+    q.add_argument(
+        "--enumerate", action="store_true", help="also enumerate them and report the rate"
+    )
     q.set_defaults(func=_count)
 
     q = gsub.add_parser("sample", help="draw designs uniformly and write their files")
@@ -46,14 +50,23 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = gsub.add_parser("search", help="search designs for an objective")
     common(q)
     q.add_argument("--objective", default="reach", choices=["reach", "workspace", "mass", "dof"])
-    q.add_argument("--constraint", action="append", default=None, help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable")
+    q.add_argument(
+        "--constraint",
+        action="append",
+        default=None,
+        help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable",
+    )
     q.add_argument("--budget", type=int, default=100, help="designs to evaluate")
     q.add_argument("--method", default="beam", choices=["beam", "random"])
     q.add_argument("--beam-width", type=int, default=4)
     q.add_argument("--max-links", type=int, default=4)
     q.add_argument("--seed", type=int, default=0)
-    q.add_argument("--workers", type=int, default=None, help="worker processes (default: CPU count)")
-    q.add_argument("-o", "--out", type=Path, default=None, help="write the best design's files here")
+    q.add_argument(
+        "--workers", type=int, default=None, help="worker processes (default: CPU count)"
+    )
+    q.add_argument(
+        "-o", "--out", type=Path, default=None, help="write the best design's files here"
+    )
     q.set_defaults(func=_search)
 
     q = gsub.add_parser("export", help="write the files of a design given as text or JSON")
@@ -107,7 +120,9 @@ def _count(args: argparse.Namespace) -> int:
         t0 = time.perf_counter()
         n = sum(1 for _ in enumerate_designs(g, args.max_links))
         dt = time.perf_counter() - t0
-        print(f"enumerated: {n} in {dt:.2f} s ({n / dt:.0f} designs/s); equal to count: {n == total}")
+        print(
+            f"enumerated: {n} in {dt:.2f} s ({n / dt:.0f} designs/s); equal to count: {n == total}"
+        )
         return 0 if n == total else 1
     return 0
 
@@ -122,7 +137,9 @@ def _sample(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     for k in range(args.n):
         d = sample(g, args.max_links, rng, counter)
-        folder = export_design(g, d, args.out / f"{k:03d}_{d.hash()}", picture=not args.no_picture, overwrite=True)
+        folder = export_design(
+            g, d, args.out / f"{k:03d}_{d.hash()}", picture=not args.no_picture, overwrite=True
+        )
         print(f"{folder}: {d}")
     return 0
 
@@ -150,7 +167,9 @@ def _search(args: argparse.Namespace) -> int:
     if res.best is None:
         print("no feasible design found")
         return 1
-    print(f"best {objective.name} = {res.best.values[objective.name]:.4f} (design {res.best.design.hash()})")
+    print(
+        f"best {objective.name} = {res.best.values[objective.name]:.4f} (design {res.best.design.hash()})"
+    )
     print(res.best.design.to_text(), end="")
     if args.out:
         export_design(g, res.best.design, args.out, overwrite=True)
@@ -165,7 +184,11 @@ def _export(args: argparse.Namespace) -> int:
     g = _grammar(args)
     text = args.design.read_text(encoding="utf-8")
     src = str(args.design)
-    d = Design.from_json(text, src) if text.lstrip().startswith("{") else Design.from_text(text, src)
+    d = (
+        Design.from_json(text, src)
+        if text.lstrip().startswith("{")
+        else Design.from_text(text, src)
+    )
     export_design(g, d, args.out, overwrite=True)
     print(f"{args.out}: {d.hash()}")
     return 0

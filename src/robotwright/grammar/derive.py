@@ -100,7 +100,11 @@ class Partial:
         step = Step(rule.name, node, choices)
         stack = self.stack[:-1] + ((node, created + new_ids),)
         return Partial(
-            self.grammar, tuple(states), stack, self.steps + (step,), self.links + self.link_delta(rule)
+            self.grammar,
+            tuple(states),
+            stack,
+            self.steps + (step,),
+            self.links + self.link_delta(rule),
         ).settle()
 
     def pending_states(self) -> list[NodeState]:
@@ -292,7 +296,9 @@ def _enum(p: Partial, max_links: int, counter: Counter) -> Iterator[Design]:
             yield from _enum(p.apply(rule, choices_at(p.grammar, rule, i)), max_links, counter)
 
 
-def sample(grammar: Grammar, max_links: int, rng: random.Random, counter: Counter | None = None) -> Design:
+def sample(
+    grammar: Grammar, max_links: int, rng: random.Random, counter: Counter | None = None
+) -> Design:
     """One design drawn uniformly from all designs with at most ``max_links`` links.
 
     All randomness comes from ``rng``; the same seed gives the same design.
@@ -324,7 +330,9 @@ def random_step(p: Partial, max_links: int, rng: random.Random, counter: Counter
         if r < w:
             if rule is None:
                 return p.stop()
-            return p.apply(rule, choices_at(p.grammar, rule, rng.randrange(rule_choices(p.grammar, rule))))
+            return p.apply(
+                rule, choices_at(p.grammar, rule, rng.randrange(rule_choices(p.grammar, rule)))
+            )
         r -= w
     raise AssertionError("unreachable")
 
@@ -338,7 +346,9 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
             incomplete design).
     """
     if design.grammar != grammar.name:
-        raise GrammarError([Problem(source, f"design is for grammar {design.grammar!r}, not {grammar.name!r}")])
+        raise GrammarError(
+            [Problem(source, f"design is for grammar {design.grammar!r}, not {grammar.name!r}")]
+        )
     p = Partial.start(grammar)
     nodes = {0: DesignNode(0, grammar.start)}
     for i, step in enumerate(design.steps):
@@ -350,7 +360,11 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
         while p.stack and p.current != step.at and p.can_stop():
             p = p.stop()
         if p.current != step.at:
-            nxt = "none (design already complete)" if p.complete else f"node {p.current} ({p.states[p.current]})"
+            nxt = (
+                "none (design already complete)"
+                if p.complete
+                else f"node {p.current} ({p.states[p.current]})"
+            )
             raise fail(f"node {step.at} is not the next node to grow; expected {nxt}", "at")
         rule = grammar.rules.get(step.rule)
         if rule is None:
@@ -359,7 +373,10 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
             raise fail(f"rule '{rule}' does not match node {step.at} ({p.states[step.at]})", "rule")
         syms = new_symbols(rule)
         if len(step.choices) != len(syms):
-            raise fail(f"expected {len(syms)} choice(s) for symbols {syms}, got {len(step.choices)}", "choices")
+            raise fail(
+                f"expected {len(syms)} choice(s) for symbols {syms}, got {len(step.choices)}",
+                "choices",
+            )
         for sym, ch in zip(syms, step.choices):
             _check_choice(grammar, sym, ch, fail)
         head = rule.rhs[0]
@@ -367,13 +384,20 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
         it = iter(step.choices)
         if not head.keep:
             ch = next(it)
-            node.symbol, node.component, node.params, node.rule = sym_of(ch), ch.component, ch.param_dict, rule.name
+            node.symbol, node.component, node.params, node.rule = (
+                sym_of(ch),
+                ch.component,
+                ch.param_dict,
+                rule.name,
+            )
         node.open = head.open
         parent = node
         next_id = len(p.states)
         for pat in rule.rhs[1:]:
             ch = next(it)
-            child = DesignNode(next_id, pat.symbol, ch.component, ch.param_dict, pat.open, rule.name, parent)
+            child = DesignNode(
+                next_id, pat.symbol, ch.component, ch.param_dict, pat.open, rule.name, parent
+            )
             parent.children.append(child)
             nodes[next_id] = child
             parent = child
@@ -382,7 +406,14 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
     while p.stack and p.can_stop():
         p = p.stop()
     if not p.complete:
-        raise GrammarError([Problem(source, f"design is incomplete: node {p.current} ({p.states[p.current]}) is still open")])
+        raise GrammarError(
+            [
+                Problem(
+                    source,
+                    f"design is incomplete: node {p.current} ({p.states[p.current]}) is still open",
+                )
+            ]
+        )
     return nodes[0]
 
 
@@ -400,13 +431,19 @@ def _check_choice(grammar: Grammar, symbol: str, ch: Choice, fail) -> None:
         return
     comp: Component | None = grammar.library.components.get(ch.component or "")
     if comp is None or comp.symbol != symbol:
-        raise fail(f"unknown component {ch.component!r} for symbol {symbol!r} (library: {[c.name for c in comps]})", "choices")
+        raise fail(
+            f"unknown component {ch.component!r} for symbol {symbol!r} (library: {[c.name for c in comps]})",
+            "choices",
+        )
     given = ch.param_dict
     for name, dom in comp.params.items():
         if name not in given:
             raise fail(f"component '{comp.name}' needs parameter '{name}'", "choices")
         if not dom.contains(given[name]):
-            raise fail(f"parameter '{name}'={given[name]} of '{comp.name}' is out of the domain [{dom.low}, {dom.high}]", "choices")
+            raise fail(
+                f"parameter '{name}'={given[name]} of '{comp.name}' is out of the domain [{dom.low}, {dom.high}]",
+                "choices",
+            )
     for name in given:
         if name not in comp.params:
             raise fail(f"component '{comp.name}' has no parameter '{name}'", "choices")

@@ -102,7 +102,9 @@ class Design:
                         Choice(
                             str(c["symbol"]),
                             None if c.get("component") is None else str(c["component"]),
-                            tuple(sorted((str(k), float(v)) for k, v in c.get("params", {}).items())),
+                            tuple(
+                                sorted((str(k), float(v)) for k, v in c.get("params", {}).items())
+                            ),
                         )
                         for c in s.get("choices", [])
                     ),
@@ -166,7 +168,13 @@ _CHOICE = re.compile(r"([A-Za-z_]\w*)(?:=([A-Za-z_][\w\-]*)\(([^)]*)\))?")
 def _parse_step(line: str, source: str, row: int) -> Step:
     m = _STEP.match(line)
     if m is None:
-        raise GrammarError([Problem(source, f"cannot parse step {line!r}: expected 'RULE @NODE: CHOICES'", row=row)])
+        raise GrammarError(
+            [
+                Problem(
+                    source, f"cannot parse step {line!r}: expected 'RULE @NODE: CHOICES'", row=row
+                )
+            ]
+        )
     choices: list[Choice] = []
     rest = m.group(3).strip()
     pos = 0
@@ -176,7 +184,15 @@ def _parse_step(line: str, source: str, row: int) -> Step:
             continue
         cm = _CHOICE.match(rest, pos)
         if cm is None:
-            raise GrammarError([Problem(source, f"cannot parse choice at {rest[pos:]!r}: expected SYMBOL=component(name=value, ...)", row=row)])
+            raise GrammarError(
+                [
+                    Problem(
+                        source,
+                        f"cannot parse choice at {rest[pos:]!r}: expected SYMBOL=component(name=value, ...)",
+                        row=row,
+                    )
+                ]
+            )
         params: list[tuple[str, float]] = []
         if cm.group(3):
             for item in cm.group(3).split(","):
@@ -186,9 +202,13 @@ def _parse_step(line: str, source: str, row: int) -> Step:
                 try:
                     params.append((k.strip(), float(v)))
                 except ValueError:
-                    raise GrammarError([Problem(source, f"parameter {item.strip()!r} is not NAME=NUMBER", row=row)]) from None
+                    raise GrammarError(
+                        [Problem(source, f"parameter {item.strip()!r} is not NAME=NUMBER", row=row)]
+                    ) from None
                 if not sep:
-                    raise GrammarError([Problem(source, f"parameter {item.strip()!r} is not NAME=NUMBER", row=row)])
+                    raise GrammarError(
+                        [Problem(source, f"parameter {item.strip()!r} is not NAME=NUMBER", row=row)]
+                    )
         choices.append(Choice(cm.group(1), cm.group(2), tuple(sorted(params))))
         pos = cm.end()
     return Step(m.group(1), int(m.group(2)), tuple(choices))

@@ -39,7 +39,9 @@ class DHRow:
 
     def __post_init__(self) -> None:
         if self.type not in ("hinge", "slide"):
-            raise ValueError(f"DHRow {self.name!r}: type must be 'hinge' or 'slide', got {self.type!r}")
+            raise ValueError(
+                f"DHRow {self.name!r}: type must be 'hinge' or 'slide', got {self.type!r}"
+            )
         for f in ("a", "alpha", "d", "theta"):
             if not np.isfinite(getattr(self, f)):
                 raise ValueError(f"DHRow {self.name!r}: {f} must be finite")

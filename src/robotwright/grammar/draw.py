@@ -50,7 +50,10 @@ def draw_limb(limb: Limb, path: str | Path, *, title: str | None = None, dpi: in
                 ax.plot(*seg.T, color=g.rgba[:3], linewidth=width, solid_capstyle="butt")
                 pts += list(seg)
             elif g.type == "box":
-                corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * g.size
+                corners = (
+                    np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+                    * g.size
+                )
                 world = corners @ R.T + c
                 for i in range(8):
                     for j in range(i + 1, 8):

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+import warnings
 from pathlib import Path
 
+from robotwright.errors import ConversionWarning
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.derive import replay
 from robotwright.grammar.design import Design, to_dot
@@ -24,10 +26,12 @@ def export_mjcf(hrdf: HRDF, path: Path) -> None:
 
 
 def export_urdf(hrdf: HRDF, path: Path) -> None:
-    """URDF of a robot through :class:`robotwright.generators.URDFHumanoidGenerator`."""
+    """URDF of a robot through :class:`robotwright.generators.URDFHumanoidGenerator`,
+    with the ``<mujoco>`` tag so that MuJoCo loads it as written (several joints on one
+    body become a chain of near-massless links, as URDF needs)."""
     from robotwright.generators import URDFHumanoidGenerator
 
-    URDFHumanoidGenerator.from_hrdf(hrdf).export(path)
+    URDFHumanoidGenerator.from_hrdf(hrdf).export(path, add_mujoco_tag=True)
 
 
 def export_design(
@@ -42,6 +46,10 @@ def export_design(
     """Write ``out_dir`` with ``<name>.xml`` (MJCF), ``<name>.urdf``, ``design.txt``,
     ``design.json``, ``tree.dot`` and ``picture.png`` (if ``picture``).
 
+    What a format cannot hold (for example actuator peak velocity in MJCF) is reported
+    by the generators as a ``ConversionWarning``; those messages are also written to
+    ``warnings.txt`` so that nothing is lost silently.
+
     Returns:
         ``out_dir``. Raises ``FileExistsError`` when it exists and not ``overwrite``.
     """
@@ -54,8 +62,16 @@ def export_design(
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
-        export_mjcf(hrdf, tmp / f"{name}.xml")
-        export_urdf(hrdf, tmp / f"{name}.urdf")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ConversionWarning)
+            export_mjcf(hrdf, tmp / f"{name}.xml")
+            export_urdf(hrdf, tmp / f"{name}.urdf")
+        for w in caught:
+            if not issubclass(w.category, ConversionWarning):
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        notes = [str(w.message) for w in caught if issubclass(w.category, ConversionWarning)]
+        if notes:
+            (tmp / "warnings.txt").write_text("\n".join(notes) + "\n", encoding="utf-8")
         (tmp / "design.txt").write_text(design.to_text(), encoding="utf-8")
         (tmp / "design.json").write_text(design.to_json() + "\n", encoding="utf-8")
         (tmp / "tree.dot").write_text(to_dot(tree, design.hash()), encoding="utf-8")

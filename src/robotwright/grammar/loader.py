@@ -106,7 +106,9 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
     comps: dict[str, Component] = {}
     raw = data.get("components")
     if not isinstance(raw, dict) or not raw:
-        problems.append(Problem(f, "expected a non-empty mapping of components", column="components"))
+        problems.append(
+            Problem(f, "expected a non-empty mapping of components", column="components")
+        )
         raw = {}
     for cname, spec in raw.items():
         where = f"component '{cname}'"
@@ -145,7 +147,9 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 err("expected {range: [low, high], values: [...]}", col)
                 continue
             rng = pspec["range"]
-            if not (isinstance(rng, list) and len(rng) == 2 and all(_num(v) is not None for v in rng)):
+            if not (
+                isinstance(rng, list) and len(rng) == 2 and all(_num(v) is not None for v in rng)
+            ):
                 err(f"range must be two numbers [low, high], got {rng!r}", col)
                 continue
             low, high = float(rng[0]), float(rng[1])
@@ -208,7 +212,9 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                     err(str(exc), col)
             for key in ("housing", "actuator"):
                 val = spec.get(key)
-                if not isinstance(val, dict) or any(_num(v) is None or _num(v) <= 0 for v in val.values()):
+                if not isinstance(val, dict) or any(
+                    _num(v) is None or _num(v) <= 0 for v in val.values()
+                ):
                     err("expected a mapping of positive numbers", key)
             for need in ("diameter", "length"):
                 if need not in (spec.get("housing") or {}):
@@ -218,10 +224,15 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                     err(f"actuator needs '{need}'", "actuator")
         density = _num(spec.get("density", 1000.0))
         if density is None or density <= 0:
-            err(f"density must be a positive number (kg/m^3), got {spec.get('density')!r}", "density")
+            err(
+                f"density must be a positive number (kg/m^3), got {spec.get('density')!r}",
+                "density",
+            )
             density = 1000.0
         rgba = spec.get("rgba", [0.7, 0.7, 0.7, 1.0])
-        if not (isinstance(rgba, list) and len(rgba) == 4 and all(_num(v) is not None for v in rgba)):
+        if not (
+            isinstance(rgba, list) and len(rgba) == 4 and all(_num(v) is not None for v in rgba)
+        ):
             err(f"rgba must be 4 numbers, got {rgba!r}", "rgba")
             rgba = [0.7, 0.7, 0.7, 1.0]
         try:
@@ -264,7 +275,9 @@ def load_grammar(path: str | Path, library: str | Path | Library | None = None) 
     else:
         if library is None:
             lib_path = (
-                path.parent / str(data["library"]) if data.get("library") else default_library_path()
+                path.parent / str(data["library"])
+                if data.get("library")
+                else default_library_path()
             )
         else:
             lib_path = Path(library)
@@ -287,7 +300,9 @@ def _parse_grammar(
     f = str(path)
     for key in data:
         if key not in _GRAMMAR_KEYS:
-            problems.append(Problem(f, f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})", column=key))
+            problems.append(
+                Problem(f, f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})", column=key)
+            )
     symbols: dict[str, Symbol] = {}
     raw_syms = data.get("symbols")
     if not isinstance(raw_syms, dict) or not raw_syms:
@@ -296,12 +311,16 @@ def _parse_grammar(
     for sname, spec in raw_syms.items():
         spec = spec if isinstance(spec, dict) else {"kind": spec}
         try:
-            symbols[str(sname)] = Symbol(str(sname), spec.get("kind"), str(spec.get("description", "")))
+            symbols[str(sname)] = Symbol(
+                str(sname), spec.get("kind"), str(spec.get("description", ""))
+            )
         except ValueError as exc:
             problems.append(Problem(f, str(exc), column="kind", element=f"symbol '{sname}'"))
     start = data.get("start")
     if start not in symbols:
-        problems.append(Problem(f, f"start symbol {start!r} is not a declared symbol", column="start"))
+        problems.append(
+            Problem(f, f"start symbol {start!r} is not a declared symbol", column="start")
+        )
     elif symbols[start].kind != "nonterminal":
         problems.append(Problem(f, f"start symbol {start!r} must be a nonterminal", column="start"))
     link_symbols = tuple(str(s) for s in (data.get("link_symbols") or []))
@@ -320,7 +339,14 @@ def _parse_grammar(
             continue
         for key in spec:
             if key not in _RULE_KEYS:
-                problems.append(Problem(f, f"unknown field (expected one of {sorted(_RULE_KEYS)})", column=key, element=where))
+                problems.append(
+                    Problem(
+                        f,
+                        f"unknown field (expected one of {sorted(_RULE_KEYS)})",
+                        column=key,
+                        element=where,
+                    )
+                )
         try:
             lhs = NodePattern.parse(spec.get("lhs", ""))
         except ValueError as exc:
@@ -334,25 +360,67 @@ def _parse_grammar(
         ok = True
         for col, node in [("lhs", lhs)] + [("rhs", n) for n in rhs]:
             if node.symbol not in symbols:
-                problems.append(Problem(f, f"unknown symbol {node.symbol!r} (declared: {sorted(symbols)})", column=col, element=where))
+                problems.append(
+                    Problem(
+                        f,
+                        f"unknown symbol {node.symbol!r} (declared: {sorted(symbols)})",
+                        column=col,
+                        element=where,
+                    )
+                )
                 ok = False
         if not ok:
             continue
         if symbols[lhs.symbol].kind == "terminal":
-            problems.append(Problem(f, f"left side {lhs} is a terminal symbol, which is never rewritten", column="lhs", element=where))
+            problems.append(
+                Problem(
+                    f,
+                    f"left side {lhs} is a terminal symbol, which is never rewritten",
+                    column="lhs",
+                    element=where,
+                )
+            )
         if rhs[0].keep and rhs[0].symbol != lhs.symbol:
-            problems.append(Problem(f, f"'{rhs[0]}' keeps the matched node, so it must be the left side's symbol {lhs.symbol!r}", column="rhs", element=where))
+            problems.append(
+                Problem(
+                    f,
+                    f"'{rhs[0]}' keeps the matched node, so it must be the left side's symbol {lhs.symbol!r}",
+                    column="rhs",
+                    element=where,
+                )
+            )
         for node in rhs:
             if node.open and symbols[node.symbol].kind == "terminal":
-                problems.append(Problem(f, f"terminal {node.symbol!r} cannot be left open ('{node}')", column="rhs", element=where))
+                problems.append(
+                    Problem(
+                        f,
+                        f"terminal {node.symbol!r} cannot be left open ('{node}')",
+                        column="rhs",
+                        element=where,
+                    )
+                )
         branching = spec.get("branching", False)
         if not isinstance(branching, bool):
-            problems.append(Problem(f, f"branching must be true or false, got {branching!r}", column="branching", element=where))
+            problems.append(
+                Problem(
+                    f,
+                    f"branching must be true or false, got {branching!r}",
+                    column="branching",
+                    element=where,
+                )
+            )
             branching = False
         rules[str(rname)] = Rule(str(rname), lhs, rhs, branching, str(spec.get("description", "")))
     for comp in lib.components.values():
         if comp.symbol not in symbols:
-            problems.append(Problem(lib.source, f"symbol {comp.symbol!r} is not declared by grammar {f}", column="symbol", element=f"component '{comp.name}'"))
+            problems.append(
+                Problem(
+                    lib.source,
+                    f"symbol {comp.symbol!r} is not declared by grammar {f}",
+                    column="symbol",
+                    element=f"component '{comp.name}'",
+                )
+            )
     if start not in symbols:
         return None
     return Grammar(
@@ -374,14 +442,35 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
         where = f"rule '{r.name}'"
         for node in r.rhs:
             if not node.open and not g.library.for_symbol(node.symbol):
-                problems.append(Problem(f, f"'{node}' is finished here but the library has no component for symbol {node.symbol!r} (mark it open or add a component)", column="rhs", element=where))
+                problems.append(
+                    Problem(
+                        f,
+                        f"'{node}' is finished here but the library has no component for symbol {node.symbol!r} (mark it open or add a component)",
+                        column="rhs",
+                        element=where,
+                    )
+                )
         if not r.lhs.open and r.lhs.symbol in closed_symbols and not r.branching:
-            problems.append(Problem(f, f"left side '{r.lhs}' matches every {r.lhs.symbol} node, also interior ones, so it would grow extra branches; write '{r.lhs}*' to grow only the open end, or set 'branching: true'", column="lhs", element=where))
+            problems.append(
+                Problem(
+                    f,
+                    f"left side '{r.lhs}' matches every {r.lhs.symbol} node, also interior ones, so it would grow extra branches; write '{r.lhs}*' to grow only the open end, or set 'branching: true'",
+                    column="lhs",
+                    element=where,
+                )
+            )
         for a, b in zip(r.rhs, r.rhs[1:]):
             for ca in g.library.for_symbol(a.symbol):
                 for cb in g.library.for_symbol(b.symbol):
                     if not set(ca.offer) & set(cb.attach):
-                        problems.append(Problem(f, f"port mismatch on edge {a.symbol} -> {b.symbol}: component '{ca.name}' offers {list(ca.offer)} but '{cb.name}' attaches by {list(cb.attach)}", column="rhs", element=where))
+                        problems.append(
+                            Problem(
+                                f,
+                                f"port mismatch on edge {a.symbol} -> {b.symbol}: component '{ca.name}' offers {list(ca.offer)} but '{cb.name}' attaches by {list(cb.attach)}",
+                                column="rhs",
+                                element=where,
+                            )
+                        )
     if problems:
         return
     # States any rule (or the start) can create, ignoring whether they are reachable.
@@ -401,10 +490,26 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
         # States the start or any *other* rule creates (a rule cannot feed itself first).
         produced = {g.start_state}.union(*(v for k, v in produced_by.items() if k != r.name))
         if not any(r.matches(s) for s in produced):
-            shown = ", ".join(sorted(str(s) for s in produced if s.symbol == r.lhs.symbol)) or "none"
-            problems.append(Problem(f, f"left side '{r.lhs}' can never match: no rule creates such a node (nodes of {r.lhs.symbol!r} that occur: {shown})", column="lhs", element=where))
+            shown = (
+                ", ".join(sorted(str(s) for s in produced if s.symbol == r.lhs.symbol)) or "none"
+            )
+            problems.append(
+                Problem(
+                    f,
+                    f"left side '{r.lhs}' can never match: no rule creates such a node (nodes of {r.lhs.symbol!r} that occur: {shown})",
+                    column="lhs",
+                    element=where,
+                )
+            )
         elif not any(r.matches(s) for s in reachable):
-            problems.append(Problem(f, f"rule is unreachable from the start symbol {g.start!r}", column="lhs", element=where))
+            problems.append(
+                Problem(
+                    f,
+                    f"rule is unreachable from the start symbol {g.start!r}",
+                    column="lhs",
+                    element=where,
+                )
+            )
     # An open state terminates if some rule turns it into terminating states only.
     done = {s for s in reachable if not s.open}
     changed = True
@@ -419,7 +524,22 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
                     break
     for st in sorted(reachable - done, key=str):
         names = [r.name for r in g.matching_rules(st)] or ["none"]
-        problems.append(Problem(f, f"an open '{st}' node can never be finished: no derivation through rules {names} closes it", column="rules", element=f"symbol '{st.symbol}'"))
+        problems.append(
+            Problem(
+                f,
+                f"an open '{st}' node can never be finished: no derivation through rules {names} closes it",
+                column="rules",
+                element=f"symbol '{st.symbol}'",
+            )
+        )
     for sym in g.symbols.values():
         if not any(s.symbol == sym.name for s in reachable):
-            problems.append(Problem(f, "symbol is declared but no derivation from the start produces it", column="symbols", element=f"symbol '{sym.name}'", severity="warning"))
+            problems.append(
+                Problem(
+                    f,
+                    "symbol is declared but no derivation from the start produces it",
+                    column="symbols",
+                    element=f"symbol '{sym.name}'",
+                    severity="warning",
+                )
+            )

@@ -37,7 +37,9 @@ def _rotate(q: Sequence[float], v: Sequence[float]) -> np.ndarray:
     return _quat_mul(_quat_mul(q, qv), qc)[1:]
 
 
-def _compose(pos_a: Sequence[float], quat_a: Sequence[float], pos_b: Sequence[float], quat_b: Sequence[float]) -> tuple[Vec3, Quat]:
+def _compose(
+    pos_a: Sequence[float], quat_a: Sequence[float], pos_b: Sequence[float], quat_b: Sequence[float]
+) -> tuple[Vec3, Quat]:
     """Pose a then pose b (b expressed in a's frame)."""
     p = np.asarray(pos_a, dtype=float) + _rotate(quat_a, pos_b)
     q = _quat_mul(quat_a, quat_b)
@@ -74,19 +76,35 @@ def mount_on(
         parent_name, frame_pos, frame_quat = site.body, site.pos, site.quat
     else:
         raise GrammarError(
-            [Problem(robot.name, f"no body or site named {at!r} to mount on (bodies: {sorted(body_names)[:12]}..., sites: {[s.name for s in robot.sites]})")]
+            [
+                Problem(
+                    robot.name,
+                    f"no body or site named {at!r} to mount on (bodies: {sorted(body_names)[:12]}..., sites: {[s.name for s in robot.sites]})",
+                )
+            ]
         )
     if limb.floating_base:
-        problems.append(Problem(limb.name, "the limb has a floating base (free joint); a mounted limb must be fixed"))
+        problems.append(
+            Problem(
+                limb.name, "the limb has a floating base (free joint); a mounted limb must be fixed"
+            )
+        )
     if limb.mjcf_extra:
-        problems.append(Problem(limb.name, "the limb carries an MJCF fragment (mjcf_extra) whose names cannot be prefixed; mount it without one"))
+        problems.append(
+            Problem(
+                limb.name,
+                "the limb carries an MJCF fragment (mjcf_extra) whose names cannot be prefixed; mount it without one",
+            )
+        )
     rn = prefix + "{}"
     new_names = [rn.format(b.name) for b in limb.bodies] + [rn.format(s.name) for s in limb.sites]
     new_names += [rn.format(j.name) for j in limb.joints if j.name]
     taken = body_names | {s.name for s in robot.sites} | {j.name for j in robot.joints if j.name}
     clash = sorted(set(new_names) & taken)
     if clash:
-        problems.append(Problem(robot.name, f"names {clash} exist in the robot already; choose another prefix"))
+        problems.append(
+            Problem(robot.name, f"names {clash} exist in the robot already; choose another prefix")
+        )
     if problems:
         raise GrammarError(problems, f"cannot mount '{limb.name}' on '{robot.name}' at {at!r}")
 
@@ -100,31 +118,58 @@ def mount_on(
         b = limb.bodies[i]
         if i == root:
             p, q = _compose(mount_pos, mount_quat, b.pos, b.quat)
-            bodies.append(dataclasses.replace(b, name=rn.format(b.name), parent=parent_index, pos=p, quat=q))
+            bodies.append(
+                dataclasses.replace(b, name=rn.format(b.name), parent=parent_index, pos=p, quat=q)
+            )
         else:
             bodies.append(dataclasses.replace(b, name=rn.format(b.name), parent=b.parent + offset))
     joints = list(robot.joints) + [
-        dataclasses.replace(j, name=rn.format(j.name) if j.name else None, body=rn.format(j.body)) for j in limb.joints
+        dataclasses.replace(j, name=rn.format(j.name) if j.name else None, body=rn.format(j.body))
+        for j in limb.joints
     ]
     actuators = list(robot.actuators) + [
-        dataclasses.replace(a, joint=rn.format(a.joint), name=rn.format(a.name) if a.name else None) for a in limb.actuators
+        dataclasses.replace(a, joint=rn.format(a.joint), name=rn.format(a.name) if a.name else None)
+        for a in limb.actuators
     ]
     meshes = list(robot.meshes) + [
-        dataclasses.replace(m, body=rn.format(m.body), file=str(limb.mesh_path(m).resolve()) if limb.root_dir else m.file)
+        dataclasses.replace(
+            m,
+            body=rn.format(m.body),
+            file=str(limb.mesh_path(m).resolve()) if limb.root_dir else m.file,
+        )
         for m in limb.meshes
     ]
     geoms = list(robot.simple_geoms) + [
-        dataclasses.replace(g, body=rn.format(g.body), name=rn.format(g.name) if g.name else g.name, geom_name=rn.format(g.geom_name) if g.geom_name else None)
+        dataclasses.replace(
+            g,
+            body=rn.format(g.body),
+            name=rn.format(g.name) if g.name else g.name,
+            geom_name=rn.format(g.geom_name) if g.geom_name else None,
+        )
         for g in limb.simple_geoms
     ]
-    sites = list(robot.sites) + [dataclasses.replace(s, name=rn.format(s.name), body=rn.format(s.body)) for s in limb.sites]
+    sites = list(robot.sites) + [
+        dataclasses.replace(s, name=rn.format(s.name), body=rn.format(s.body)) for s in limb.sites
+    ]
     sensors = list(robot.sensors) + [
-        dataclasses.replace(s, name=rn.format(s.name), objname=rn.format(s.objname), refname=rn.format(s.refname) if s.refname else None)
+        dataclasses.replace(
+            s,
+            name=rn.format(s.name),
+            objname=rn.format(s.objname),
+            refname=rn.format(s.refname) if s.refname else None,
+        )
         for s in limb.sensors
     ]
     meta = dataclasses.replace(robot.meta, extra=dict(robot.meta.extra))
     mounted = list(meta.extra.get("mounted_limbs", []))
-    mounted.append({"limb": limb.name, "at": at, "prefix": prefix, "design_hash": limb.meta.extra.get("design_hash")})
+    mounted.append(
+        {
+            "limb": limb.name,
+            "at": at,
+            "prefix": prefix,
+            "design_hash": (limb.meta.extra.get("grammar") or {}).get("design_hash"),
+        }
+    )
     meta.extra["mounted_limbs"] = mounted
     return HRDF(
         name=name or f"{robot.name}_{limb.name}",

@@ -154,7 +154,11 @@ class JointLimitsFeasible:
     name: str = "joint-limits"
 
     def __call__(self, ctx: EvalContext) -> str | None:
-        bad = [j.name for j in ctx.limb.joints if not (j.range[0] < j.range[1] and j.range[0] <= 0.0 <= j.range[1])]
+        bad = [
+            j.name
+            for j in ctx.limb.joints
+            if not (j.range[0] < j.range[1] and j.range[0] <= 0.0 <= j.range[1])
+        ]
         return None if not bad else f"joint ranges empty or excluding 0: {bad}"
 
 
@@ -180,7 +184,12 @@ class NoSelfCollision:
         return f"self-collision at zero pose: {pairs}"
 
 
-OBJECTIVES: dict[str, type] = {"reach": Reach, "workspace": WorkspaceVolume, "mass": Mass, "dof": DoFCount}
+OBJECTIVES: dict[str, type] = {
+    "reach": Reach,
+    "workspace": WorkspaceVolume,
+    "mass": Mass,
+    "dof": DoFCount,
+}
 
 
 def make_constraint(text: str) -> Constraint:

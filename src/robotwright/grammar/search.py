@@ -35,8 +35,18 @@ class SearchResult:
 class _Evaluator:
     """Evaluates batches of designs once each (by hash) through an executor."""
 
-    def __init__(self, grammar: Grammar, objectives, constraints, budget: int, executor: Executor | None, workers: int | None) -> None:
-        self.fn = bind(evaluate, grammar, objectives=tuple(objectives), constraints=tuple(constraints))
+    def __init__(
+        self,
+        grammar: Grammar,
+        objectives,
+        constraints,
+        budget: int,
+        executor: Executor | None,
+        workers: int | None,
+    ) -> None:
+        self.fn = bind(
+            evaluate, grammar, objectives=tuple(objectives), constraints=tuple(constraints)
+        )
         self.budget = budget
         self.cache: dict[str, Evaluation] = {}
         self.order: list[Evaluation] = []
