@@ -20,6 +20,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.demo",
     "robotwright.sensors.cli",
     "robotwright.grammar.cli",
+    "robotwright.generators.cli",
 )
 
 

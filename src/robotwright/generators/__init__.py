@@ -6,9 +6,13 @@
 """
 
 from robotwright.generators.base import GeneratorBase
+from robotwright.generators.composite import MJCFGeneratorComposite
+from robotwright.generators.composite_urdf import URDFGeneratorComposite
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf import MJCFHumanoidGenerator
 from robotwright.generators.mjcf_base import DEFAULT_SCENE, MJCFGeneratorBase, SceneDefaults
+from robotwright.generators.placement import Placement
+from robotwright.generators.tasks import compose_scene, export_robot
 from robotwright.generators.urdf import URDFHumanoidGenerator
 from robotwright.generators.urdf_base import URDFGeneratorBase
 
@@ -17,8 +21,13 @@ __all__ = [
     "GeneratorBase",
     "HRDFMixin",
     "MJCFGeneratorBase",
+    "MJCFGeneratorComposite",
     "MJCFHumanoidGenerator",
+    "Placement",
     "SceneDefaults",
     "URDFGeneratorBase",
+    "URDFGeneratorComposite",
     "URDFHumanoidGenerator",
+    "compose_scene",
+    "export_robot",
 ]

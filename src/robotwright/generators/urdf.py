@@ -141,9 +141,11 @@ class _RobotWriter:
         parent_link: str = WORLD_LINK,
         placement: tuple[tuple[float, float, float], tuple[float, float, float, float]]
         | None = None,
+        fixed_root: bool = False,
     ) -> None:
         """Append the robot's links and joints to ``root``; the root body hangs from
-        ``parent_link`` at its own pose composed with ``placement`` (pos, quat)."""
+        ``parent_link`` at its own pose composed with ``placement`` (pos, quat), welded
+        there when ``fixed_root``."""
         hrdf = self.hrdf
         self._check_names()
         joints: dict[str, list[Joint]] = {}
@@ -205,9 +207,8 @@ class _RobotWriter:
                         name = "floating_base" if free else f"{b.name}_world_joint"
                     if free:
                         self._joint_losses(free[0])
-                    el = ET.Element(
-                        "joint", {"name": self.p(name), "type": "floating" if free else "fixed"}
-                    )
+                    jtype = "floating" if free and not fixed_root else "fixed"
+                    el = ET.Element("joint", {"name": self.p(name), "type": jtype})
                     _origin(el, placed.pos, placed.quat)
                     ET.SubElement(el, "parent", {"link": parent_link})
                     ET.SubElement(el, "child", {"link": self.p(b.name)})

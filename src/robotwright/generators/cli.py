@@ -1,0 +1,113 @@
+"""``robotwright export`` and ``robotwright compose``."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+from robotwright.errors import GeneratorError
+from robotwright.generators.mjcf import MJCFHumanoidGenerator
+from robotwright.generators.placement import Placement
+from robotwright.generators.tasks import compose_scene, load_robot
+from robotwright.generators.urdf import URDFHumanoidGenerator
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "export",
+        help="write a robot as MJCF or URDF",
+        description="Write a robot (bundled name or HRDF folder) as MJCF or URDF. Mesh "
+        "paths are written relative to the output file, so it loads as is.",
+    )
+    p.add_argument("robot", help="robot name or HRDF folder")
+    p.add_argument("--format", choices=("mjcf", "urdf"), default="mjcf")
+    p.add_argument("--prefix", default=None, help="MJCF: prefix every name with P_")
+    p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")
+    p.add_argument(
+        "--no-mujoco-tag", action="store_true", help="URDF: leave out the <mujoco> block"
+    )
+    p.add_argument("--copy-meshes", action="store_true", help="copy meshes next to the output file")
+    p.add_argument("--strict", action="store_true", help="fail instead of warning on losses")
+    p.add_argument("-o", "--output", required=True, help="output file")
+    p.set_defaults(func=_export)
+
+    p = sub.add_parser(
+        "compose",
+        help="put several robots in one scene file",
+        description="Compose robots into one MJCF (or URDF) scene. Each ROBOT is "
+        "[KEY=]NAME_OR_PATH[@x,y,z[,yaw]] (metres, radians); names are prefixed with "
+        "KEY (default: the robot name, numbered when repeated).",
+    )
+    p.add_argument("robots", nargs="+", metavar="ROBOT")
+    p.add_argument("--format", choices=("mjcf", "urdf"), default="mjcf")
+    p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")
+    p.add_argument("--copy-meshes", action="store_true", help="copy meshes next to the output file")
+    p.add_argument("-o", "--output", required=True, help="output scene file")
+    p.set_defaults(func=_compose)
+
+
+def _export(args: argparse.Namespace) -> int:
+    hrdf = load_robot(args.robot)
+    out = Path(args.output)
+    if args.format == "mjcf":
+        MJCFHumanoidGenerator.from_hrdf(hrdf).export(
+            out,
+            copy_meshes=args.copy_meshes,
+            prefix=args.prefix,
+            add_scene=not args.no_scene,
+            strict=args.strict,
+        )
+    else:
+        if args.prefix:
+            raise GeneratorError("--prefix applies to MJCF; URDF composites prefix by robot")
+        URDFHumanoidGenerator.from_hrdf(hrdf).export(
+            out,
+            copy_meshes=args.copy_meshes,
+            add_mujoco_tag=not args.no_mujoco_tag,
+            strict=args.strict,
+        )
+    print(f"wrote {out} ({args.format}, robot '{hrdf.name}', {len(hrdf.bodies)} bodies)")
+    return 0
+
+
+def parse_robot_spec(spec: str) -> tuple[str | None, str, Placement | None]:
+    """``[KEY=]ROBOT[@x,y,z[,yaw]]`` -> (key or None, robot, placement or None)."""
+    key = None
+    m = re.match(r"^([A-Za-z_][A-Za-z0-9_]*)=(.+)$", spec)
+    if m:
+        key, spec = m.group(1), m.group(2)
+    placement = None
+    if "@" in spec:
+        spec, _, pose = spec.rpartition("@")
+        placement = Placement.parse(pose)
+    if not spec:
+        raise GeneratorError(f"robot spec '{spec}': empty robot name")
+    return key, spec, placement
+
+
+def _compose(args: argparse.Namespace) -> int:
+    robots: list[tuple[str, object]] = []
+    placements: dict[str, Placement] = {}
+    used: dict[str, int] = {}
+    for spec in args.robots:
+        key, robot, placement = parse_robot_spec(spec)
+        hrdf = load_robot(robot)
+        if key is None:
+            base = re.sub(r"[^A-Za-z0-9_]", "_", hrdf.name)
+            n = used.get(base, 0)
+            used[base] = n + 1
+            key = base if n == 0 else f"{base}{n + 1}"
+        robots.append((key, hrdf))
+        if placement is not None:
+            placements[key] = placement
+    out = compose_scene(
+        robots,  # type: ignore[arg-type]
+        args.output,
+        placements,
+        fmt=args.format,
+        add_scene=not args.no_scene,
+        copy_meshes=args.copy_meshes,
+    )
+    print(f"wrote {out} ({args.format}, robots: {', '.join(k for k, _ in robots)})")
+    return 0
