@@ -227,7 +227,6 @@ class Limb:
                 type="motor",
                 peak_torque=j.peak_torque,
                 peak_velocity=j.peak_velocity,
-                ctrl_range=(-j.peak_torque, j.peak_torque),
             )
             for j in self.joints
         ]

@@ -1,14 +1,15 @@
 """Pictures of limbs: a matplotlib 3D drawing of links, joint axes and tool points.
 
-Drawn at the zero pose in the mount frame (m). Hinge axes are red arrows, slide axes
-blue arrows, tool points red dots; each geom is drawn as a segment (cylinders) or a
-box outline.
+Poses come from MuJoCo's forward kinematics of the limb (positions in metres, in the
+mount frame). Hinge axes are red arrows, slide axes blue arrows, tool points red dots;
+cylinders are drawn as thick segments and boxes as outlines.
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib
@@ -16,63 +17,78 @@ import matplotlib
 matplotlib.use("Agg")  # files only; never open a window
 
 import matplotlib.pyplot as plt  # noqa: E402
+import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from robotwright.grammar.build import Limb  # noqa: E402
 
 
-def _quat_to_mat(q) -> np.ndarray:
-    w, x, y, z = q
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+def display_pose(limb: Limb, angle: float = 0.5) -> np.ndarray:
+    """A pose that shows the structure: hinges at +-``angle`` rad (alternating, within
+    limits), slides at mid-stroke."""
+    q = []
+    for i, j in enumerate(limb.joints):
+        lo, hi = j.range
+        v = angle * (-1) ** i if j.type == "hinge" else (lo + hi) / 2
+        q.append(min(max(v, lo), hi))
+    return np.array(q)
 
 
-def draw_limb(limb: Limb, path: str | Path, *, title: str | None = None, dpi: int = 100) -> Path:
-    """Write a PNG drawing of ``limb`` at its zero pose; returns the path (atomic write)."""
+def draw_limb(
+    limb: Limb,
+    path: str | Path,
+    *,
+    q: Sequence[float] | None = None,
+    title: str | None = None,
+    dpi: int = 100,
+) -> Path:
+    """Write a PNG drawing of ``limb`` at joint values ``q`` (default: zero pose).
+
+    The file is written atomically; returns its path.
+    """
     path = Path(path)
+    model = limb.to_spec().compile()
+    data = mujoco.MjData(model)
+    qv = np.zeros(model.nq) if q is None else np.asarray(q, dtype=float)
+    if qv.shape != (model.nq,):
+        raise ValueError(f"q has shape {qv.shape}; expected ({model.nq},)")
+    for j, v in zip(limb.joints, qv):
+        data.joint(j.name).qpos[0] = v
+    mujoco.mj_kinematics(model, data)
     fig = plt.figure(figsize=(5, 5))
     ax = fig.add_subplot(projection="3d")
     pts = [np.zeros(3)]
-    for body in limb.bodies:
-        F = body.frame
-        for g in body.geoms:
-            R = F[:3, :3] @ _quat_to_mat(g.quat)
-            c = F[:3, :3] @ np.asarray(g.pos) + F[:3, 3]
-            if g.type == "cylinder":
-                half = R[:, 2] * g.size[1]
-                seg = np.array([c - half, c + half])
-                width = max(1.0, 200 * g.size[0])
-                ax.plot(*seg.T, color=g.rgba[:3], linewidth=width, solid_capstyle="butt")
-                pts += list(seg)
-            elif g.type == "box":
-                corners = (
-                    np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-                    * g.size
-                )
-                world = corners @ R.T + c
-                for i in range(8):
-                    for j in range(i + 1, 8):
-                        if np.sum(corners[i] != corners[j]) == 1:
-                            ax.plot(*world[[i, j]].T, color=g.rgba[:3], linewidth=1.5)
-                pts += list(world)
+    for gid in range(model.ngeom):
+        c = data.geom_xpos[gid]
+        R = data.geom_xmat[gid].reshape(3, 3)
+        size = model.geom_size[gid]
+        rgba = model.geom_rgba[gid]
+        if model.geom_type[gid] == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            half = R[:, 2] * size[1]
+            seg = np.array([c - half, c + half])
+            ax.plot(
+                *seg.T, color=rgba[:3], linewidth=max(1.0, 200 * size[0]), solid_capstyle="butt"
+            )
+            pts += list(seg)
+        elif model.geom_type[gid] == mujoco.mjtGeom.mjGEOM_BOX:
+            corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+            world = (corners * size) @ R.T + c
+            for i in range(8):
+                for k in range(i + 1, 8):
+                    if np.sum(corners[i] != corners[k]) == 1:
+                        ax.plot(*world[[i, k]].T, color=rgba[:3], linewidth=1.5)
+            pts += list(world)
     scale = max(0.05, 0.15 * float(np.ptp(np.array(pts), axis=0).max()))
-    names = {b.name: b for b in limb.bodies}
-    for j in limb.joints:
-        F = names[j.body].frame
-        p = F[:3, :3] @ np.asarray(j.pos) + F[:3, 3]
-        a = F[:3, :3] @ np.asarray(j.axis)
-        color = "red" if j.type == "hinge" else "blue"
+    for jid in range(model.njnt):
+        p, a = data.xanchor[jid], data.xaxis[jid]
+        color = "red" if model.jnt_type[jid] == mujoco.mjtJoint.mjJNT_HINGE else "blue"
         ax.quiver(*p, *(a * scale), color=color, linewidth=2, arrow_length_ratio=0.25)
-        ax.text(*(p + a * scale * 1.1), j.name, fontsize=7)
-    for s in limb.sites:
-        F = names[s.body].frame
-        p = F[:3, :3] @ np.asarray(s.pos) + F[:3, 3]
-        ax.scatter(*p, color="red" if "tcp" in s.name else "black", s=25)
+        ax.text(*(p + a * scale * 1.1), model.joint(jid).name, fontsize=7)
+    for sid in range(model.nsite):
+        p = data.site_xpos[sid]
+        ax.scatter(
+            *p, color="red" if model.site(sid).name.startswith(("tcp", "tip")) else "black", s=25
+        )
         pts.append(p)
     P = np.array(pts)
     center = (P.max(axis=0) + P.min(axis=0)) / 2

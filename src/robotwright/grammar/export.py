@@ -13,7 +13,7 @@ from robotwright.errors import ConversionWarning
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.derive import replay
 from robotwright.grammar.design import Design, to_dot
-from robotwright.grammar.draw import draw_limb
+from robotwright.grammar.draw import display_pose, draw_limb
 from robotwright.grammar.rules import Grammar
 from robotwright.hrdf.model import HRDF
 
@@ -76,7 +76,12 @@ def export_design(
         (tmp / "design.json").write_text(design.to_json() + "\n", encoding="utf-8")
         (tmp / "tree.dot").write_text(to_dot(tree, design.hash()), encoding="utf-8")
         if picture:
-            draw_limb(limb, tmp / "picture.png")
+            draw_limb(
+                limb,
+                tmp / "picture.png",
+                q=display_pose(limb),
+                title=f"{name} {design.hash()}: {limb.dof} DoF (hinges at +-0.5 rad)",
+            )
         if out.exists():
             shutil.rmtree(out)
         tmp.rename(out)

@@ -1,0 +1,105 @@
+"""``robotwright grammar ...`` commands."""
+
+from __future__ import annotations
+
+import mujoco
+import pytest
+
+from robotwright.cli import main
+from robotwright.grammar.design import Design
+from robotwright.grammar.loader import default_grammar_path
+
+from .helpers import default_data, write
+
+
+def test_check_valid_and_invalid(tmp_path, capsys):
+    assert main(["grammar", "check", str(default_grammar_path())]) == 0
+    assert "r3: -L* => -L -> C -> L*" in capsys.readouterr().out
+    g, lib = default_data()
+    g["rules"]["r4"]["lhs"] = "-L"
+    gp, lp = write(tmp_path, g, lib)
+    assert main(["grammar", "check", str(gp), "--library", str(lp)]) == 1
+    out = capsys.readouterr().out
+    assert "rule 'r4'" in out and "column 'lhs'" in out and "grammar.yaml" in out
+
+
+def test_count_with_enumeration(capsys):
+    assert main(["grammar", "count", "--max-links", "2", "--enumerate"]) == 0
+    out = capsys.readouterr().out
+    assert "designs with at most 2 link(s): 4800" in out and "equal to count: True" in out
+
+
+@pytest.mark.filterwarnings("ignore::robotwright.errors.ConversionWarning")
+def test_sample_writes_every_file_and_they_load(tmp_path, capsys):
+    assert (
+        main(
+            ["grammar", "sample", "--seed", "4", "-n", "2", "--max-links", "3", "-o", str(tmp_path)]
+        )
+        == 0
+    )
+    folders = sorted(p for p in tmp_path.iterdir() if p.is_dir())
+    assert len(folders) == 2
+    for f in folders:
+        names = {p.name for p in f.iterdir()}
+        assert {
+            "srl.xml",
+            "srl.urdf",
+            "design.txt",
+            "design.json",
+            "tree.dot",
+            "picture.png",
+        } <= names
+        d = Design.from_text((f / "design.txt").read_text())
+        assert f.name.endswith(d.hash())
+        m = mujoco.MjModel.from_xml_path(str(f / "srl.xml"))
+        u = mujoco.MjModel.from_xml_path(str(f / "srl.urdf"))
+        assert m.nq == u.nq >= 1
+        assert (f / "picture.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    again = tmp_path / "again"
+    assert (
+        main(
+            [
+                "grammar",
+                "sample",
+                "--seed",
+                "4",
+                "-n",
+                "2",
+                "--max-links",
+                "3",
+                "-o",
+                str(again),
+                "--no-picture",
+            ]
+        )
+        == 0
+    )
+    assert sorted(p.name for p in again.iterdir()) == [f.name for f in folders]
+
+
+@pytest.mark.filterwarnings("ignore::robotwright.errors.ConversionWarning")
+def test_search_and_export(tmp_path, capsys):
+    out = tmp_path / "best"
+    rc = main(
+        [
+            "grammar",
+            "search",
+            "--objective",
+            "reach",
+            "--budget",
+            "12",
+            "--max-links",
+            "2",
+            "--workers",
+            "1",
+            "-o",
+            str(out),
+        ]
+    )
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "12 designs evaluated" in text and "best reach" in text
+    again = tmp_path / "again"
+    assert main(["grammar", "export", str(out / "design.json"), "-o", str(again)]) == 0
+    assert (again / "srl.xml").read_text() == (out / "srl.xml").read_text()
+    assert main(["grammar", "search", "--constraint", "shiny", "--budget", "2"]) == 2

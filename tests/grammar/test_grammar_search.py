@@ -1,0 +1,122 @@
+"""Objectives, constraints, and search through executors."""
+
+from __future__ import annotations
+
+import math
+import random
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+
+from robotwright.grammar import derive
+from robotwright.grammar.build import build_hrdf
+from robotwright.grammar.design import Design
+from robotwright.grammar.loader import default_grammar
+from robotwright.grammar.objectives import (
+    DoFCount,
+    DoFRange,
+    EvalContext,
+    JointLimitsFeasible,
+    Mass,
+    MaxMass,
+    NoSelfCollision,
+    Reach,
+    WorkspaceVolume,
+    evaluate,
+    make_constraint,
+)
+from robotwright.grammar.search import beam_search, random_search
+
+from .helpers import default_data, load_variant
+
+PLANAR = Design.from_text(
+    "# grammar=srl\n"
+    "r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()\n"
+    "r2 @0: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)\n"
+    "r3 @3: C=revolute(limit=2.618) L=link(diameter=0.04, length=0.15, rotation=0.0)\n"
+    "r4 @5: E=gripper(finger_length=0.06)\n"
+)
+
+
+def test_objectives_on_a_hand_computed_design():
+    g = default_grammar()
+    ctx = EvalContext(g, PLANAR)
+    # stretched out (the zero pose, always sampled) is the farthest: 0.25+0.15+0.084
+    # along x, 0.047 above the mount.
+    assert Reach()(ctx) == pytest.approx(math.hypot(0.484, 0.047), abs=1e-9)
+    assert DoFCount()(ctx) == 2.0
+    assert Mass()(ctx) == pytest.approx(build_hrdf(g, PLANAR).total_mass, rel=1e-9)
+    # planar arm: tool points lie in the plane z = 0.047, so at most one voxel layer
+    # of an annulus of outer radius 0.484 m.
+    vol = WorkspaceVolume(voxel=0.02)(ctx)
+    assert 0 < vol <= math.pi * 0.5**2 * 0.02 * 2
+    assert JointLimitsFeasible()(ctx) is None and NoSelfCollision()(ctx) is None
+    assert MaxMass(0.1)(ctx) is not None and DoFRange(low=3)(ctx) is not None
+
+
+def test_self_collision_is_detected_by_mujoco():
+    fat = Design.from_text(
+        PLANAR.to_text().replace("diameter=0.04, length=0.25", "diameter=0.2, length=0.25")
+    )
+    msg = NoSelfCollision()(EvalContext(default_grammar(), fat))
+    assert msg is not None and "base_geom" in msg and "link1_geom" in msg
+
+
+def test_joint_limits_excluding_zero_are_infeasible(tmp_path):
+    g, lib = default_data()
+    lib["components"]["prismatic"]["dofs"][0]["range"] = [0.05, "stroke"]
+    grammar = load_variant(tmp_path, g, lib)
+    text = PLANAR.to_text().replace("C=revolute(limit=2.618)", "C=prismatic(stroke=0.1)")
+    msg = JointLimitsFeasible()(EvalContext(grammar, Design.from_text(text)))
+    assert msg is not None and "joint2" in msg
+
+
+def test_evaluation_score_and_infeasible():
+    g = default_grammar()
+    ev = evaluate(g, PLANAR, (Mass(), Reach()), (NoSelfCollision(),))
+    assert ev.feasible and ev.score == -ev.values["mass"]
+    ev = evaluate(g, PLANAR, (Reach(),), (MaxMass(0.01),))
+    assert not ev.feasible and ev.score == float("-inf")
+
+
+def test_make_constraint_parses_and_rejects():
+    assert make_constraint("max-mass=2.5") == MaxMass(2.5)
+    assert make_constraint("min-dof=3") == DoFRange(low=3)
+    with pytest.raises(ValueError, match="needs a number"):
+        make_constraint("max-dof=many")
+    with pytest.raises(ValueError, match="unknown constraint"):
+        make_constraint("pretty")
+
+
+def test_beam_search_respects_budget_and_is_reproducible():
+    g = default_grammar()
+    kw = dict(budget=40, max_links=3, seed=5, beam_width=2)
+    with ThreadPoolExecutor(2) as ex:
+        a = beam_search(g, [Reach()], [NoSelfCollision()], executor=ex, **kw)
+        b = beam_search(g, [Reach()], [NoSelfCollision()], executor=ex, **kw)
+    assert a.n_evaluated == 40
+    assert len({e.design.hash() for e in a.evaluations}) == 40
+    assert a.best is not None and a.best.feasible
+    assert a.best.score == max(e.score for e in a.evaluations)
+    assert [e.design.hash() for e in a.evaluations] == [e.design.hash() for e in b.evaluations]
+    assert all(
+        sum(n.symbol == "L" for n in derive.replay(g, e.design).walk()) <= 3 for e in a.evaluations
+    )
+
+
+def test_beam_search_beats_the_median_random_design():
+    g = default_grammar()
+    with ThreadPoolExecutor(2) as ex:
+        beam = beam_search(g, [Reach()], budget=60, max_links=3, seed=1, executor=ex)
+        rand = random_search(g, [Reach()], budget=60, max_links=3, seed=1, executor=ex)
+    scores = sorted(e.score for e in rand.evaluations)
+    assert beam.best.score > scores[len(scores) // 2]
+    assert rand.n_evaluated == 60
+
+
+def test_default_executor_is_a_process_pool():
+    g = default_grammar()
+    res = random_search(g, [DoFCount()], budget=4, max_links=2, seed=0, workers=2)
+    assert res.n_evaluated == 4
+    d = derive.sample(g, 2, random.Random(0))
+    assert evaluate(g, d, (DoFCount(),)).values["dof"] >= 1
