@@ -16,7 +16,7 @@ from __future__ import annotations
 import difflib
 import fnmatch
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -39,9 +39,10 @@ class LidarSensorData:
         ray_directions_w: ``(E, N, 3)`` unit ray directions, world frame.
         distances: ``(E, N)`` range along each ray [m] (noise applied; misses
             ``cfg.miss_distance``).
-        hit_points_w: ``(E, N, 3)`` hit points, world frame [m] (NaN for misses).
         hit_mask: ``(E, N)`` True where the ray returned a point.
         frame: index of the scan frame (0 for the first update).
+        hit_points_w: ``(E, N, 3)`` hit points, world frame [m] (NaN for misses),
+            computed on first access after each update.
     """
 
     pos_w: np.ndarray
@@ -49,9 +50,23 @@ class LidarSensorData:
     ray_origins_w: np.ndarray
     ray_directions_w: np.ndarray
     distances: np.ndarray
-    hit_points_w: np.ndarray
     hit_mask: np.ndarray
     frame: int = -1
+    _hit_points: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
+
+    @property
+    def hit_points_w(self) -> np.ndarray:
+        if self._hit_points is None:
+            # Misses have a non-finite or arbitrary miss distance: use 0, then NaN them.
+            dist = np.where(self.hit_mask, self.distances, 0.0)
+            pts = np.multiply(self.ray_directions_w, dist[..., None])
+            pts += self.ray_origins_w
+            np.copyto(pts, np.nan, where=~self.hit_mask[..., None])
+            self._hit_points = pts
+        return self._hit_points
+
+    def _invalidate(self) -> None:
+        self._hit_points = None
 
 
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, idx: int, fallback: str) -> str:
@@ -252,7 +267,6 @@ class LidarSensor:
             ray_origins_w=np.zeros((e, n, 3)),
             ray_directions_w=np.zeros((e, n, 3)),
             distances=np.full((e, n), self.cfg.miss_distance),
-            hit_points_w=np.full((e, n, 3), np.nan),
             hit_mask=np.zeros((e, n), dtype=bool),
         )
 
@@ -296,8 +310,12 @@ class LidarSensor:
         origins_s, dirs_s = self._pattern(self._frame)
         pos, mat = self.sensor_poses()
         rot = self._ray_rotation(mat)
-        dirs_w = np.einsum("eij,nj->eni", rot, dirs_s)
-        origins_w = np.einsum("eij,nj->eni", rot, origins_s) + pos[:, None, :]
+        # (E, N, 3) = pattern rows rotated by each environment's ray rotation.
+        dirs_w = np.matmul(dirs_s[None], rot.transpose(0, 2, 1))
+        if self._single_origin:
+            origins_w = np.broadcast_to(pos[:, None, :], dirs_w.shape)
+        else:
+            origins_w = np.matmul(origins_s[None], rot.transpose(0, 2, 1)) + pos[:, None, :]
         raw_dist, geom_ids = self._engine.cast(
             self._datas,
             origins_w,
@@ -309,25 +327,31 @@ class LidarSensor:
 
     def _apply_range_model(self, dist, geom_ids, origins_w, dirs_w, pos, mat) -> None:
         cfg = self.cfg
-        hit = (geom_ids >= 0) & (dist >= cfg.min_distance) & (dist <= cfg.max_distance)
+        hit = geom_ids >= 0
+        if cfg.min_distance > 0:
+            hit &= dist >= cfg.min_distance
+        hit &= dist <= cfg.max_distance
         if cfg.range_noise_std > 0:
-            noisy = dist + self._rng.normal(0.0, cfg.range_noise_std, size=dist.shape)
-            dist = np.where(hit, np.clip(noisy, cfg.min_distance, cfg.max_distance), dist)
+            dist = dist + self._rng.normal(0.0, cfg.range_noise_std, size=dist.shape)
+            np.clip(dist, cfg.min_distance, cfg.max_distance, out=dist)
         if cfg.dropout_prob > 0:
             hit &= self._rng.random(dist.shape) >= cfg.dropout_prob
+        miss = ~hit
+        # copyto(where=) is several times faster than boolean-index assignment here.
+        np.copyto(dist, cfg.miss_distance, where=miss)
+        np.copyto(geom_ids, -1, where=miss)
         d = self._data
         d.frame = self._frame
         d.pos_w[:] = pos
         for e in range(self.num_envs):
             mujoco.mju_mat2Quat(d.quat_w[e], mat[e].ravel())
-        d.ray_origins_w[:] = origins_w
-        d.ray_directions_w[:] = dirs_w
-        d.hit_mask[:] = hit
-        d.distances[:] = np.where(hit, dist, cfg.miss_distance)
-        d.hit_points_w[:] = np.where(
-            hit[..., None], origins_w + dirs_w * np.where(hit, dist, 0.0)[..., None], np.nan
-        )
-        self._raw_geom_ids[:] = np.where(hit, geom_ids, -1)
+        # Fresh arrays every frame: keep them rather than copying into old buffers.
+        d.ray_origins_w = origins_w
+        d.ray_directions_w = dirs_w
+        d.hit_mask = hit
+        d.distances = dist
+        d._invalidate()
+        self._raw_geom_ids = geom_ids
 
     # ------------------------------------------------------------------ getters
     def _rows(self, env_ids: Sequence[int] | np.ndarray | None) -> slice | np.ndarray:
@@ -358,9 +382,10 @@ class LidarSensor:
             return pts.copy()
         if frame != "sensor":
             raise SensorError(f"frame: expected 'world' or 'sensor', got {frame!r}")
-        pos, mat = self.sensor_poses()
-        # p_s = R^T (p_w - pos), batched over environments.
-        return np.einsum("eji,enj->eni", mat[rows], pts - pos[rows][:, None, :])
+        # The sensor pose at scan time (not the current one): p_s = R^T (p_w - pos).
+        quat = self._data.quat_w[rows]
+        mat = np.stack([_quat_to_mat(q) for q in quat]) if len(quat) else np.zeros((0, 3, 3))
+        return np.einsum("eji,enj->eni", mat, pts - self._data.pos_w[rows][:, None, :])
 
     def get_hit_mask(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
         """``(num_envs, num_rays)`` bool, True where a ray returned a point."""

@@ -165,16 +165,19 @@ class LivoxPatternCfg(PatternCfg):
             )
 
     def _directions(self, frame: int) -> np.ndarray:
-        idx = np.arange(self.num_rays, dtype=np.float64) + float(frame) * self.num_rays
+        first = int(frame) * int(self.num_rays)
+        idx = np.arange(first, first + self.num_rays, dtype=np.int64)
         t = idx / self.points_per_second
         lo, hi = self.vertical_fov_min, self.vertical_fov_max
         if self.sensor_type == "mid360":
-            line = np.mod(idx, self.num_lines)
-            az = 2.0 * math.pi * (self.rotation_hz * t + line / self.num_lines)
-            # Keep the azimuth inside the field of view when it is less than a full turn.
-            az = np.mod(az, 2.0 * math.pi) * (self.horizontal_fov / (2.0 * math.pi))
-            az = az - self.horizontal_fov / 2.0 if self.horizontal_fov < 2.0 * math.pi else az
-            phase = np.mod(self.elevation_sweep_hz * t + line / self.num_lines, 1.0)
+            line_frac = (idx % self.num_lines) / self.num_lines
+            turns = self.rotation_hz * t + line_frac
+            az = (2.0 * math.pi) * (turns - np.floor(turns))  # in [0, 2 pi)
+            if self.horizontal_fov < 2.0 * math.pi:
+                # Squeeze one turn into the field of view, centred on +x.
+                az = az * (self.horizontal_fov / (2.0 * math.pi)) - self.horizontal_fov / 2.0
+            phase = self.elevation_sweep_hz * t + line_frac
+            phase -= np.floor(phase)
             tri = 1.0 - np.abs(2.0 * phase - 1.0)  # triangle wave in [0, 1]
             el = lo + (hi - lo) * tri
         else:

@@ -8,7 +8,7 @@ its path, and a lookup table turns hit geom ids into class ids on every update.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import mujoco
 import numpy as np
@@ -89,7 +89,7 @@ class SemanticLidarSensor(LidarSensor):
         base = super()._make_data()
         shape = (self.num_envs, self.num_rays)
         return SemanticLidarData(
-            **vars(base),
+            **{f.name: getattr(base, f.name) for f in fields(base) if f.init},
             semantic_labels=np.zeros(shape, dtype=np.int32)
             if self.cfg.return_semantic_labels
             else None,
