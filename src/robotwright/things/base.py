@@ -105,19 +105,38 @@ class BaseThing(metaclass=ThingType):
         object.__setattr__(self, "_version", next_version())
         object.__setattr__(self, "_name_cache", None)
         self.name = name
-        unknown = [k for k in kwargs if k not in self._BLUEPRINT_ATTR or k in self._DERIVED_ATTR]
+        cls = type(self)
+        unknown = [k for k in kwargs if k not in cls._BLUEPRINT_ATTR or k in cls._DERIVED_ATTR]
         if unknown:
             raise TypeError(
-                f"{type(self).__name__}() got unknown attribute(s) {', '.join(sorted(unknown))}; "
-                f"known: {', '.join(sorted(a for a in self._BLUEPRINT_ATTR if a != 'name'))}"
+                f"{cls.__name__}() got unknown attribute(s) {', '.join(sorted(unknown))}; "
+                f"known: {', '.join(sorted(a for a in cls._BLUEPRINT_ATTR if a != 'name'))}"
             )
-        for key, default in self._DEFAULT_VALS.items():
-            if key in self._MUJOCO_ATTR and key not in self._DERIVED_ATTR and key not in kwargs:
-                setattr(self, key, _copy.deepcopy(default))
+        state = self.__dict__
+        defaults = cls.__dict__.get("_INIT_DEFAULTS")
+        if defaults is None:
+            defaults = cls._init_defaults()
+        # Validated defaults are immutable (read-only arrays), so instances may share them.
+        state.update(defaults)
+        attrs = cls._MUJOCO_ATTR
         for key, value in kwargs.items():
-            setattr(self, key, value)
+            spec = attrs.get(key)
+            if spec is None:
+                setattr(self, key, value)
+            else:
+                state[key] = spec.convert(value, self, key)
         if parent is not None:
             parent.attach(self)
+
+    @classmethod
+    def _init_defaults(cls) -> dict[str, Any]:
+        defaults = {
+            key: cls._MUJOCO_ATTR[key].convert(_copy.deepcopy(value), cls, key)
+            for key, value in cls._DEFAULT_VALS.items()
+            if key in cls._MUJOCO_ATTR and key not in cls._DERIVED_ATTR
+        }
+        cls._INIT_DEFAULTS = defaults
+        return defaults
 
     # ----------------------------------------------------------------- attributes
     def __setattr__(self, key: str, value: Any) -> None:

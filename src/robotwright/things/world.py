@@ -198,6 +198,8 @@ class World(BaseThing):
 
     def to_xml_string(self) -> str:
         """The MJCF text of this World (files referenced by their paths as stored)."""
+        if self._built is not None and self._built_version == self._version:
+            return self._built_text  # the text the current model was compiled from
         return write_mjcf(self)[0]
 
     def export(self, path: str | os.PathLike[str], copy_assets: bool = True) -> Path:
@@ -267,7 +269,12 @@ class World(BaseThing):
     def _ensure_built(self) -> tuple[mujoco.MjModel, mujoco.MjData, dict[int, int]]:
         if self._built is None or self._built_version != self._version:
             self.rebuild()
-        return self._built
+        model, data, index = self._built
+        if data is None:  # created on first use, so that compiling alone stays cheap
+            data = mujoco.MjData(model)
+            mujoco.mj_forward(model, data)
+            object.__setattr__(self, "_built", (model, data, index))
+        return model, data, index
 
     def rebuild(self) -> None:
         """Compile the tree now (normally done lazily by ``model``/``data``/``step``)."""
@@ -280,20 +287,21 @@ class World(BaseThing):
                 f"{self._label()}: MuJoCo could not compile the Things: {exc} "
                 "(see world.to_xml_string() for the MJCF that was compiled)"
             ) from None
-        data = mujoco.MjData(model)
-        mujoco.mj_forward(model, data)
         index: dict[int, int] = {}
         for ids in order.values():
             for i, thing_id in enumerate(ids):
                 index[thing_id] = i
-        object.__setattr__(self, "_built", (model, data, index))
+        object.__setattr__(self, "_built", (model, None, index))
         object.__setattr__(self, "_built_version", self._version)
+        object.__setattr__(self, "_built_text", text)
         object.__setattr__(self, "_spec", spec)
 
     @property
     def model(self) -> mujoco.MjModel:
         """The compiled ``MjModel`` (rebuilt when the tree changed)."""
-        return self._ensure_built()[0]
+        if self._built is None or self._built_version != self._version:
+            self.rebuild()
+        return self._built[0]
 
     @property
     def data(self) -> mujoco.MjData:

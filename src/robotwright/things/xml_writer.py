@@ -19,7 +19,9 @@ _QUOTE = {'"': "&quot;"}
 
 
 def _q(text: str) -> str:
-    return escape(text, _QUOTE)
+    if "&" in text or "<" in text or ">" in text or '"' in text:
+        return escape(text, _QUOTE)
+    return text
 
 
 class _Writer:
@@ -52,11 +54,13 @@ class _Writer:
         if name:
             parts.append(f'name="{_q(name)}"')
         defaults = thing._DEFAULT_VALS
+        # Untouched attributes still hold the shared default object: skip them cheaply.
+        shared = type(thing).__dict__.get("_INIT_DEFAULTS") or {}
         for key, spec in thing._MUJOCO_ATTR.items():
             if key in skip:
                 continue
             value = getattr(thing, key)
-            if value is None:
+            if value is None or value is shared.get(key, False):
                 continue
             if key in defaults and spec.equal(value, defaults[key]):
                 continue
