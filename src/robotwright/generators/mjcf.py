@@ -439,10 +439,9 @@ def _report(hrdf: HRDF, fmt: str, losses: list[Problem], strict: bool) -> None:
         return
     if strict:
         raise ConversionError(losses, f"robot '{hrdf.name}': {fmt} cannot hold every value")
-    shown = "; ".join(str(p) for p in losses[:6])
-    more = f" (+{len(losses) - 6} more)" if len(losses) > 6 else ""
+    shown = "\n".join(f"  - {p}" for p in losses)
     warnings.warn(
-        f"robot '{hrdf.name}' to {fmt}: {len(losses)} value(s) not written: {shown}{more}",
+        f"robot '{hrdf.name}' to {fmt}: {len(losses)} value(s) not written:\n{shown}",
         ConversionWarning,
         stacklevel=4,
     )

@@ -1,0 +1,56 @@
+"""``robotwright export`` and ``robotwright compose``."""
+
+from __future__ import annotations
+
+import mujoco
+import pytest
+
+from robotwright.cli import main
+from robotwright.generators.cli import parse_robot_spec
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+
+def test_export_mjcf_with_prefix_and_no_scene(tmp_path, capsys):
+    out = tmp_path / "arm.xml"
+    assert main(["export", "arm6", "--prefix", "p", "--no-scene", "-o", str(out)]) == 0
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert m.body("p_base_link").id == 1
+    assert m.ngeom == 7  # no floor
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_export_urdf_from_path(synth_hrdf_dir, tmp_path):
+    out = tmp_path / "r.urdf"
+    assert main(["export", str(synth_hrdf_dir), "--format", "urdf", "-o", str(out)]) == 0
+    assert mujoco.MjModel.from_xml_path(str(out)).nq == 8
+
+
+def test_compose_with_poses(tmp_path):
+    out = tmp_path / "scene.xml"
+    argv = [
+        "compose",
+        "mini_humanoid",
+        "mini_humanoid@1,0,0,3.14159",
+        "arm=arm6@0,1.5,0",
+        "-o",
+        str(out),
+    ]
+    assert main(argv) == 0
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    assert d.xpos[m.body("mini_humanoid2_pelvis").id][0] == pytest.approx(1.0)
+    assert d.xpos[m.body("arm_base_link").id][1] == pytest.approx(1.5)
+
+
+def test_compose_unknown_robot_exit_code(tmp_path, capsys):
+    assert main(["compose", "no_such_robot", "-o", str(tmp_path / "s.xml")]) == 2
+    assert "no robot named 'no_such_robot'" in capsys.readouterr().err
+    assert not (tmp_path / "s.xml").exists()
+
+
+def test_parse_robot_spec():
+    assert parse_robot_spec("k=arm6@1,2,3")[0:2] == ("k", "arm6")
+    key, robot, p = parse_robot_spec("/some/path@0,0,1,0.5")
+    assert key is None and robot == "/some/path" and p.yaw == 0.5 and p.pos == (0, 0, 1)

@@ -1,0 +1,160 @@
+"""Compiled-model equivalence: ours vs hurodes' export (G1), and our URDF vs our MJCF."""
+
+from __future__ import annotations
+
+import warnings
+
+import mujoco
+import numpy as np
+import pytest
+
+from robotwright.errors import ConversionWarning
+from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
+from robotwright.hrdf.model import HRDF
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+
+def _random_qpos(m: mujoco.MjModel, rng: np.random.Generator) -> np.ndarray:
+    q = m.qpos0.copy()
+    for j in range(m.njnt):
+        a = m.jnt_qposadr[j]
+        t = m.jnt_type[j]
+        if t == mujoco.mjtJoint.mjJNT_FREE:
+            q[a : a + 3] = rng.normal(size=3)
+            v = rng.normal(size=4)
+            q[a + 3 : a + 7] = v / np.linalg.norm(v)
+        elif t == mujoco.mjtJoint.mjJNT_BALL:
+            v = rng.normal(size=4)
+            q[a : a + 4] = v / np.linalg.norm(v)
+        else:
+            lo, hi = m.jnt_range[j] if m.jnt_limited[j] else (-3.0, 3.0)
+            q[a] = rng.uniform(lo, hi)
+    return q
+
+
+def _same_quat(a: np.ndarray, b: np.ndarray) -> float:
+    return float(min(np.abs(a - b).max(), np.abs(a + b).max()))
+
+
+@pytest.mark.hurodes
+def test_g1_matches_hurodes_export(g1_hrdf_dir):
+    ref_path = g1_hrdf_dir / "exported" / "robot.xml"
+    if not ref_path.is_file():
+        pytest.skip(f"hurodes export absent: {ref_path}")
+    ours = MJCFHumanoidGenerator.from_hrdf_path(g1_hrdf_dir).to_model()
+    ref = mujoco.MjModel.from_xml_path(str(ref_path))
+    assert (ours.nbody, ours.njnt, ours.nq, ours.nv, ours.nu) == (
+        ref.nbody, ref.njnt, ref.nq, ref.nv, ref.nu,
+    )  # fmt: skip
+    for i in range(1, ref.nbody):
+        name = ref.body(i).name
+        j = ours.body(name).id
+        for field in (
+            "body_mass",
+            "body_inertia",
+            "body_ipos",
+            "body_iquat",
+            "body_pos",
+            "body_quat",
+        ):
+            np.testing.assert_allclose(getattr(ours, field)[j], getattr(ref, field)[i], atol=1e-12, err_msg=f"{field} {name}")  # fmt: skip
+        assert ours.body(ours.body_parentid[j]).name == ref.body(ref.body_parentid[i]).name
+    for i in range(ref.njnt):
+        name = ref.joint(i).name
+        j = ours.joint(name).id if name else 0
+        assert ours.jnt_type[j] == ref.jnt_type[i]
+        assert ours.jnt_limited[j] == ref.jnt_limited[i]
+        np.testing.assert_array_equal(ours.jnt_axis[j], ref.jnt_axis[i])
+        np.testing.assert_array_equal(ours.jnt_range[j], ref.jnt_range[i])
+        np.testing.assert_array_equal(ours.jnt_pos[j], ref.jnt_pos[i])
+    for field in ("dof_armature", "dof_damping", "dof_frictionloss"):
+        np.testing.assert_array_equal(getattr(ours, field), getattr(ref, field))
+    for i in range(ref.nu):
+        assert (
+            ours.joint(ours.actuator_trnid[i, 0]).name == ref.joint(ref.actuator_trnid[i, 0]).name
+        )
+    np.testing.assert_array_equal(ours.actuator_ctrlrange, ref.actuator_ctrlrange)
+    np.testing.assert_array_equal(ours.actuator_ctrllimited, ref.actuator_ctrllimited)
+    np.testing.assert_array_equal(ours.actuator_gainprm, ref.actuator_gainprm)
+    np.testing.assert_array_equal(ours.geom_size, ref.geom_size)
+    np.testing.assert_array_equal(ours.geom_friction, ref.geom_friction)
+    np.testing.assert_array_equal(ours.geom_contype, ref.geom_contype)
+
+    rng = np.random.default_rng(0)
+    da, db = mujoco.MjData(ours), mujoco.MjData(ref)
+    names = [ref.body(i).name for i in range(1, ref.nbody)]
+    idx_o = [ours.body(n).id for n in names]
+    idx_r = list(range(1, ref.nbody))
+    for _ in range(50):
+        q = _random_qpos(ref, rng)
+        da.qpos[:] = q
+        db.qpos[:] = q
+        mujoco.mj_kinematics(ours, da)
+        mujoco.mj_kinematics(ref, db)
+        np.testing.assert_allclose(da.xpos[idx_o], db.xpos[idx_r], atol=1e-9)
+        np.testing.assert_allclose(da.xquat[idx_o], db.xquat[idx_r], atol=1e-9)
+
+
+def _urdf_vs_mjcf(hrdf: HRDF, tmp_path, n: int = 20) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConversionWarning)
+        mj = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
+        path = tmp_path / f"{hrdf.name}.urdf"
+        URDFHumanoidGenerator.from_hrdf(hrdf).export(path, add_mujoco_tag=True)
+    ur = mujoco.MjModel.from_xml_path(str(path))
+    assert ur.body_mass.sum() == pytest.approx(mj.body_mass.sum(), abs=1e-6)
+    assert ur.nq == mj.nq
+    # Inertia tensors about the centre of mass, in the world frame at qpos0.
+    da, db = mujoco.MjData(mj), mujoco.MjData(ur)
+    mujoco.mj_kinematics(mj, da)
+    mujoco.mj_kinematics(ur, db)
+    for b in hrdf.bodies:
+        i, j = mj.body(b.name).id, ur.body(b.name).id
+        ta = da.ximat[i].reshape(3, 3) @ np.diag(mj.body_inertia[i]) @ da.ximat[i].reshape(3, 3).T
+        tb = db.ximat[j].reshape(3, 3) @ np.diag(ur.body_inertia[j]) @ db.ximat[j].reshape(3, 3).T
+        np.testing.assert_allclose(ta, tb, atol=1e-9, err_msg=b.name)
+        np.testing.assert_allclose(da.xipos[i], db.xipos[j], atol=1e-9)
+    rng = np.random.default_rng(1)
+    for _ in range(n):
+        q = _random_qpos(mj, rng)
+        da.qpos[:] = q
+        for jid in range(mj.njnt):
+            name = mj.joint(jid).name
+            uj = ur.joint(name).id if name else 0
+            size = {0: 7, 1: 4}.get(int(mj.jnt_type[jid]), 1)
+            a, b = mj.jnt_qposadr[jid], ur.jnt_qposadr[uj]
+            db.qpos[b : b + size] = q[a : a + size]
+        mujoco.mj_kinematics(mj, da)
+        mujoco.mj_kinematics(ur, db)
+        for body in hrdf.bodies:
+            i, j = mj.body(body.name).id, ur.body(body.name).id
+            # The URDF link frame sits at the last joint anchor; compare body frames via
+            # the centre of mass (frame-independent) and the orientation.
+            np.testing.assert_allclose(da.xipos[i], db.xipos[j], atol=1e-6)
+            assert _same_quat(da.xquat[i], db.xquat[j]) < 1e-6
+        for s in range(mj.nsite):
+            np.testing.assert_allclose(
+                da.site_xpos[s], db.xpos[ur.body(mj.site(s).name).id], atol=1e-6
+            )
+
+
+@pytest.mark.hurodes
+def test_g1_urdf_matches_mjcf(g1_hrdf_dir, tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        hrdf = HRDF.from_dir(g1_hrdf_dir)
+    _urdf_vs_mjcf(hrdf, tmp_path)
+
+
+@pytest.mark.parametrize("name", ["mini_humanoid", "arm6"])
+def test_bundled_urdf_matches_mjcf(name, tmp_path):
+    _urdf_vs_mjcf(HRDF.from_robot_name(name), tmp_path)
+
+
+def test_multi_joint_bodies_anchors_and_slides_urdf_matches_mjcf(synth_urdf_safe, tmp_path):
+    _urdf_vs_mjcf(synth_urdf_safe, tmp_path, n=50)
+
+
+def test_fixed_base_urdf_matches_mjcf(synth_fixed, tmp_path):
+    _urdf_vs_mjcf(synth_fixed, tmp_path)
