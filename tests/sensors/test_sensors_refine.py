@@ -35,8 +35,10 @@ def test_refine_recovers_mujoco_distances_from_perturbed_ones():
         model,
         data.geom_xpos[None],
         data.geom_xmat[None],
-        np.zeros((1, len(dirs), 3)),
-        dirs[None],
+        np.zeros((len(dirs), 3)),
+        dirs,
+        np.eye(3)[None],
+        np.zeros((1, 3)),
         out,
         gid[None].copy(),
     )

@@ -35,38 +35,58 @@ class LidarSensorData:
     Attributes:
         pos_w: ``(E, 3)`` sensor position, world frame [m].
         quat_w: ``(E, 4)`` sensor orientation (w, x, y, z), world frame (offset included).
-        ray_origins_w: ``(E, N, 3)`` ray origins, world frame [m].
-        ray_directions_w: ``(E, N, 3)`` unit ray directions, world frame.
         distances: ``(E, N)`` range along each ray [m] (noise applied; misses
             ``cfg.miss_distance``).
         hit_mask: ``(E, N)`` True where the ray returned a point.
         frame: index of the scan frame (0 for the first update).
-        hit_points_w: ``(E, N, 3)`` hit points, world frame [m] (NaN for misses),
-            computed on first access after each update.
+        ray_rot_w: ``(E, 3, 3)`` rotation applied to the pattern (set by ``ray_alignment``).
+        pattern_origins, pattern_directions: ``(N, 3)`` the pattern's rays in the sensor
+            frame for this frame [m].
+        ray_origins_w, ray_directions_w, hit_points_w: ``(E, N, 3)`` world-frame ray
+            origins [m], unit directions and hit points [m] (NaN for misses), computed
+            on first access after each update.
     """
 
     pos_w: np.ndarray
     quat_w: np.ndarray
-    ray_origins_w: np.ndarray
-    ray_directions_w: np.ndarray
     distances: np.ndarray
     hit_mask: np.ndarray
+    ray_rot_w: np.ndarray
+    pattern_origins: np.ndarray
+    pattern_directions: np.ndarray
     frame: int = -1
-    _hit_points: np.ndarray | None = field(default=None, init=False, repr=False, compare=False)
+    _cache: dict[str, np.ndarray] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+
+    @property
+    def ray_directions_w(self) -> np.ndarray:
+        if "dirs" not in self._cache:
+            self._cache["dirs"] = np.matmul(
+                self.pattern_directions[None], self.ray_rot_w.transpose(0, 2, 1)
+            )
+        return self._cache["dirs"]
+
+    @property
+    def ray_origins_w(self) -> np.ndarray:
+        if "origins" not in self._cache:
+            rotated = np.matmul(self.pattern_origins[None], self.ray_rot_w.transpose(0, 2, 1))
+            self._cache["origins"] = rotated + self.pos_w[:, None, :]
+        return self._cache["origins"]
 
     @property
     def hit_points_w(self) -> np.ndarray:
-        if self._hit_points is None:
-            # Misses have a non-finite or arbitrary miss distance: use 0, then NaN them.
+        if "points" not in self._cache:
+            # Misses carry the miss distance (inf by default): use 0, then NaN them.
             dist = np.where(self.hit_mask, self.distances, 0.0)
             pts = np.multiply(self.ray_directions_w, dist[..., None])
             pts += self.ray_origins_w
             np.copyto(pts, np.nan, where=~self.hit_mask[..., None])
-            self._hit_points = pts
-        return self._hit_points
+            self._cache["points"] = pts
+        return self._cache["points"]
 
     def _invalidate(self) -> None:
-        self._hit_points = None
+        self._cache.clear()
 
 
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, idx: int, fallback: str) -> str:
@@ -261,13 +281,15 @@ class LidarSensor:
 
     def _make_data(self) -> LidarSensorData:
         e, n = self.num_envs, self.num_rays
+        origins, dirs = self._pattern(0)
         return LidarSensorData(
             pos_w=np.zeros((e, 3)),
             quat_w=np.tile([1.0, 0.0, 0.0, 0.0], (e, 1)),
-            ray_origins_w=np.zeros((e, n, 3)),
-            ray_directions_w=np.zeros((e, n, 3)),
             distances=np.full((e, n), self.cfg.miss_distance),
             hit_mask=np.zeros((e, n), dtype=bool),
+            ray_rot_w=np.tile(np.eye(3), (e, 1, 1)),
+            pattern_origins=origins,
+            pattern_directions=dirs,
         )
 
     def _pattern(self, frame: int) -> tuple[np.ndarray, np.ndarray]:
@@ -310,22 +332,22 @@ class LidarSensor:
         origins_s, dirs_s = self._pattern(self._frame)
         pos, mat = self.sensor_poses()
         rot = self._ray_rotation(mat)
-        # (E, N, 3) = pattern rows rotated by each environment's ray rotation.
-        dirs_w = np.matmul(dirs_s[None], rot.transpose(0, 2, 1))
-        if self._single_origin:
-            origins_w = np.broadcast_to(pos[:, None, :], dirs_w.shape)
-        else:
-            origins_w = np.matmul(origins_s[None], rot.transpose(0, 2, 1)) + pos[:, None, :]
         raw_dist, geom_ids = self._engine.cast(
-            self._datas,
-            origins_w,
-            dirs_w,
-            self.cfg.max_distance,
-            self._single_origin,
+            self._datas, origins_s, dirs_s, rot, pos, self.cfg.max_distance, self._single_origin
         )
-        self._apply_range_model(raw_dist, geom_ids, origins_w, dirs_w, pos, mat)
+        self._apply_range_model(raw_dist, geom_ids)
+        d = self._data
+        d._invalidate()
+        d.frame = self._frame
+        d.pos_w[:] = pos
+        for e in range(self.num_envs):
+            mujoco.mju_mat2Quat(d.quat_w[e], mat[e].ravel())
+        d.ray_rot_w = rot
+        d.pattern_origins = origins_s
+        d.pattern_directions = dirs_s
 
-    def _apply_range_model(self, dist, geom_ids, origins_w, dirs_w, pos, mat) -> None:
+    def _apply_range_model(self, dist: np.ndarray, geom_ids: np.ndarray) -> None:
+        """Ranges, noise and dropout on the engine output (both arrays are modified)."""
         cfg = self.cfg
         hit = geom_ids >= 0
         if cfg.min_distance > 0:
@@ -340,17 +362,8 @@ class LidarSensor:
         # copyto(where=) is several times faster than boolean-index assignment here.
         np.copyto(dist, cfg.miss_distance, where=miss)
         np.copyto(geom_ids, -1, where=miss)
-        d = self._data
-        d.frame = self._frame
-        d.pos_w[:] = pos
-        for e in range(self.num_envs):
-            mujoco.mju_mat2Quat(d.quat_w[e], mat[e].ravel())
-        # Fresh arrays every frame: keep them rather than copying into old buffers.
-        d.ray_origins_w = origins_w
-        d.ray_directions_w = dirs_w
-        d.hit_mask = hit
-        d.distances = dist
-        d._invalidate()
+        self._data.hit_mask = hit
+        self._data.distances = dist
         self._raw_geom_ids = geom_ids
 
     # ------------------------------------------------------------------ getters

@@ -93,29 +93,36 @@ class MujocoRayEngine:
     def cast(
         self,
         datas: Sequence[mujoco.MjData],
-        origins: np.ndarray,
-        directions: np.ndarray,
+        origins_s: np.ndarray,
+        directions_s: np.ndarray,
+        rot: np.ndarray,
+        pos: np.ndarray,
         cutoff: float,
         single_origin: bool,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Cast rays for every environment.
+        """Cast one pattern from every environment's sensor pose.
+
+        World rays of environment ``e``: origin ``pos[e] + rot[e] @ origins_s[i]``,
+        direction ``rot[e] @ directions_s[i]``.
 
         Args:
             datas: one ``MjData`` per environment holding the current poses (only read).
-            origins: ``(E, N, 3)`` ray origins, world frame [m].
-            directions: ``(E, N, 3)`` unit directions, world frame.
+            origins_s: ``(N, 3)`` ray origins in the sensor frame [m].
+            directions_s: ``(N, 3)`` unit ray directions in the sensor frame.
+            rot: ``(E, 3, 3)`` rotation of the rays of each environment (world frame).
+            pos: ``(E, 3)`` sensor position of each environment (world frame) [m].
             cutoff: geoms further than this are skipped [m] (a speed hint only).
-            single_origin: every ray of an environment starts at ``origins[e, 0]``
-                (lets ``mj_multiRay`` share its per-geom culling over all rays).
+            single_origin: ``origins_s`` is all zero, so every ray of an environment
+                starts at ``pos[e]`` (one ``mj_multiRay`` call shares its culling).
 
         Returns:
             distances ``(E, N)`` float64 (-1 on a miss) and geom ids ``(E, N)`` int32.
         """
-        num_envs, num_rays = directions.shape[:2]
+        num_envs, num_rays = rot.shape[0], directions_s.shape[0]
         dist = np.empty((num_envs, num_rays), dtype=np.float64)
         geomid = np.empty((num_envs, num_rays), dtype=np.int32)
-        directions = np.ascontiguousarray(directions, dtype=np.float64)
-        origins = np.ascontiguousarray(origins, dtype=np.float64)
+        directions_s = np.asarray(directions_s, dtype=np.float64)
+        origins_s = np.asarray(origins_s, dtype=np.float64)
         # Enough chunks to keep every thread busy, whole environments when there are many.
         per_env = max(1, -(-self.num_threads // num_envs))
         tasks = [(e, a, b) for e in range(num_envs) for a, b in _split(num_rays, per_env)]
@@ -129,12 +136,14 @@ class MujocoRayEngine:
                     for name in self._pose_fields:
                         getattr(scratch, name)[:] = getattr(datas[e], name)
                     last_env = e
+                # World directions of this chunk, computed in the worker (numpy releases the GIL).
+                vec = directions_s[a:b] @ rot[e].T
                 if single_origin:
                     mujoco.mj_multiRay(
                         self.model,
                         scratch,
-                        origins[e, 0],
-                        directions[e, a:b].ravel(),
+                        pos[e],
+                        vec.ravel(),
                         _GEOMGROUP,
                         1,
                         -1,
@@ -145,19 +154,13 @@ class MujocoRayEngine:
                         cutoff,
                     )
                 else:
+                    pnt = origins_s[a:b] @ rot[e].T + pos[e]
                     gid = np.empty(1, dtype=np.int32)
-                    for i in range(a, b):
-                        dist[e, i] = mujoco.mj_ray(
-                            self.model,
-                            scratch,
-                            origins[e, i],
-                            directions[e, i],
-                            _GEOMGROUP,
-                            1,
-                            -1,
-                            gid,
+                    for i in range(b - a):
+                        dist[e, a + i] = mujoco.mj_ray(
+                            self.model, scratch, pnt[i], vec[i], _GEOMGROUP, 1, -1, gid
                         )
-                        geomid[e, i] = gid[0]
+                        geomid[e, a + i] = gid[0]
 
         busy = [w for w in range(self.num_threads) if groups[w]]
         if self._pool is None or len(busy) == 1:
@@ -192,8 +195,10 @@ def refine_curved_hits(
     model: mujoco.MjModel,
     geom_xpos: np.ndarray,
     geom_xmat: np.ndarray,
-    origins: np.ndarray,
-    directions: np.ndarray,
+    origins_s: np.ndarray,
+    directions_s: np.ndarray,
+    rot: np.ndarray,
+    pos: np.ndarray,
     dist: np.ndarray,
     geomid: np.ndarray,
 ) -> None:
@@ -206,7 +211,7 @@ def refine_curved_hits(
 
     Args:
         geom_xpos, geom_xmat: ``(E, ngeom, 3)`` and ``(E, ngeom, 9)`` geom poses.
-        origins, directions: ``(E, N, 3)`` world-frame rays (unit directions).
+        origins_s, directions_s, rot, pos: the rays, as in :meth:`MujocoRayEngine.cast`.
         dist, geomid: ``(E, N)`` engine results, refined in place.
     """
     gtype = model.geom_type
@@ -216,51 +221,80 @@ def refine_curved_hits(
     if e_idx.size == 0:
         return
     g = geomid[e_idx, r_idx]
-    pos = geom_xpos[e_idx, g]
+    gpos = geom_xpos[e_idx, g]
     mat = geom_xmat[e_idx, g].reshape(-1, 3, 3)
-    # Ray in the geom frame: p = R^T (o - x), v = R^T d.
-    p = np.einsum("kji,kj->ki", mat, origins[e_idx, r_idx] - pos)
-    v = np.einsum("kji,kj->ki", mat, directions[e_idx, r_idx])
+    # World rays of the selected hits only, then in the geom frame: p = R^T (o - x), v = R^T d.
+    ray_rot = rot[e_idx]
+    origin_w = np.einsum("kij,kj->ki", ray_rot, origins_s[r_idx]) + pos[e_idx]
+    dir_w = np.einsum("kij,kj->ki", ray_rot, directions_s[r_idx])
+    p = np.einsum("kji,kj->ki", mat, origin_w - gpos)
+    v = np.einsum("kji,kj->ki", mat, dir_w)
     size = model.geom_size[g]
     kind = gtype[g]
     t0 = dist[e_idx, r_idx]
-    cands: list[np.ndarray] = []
+    refined = t0.copy()
+    # Each geom type only evaluates its own surfaces (few array passes per subset).
+    for kinds, candidates in (
+        ((_SPHERE, _ELLIPSOID), _ellipsoid_candidates),
+        ((_CAPSULE,), _capsule_candidates),
+        ((_CYLINDER,), _cylinder_candidates),
+    ):
+        sel = np.flatnonzero(np.isin(kind, kinds))
+        if sel.size == 0:
+            continue
+        sz = size[sel]
+        if kinds[0] == _SPHERE:
+            sz = np.where((kind[sel] == _ELLIPSOID)[:, None], sz, sz[:, :1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            stack = np.stack(candidates(p[sel], v[sel], sz), axis=1)
+        err = np.abs(stack - t0[sel, None])
+        err[~(stack >= 0)] = np.inf  # NaN (no root) and roots behind the origin
+        best = np.argmin(err, axis=1)
+        rows = np.arange(sel.size)
+        ok = np.isfinite(err[rows, best])
+        refined[sel[ok]] = stack[rows, best][ok]
+    dist[e_idx, r_idx] = refined
 
-    def add(t: np.ndarray, valid: np.ndarray) -> None:
-        cands.append(np.where(valid & (t >= 0), t, np.nan))
 
-    # Ellipsoid and sphere: scaled unit sphere.
-    radii = np.where((kind == _ELLIPSOID)[:, None], size, size[:, :1])
+def _ellipsoid_candidates(p: np.ndarray, v: np.ndarray, radii: np.ndarray) -> list[np.ndarray]:
     ps, vs = p / radii, v / radii
-    is_ell = (kind == _SPHERE) | (kind == _ELLIPSOID)
-    t1, t2 = _quadric_roots((vs * vs).sum(1), (ps * vs).sum(1), (ps * ps).sum(1) - 1.0)
-    add(t1, is_ell)
-    add(t2, is_ell)
-    # Capsule and cylinder sides: infinite cylinder x^2 + y^2 = r^2, |z| <= half length.
-    r, h = size[:, 0], size[:, 1]
-    is_cyl = (kind == _CAPSULE) | (kind == _CYLINDER)
+    return list(_quadric_roots((vs * vs).sum(1), (ps * vs).sum(1), (ps * ps).sum(1) - 1.0))
+
+
+def _side_candidates(
+    p: np.ndarray, v: np.ndarray, r: np.ndarray, h: np.ndarray
+) -> list[np.ndarray]:
+    """Infinite cylinder x^2 + y^2 = r^2 restricted to |z| <= h."""
+    out = []
     for t in _quadric_roots(
         v[:, 0] ** 2 + v[:, 1] ** 2,
         p[:, 0] * v[:, 0] + p[:, 1] * v[:, 1],
         p[:, 0] ** 2 + p[:, 1] ** 2 - r * r,
     ):
-        add(t, is_cyl & (np.abs(p[:, 2] + t * v[:, 2]) <= h))
-    for sign in (-1.0, 1.0):
-        # Capsule caps: spheres of radius r at z = +-h.
-        pc = p - np.stack([np.zeros_like(h), np.zeros_like(h), sign * h], axis=1)
-        for t in _quadric_roots((v * v).sum(1), (pc * v).sum(1), (pc * pc).sum(1) - r * r):
-            add(t, (kind == _CAPSULE) & (sign * (p[:, 2] + t * v[:, 2]) >= h))
-        # Cylinder caps: discs at z = +-h.
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = (sign * h - p[:, 2]) / v[:, 2]
-            x, y = p[:, 0] + t * v[:, 0], p[:, 1] + t * v[:, 1]
-            add(t, (kind == _CYLINDER) & (v[:, 2] != 0) & (x * x + y * y <= r * r))
-    stack = np.stack(cands, axis=1)
-    err = np.abs(stack - t0[:, None])
-    err[np.isnan(err)] = np.inf
-    best = np.argmin(err, axis=1)
-    found = np.isfinite(err[np.arange(best.size), best])
-    dist[e_idx[found], r_idx[found]] = stack[np.arange(best.size), best][found]
+        out.append(np.where(np.abs(p[:, 2] + t * v[:, 2]) <= h, t, np.nan))
+    return out
+
+
+def _capsule_candidates(p: np.ndarray, v: np.ndarray, size: np.ndarray) -> list[np.ndarray]:
+    r, h = size[:, 0], size[:, 1]
+    out = _side_candidates(p, v, r, h)
+    vv = (v * v).sum(1)
+    for sign in (-1.0, 1.0):  # hemispherical caps: spheres of radius r at z = +-h
+        pc = p.copy()
+        pc[:, 2] -= sign * h
+        for t in _quadric_roots(vv, (pc * v).sum(1), (pc * pc).sum(1) - r * r):
+            out.append(np.where(sign * (p[:, 2] + t * v[:, 2]) >= h, t, np.nan))
+    return out
+
+
+def _cylinder_candidates(p: np.ndarray, v: np.ndarray, size: np.ndarray) -> list[np.ndarray]:
+    r, h = size[:, 0], size[:, 1]
+    out = _side_candidates(p, v, r, h)
+    for sign in (-1.0, 1.0):  # flat caps: discs at z = +-h
+        t = (sign * h - p[:, 2]) / v[:, 2]
+        x, y = p[:, 0] + t * v[:, 0], p[:, 1] + t * v[:, 1]
+        out.append(np.where(x * x + y * y <= r * r, t, np.nan))
+    return out
 
 
 def warp_available() -> bool:
@@ -332,71 +366,91 @@ class WarpRayEngine:
                 enabled_geom_groups=[0],
             )
         self._geomgroup = vec6(1, 0, 0, 0, 0, 0)
-        self._buffers: dict[int, tuple[Any, ...]] = {}
+        self._buffers: dict[str, Any] = {}
+        from robotwright.sensors import _warp_kernels
 
-    def _alloc(self, num_rays: int) -> tuple[Any, ...]:
-        if num_rays not in self._buffers:
+        self._kernels = _warp_kernels
+
+    def _alloc(self, num_rays: int) -> dict[str, Any]:
+        if self._buffers.get("num_rays") != num_rays:
             wp = self._wp
             shape = (self.num_envs, num_rays)
             with wp.ScopedDevice(self.device):
                 self._buffers = {
-                    num_rays: (
-                        wp.empty(shape, dtype=wp.vec3),
-                        wp.empty(shape, dtype=wp.vec3),
-                        wp.full(num_rays, -1, dtype=int),
-                        wp.empty(shape, dtype=float),
-                        wp.empty(shape, dtype=int),
-                        wp.empty(shape, dtype=wp.vec3),
-                    )
+                    "num_rays": num_rays,
+                    "pat_o": wp.empty(num_rays, dtype=wp.vec3),
+                    "pat_d": wp.empty(num_rays, dtype=wp.vec3),
+                    "rot": wp.empty(self.num_envs, dtype=wp.mat33),
+                    "pos": wp.empty(self.num_envs, dtype=wp.vec3),
+                    "pnt": wp.empty(shape, dtype=wp.vec3),
+                    "vec": wp.empty(shape, dtype=wp.vec3),
+                    "bodyexclude": wp.full(num_rays, -1, dtype=int),
+                    "dist": wp.empty(shape, dtype=float),
+                    "geomid": wp.empty(shape, dtype=int),
+                    "normal": wp.empty(shape, dtype=wp.vec3),
                 }
-        return self._buffers[num_rays]
+        return self._buffers
 
     def cast(
         self,
         datas: Sequence[mujoco.MjData],
-        origins: np.ndarray,
-        directions: np.ndarray,
+        origins_s: np.ndarray,
+        directions_s: np.ndarray,
+        rot: np.ndarray,
+        pos: np.ndarray,
         cutoff: float,
         single_origin: bool,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Same contract as :meth:`MujocoRayEngine.cast` (distances computed in float32)."""
+        """Same contract as :meth:`MujocoRayEngine.cast` (rays cast in float32).
+
+        Only the pattern (``N`` rays) and one pose per environment are uploaded; the
+        world rays of every environment are made on the device.
+        """
         wp, mjw = self._wp, self._mjw
-        num_envs, num_rays = directions.shape[:2]
-        geom_xpos = [d.geom_xpos for d in datas]
-        geom_xmat = [d.geom_xmat for d in datas]
+        num_envs, num_rays = rot.shape[0], directions_s.shape[0]
         if num_envs != self.num_envs:
             raise SensorError(f"warp engine built for {self.num_envs} environments, got {num_envs}")
-        pnt, vec, bodyexclude, dist, geomid, normal = self._alloc(num_rays)
+        buf = self._alloc(num_rays)
+        geom_xpos = np.stack([d.geom_xpos for d in datas])
+        geom_xmat = np.stack([d.geom_xmat for d in datas])
         with wp.ScopedDevice(self.device):
-            self._d.geom_xpos.assign(np.asarray(geom_xpos, dtype=np.float32))
-            self._d.geom_xmat.assign(
-                np.asarray(geom_xmat, dtype=np.float32).reshape(num_envs, -1, 3, 3)
+            self._d.geom_xpos.assign(geom_xpos.astype(np.float32))
+            self._d.geom_xmat.assign(geom_xmat.astype(np.float32).reshape(num_envs, -1, 3, 3))
+            buf["pat_o"].assign(np.asarray(origins_s, dtype=np.float32))
+            buf["pat_d"].assign(np.asarray(directions_s, dtype=np.float32))
+            buf["rot"].assign(np.asarray(rot, dtype=np.float32))
+            buf["pos"].assign(np.asarray(pos, dtype=np.float32))
+            wp.launch(
+                self._kernels.world_rays,
+                dim=(num_envs, num_rays),
+                inputs=[buf["pat_o"], buf["pat_d"], buf["rot"], buf["pos"]],
+                outputs=[buf["pnt"], buf["vec"]],
             )
-            pnt.assign(np.asarray(origins, dtype=np.float32))
-            vec.assign(np.asarray(directions, dtype=np.float32))
             mjw.refit_bvh(self._m, self._d, self._rc)
             mjw.rays(
                 self._m,
                 self._d,
-                pnt,
-                vec,
+                buf["pnt"],
+                buf["vec"],
                 self._geomgroup,
                 True,
-                bodyexclude,
-                dist,
-                geomid,
-                normal,
+                buf["bodyexclude"],
+                buf["dist"],
+                buf["geomid"],
+                buf["normal"],
                 self._rc,
             )
-            out_dist = dist.numpy().astype(np.float64)
-            out_ids = geomid.numpy().astype(np.int32)
+            out_dist = buf["dist"].numpy().astype(np.float64)
+            out_ids = buf["geomid"].numpy().astype(np.int32)
         if self.refine:
             refine_curved_hits(
                 self.model,
-                np.asarray(geom_xpos),
-                np.asarray(geom_xmat),
-                origins,
-                directions,
+                geom_xpos,
+                geom_xmat,
+                origins_s,
+                directions_s,
+                rot,
+                pos,
                 out_dist,
                 out_ids,
             )
