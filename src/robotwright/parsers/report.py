@@ -1,0 +1,63 @@
+"""Warnings collected while parsing, and the ``strict`` switch.
+
+Every element a parser drops or approximates is recorded as a
+:class:`~robotwright.errors.Problem` with ``severity="warning"`` naming the file and the
+element. With ``strict=True`` the parse still runs to the end (so that all problems are
+found) and then raises one :class:`~robotwright.errors.ConversionError` listing them all.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+from robotwright.errors import ConversionError, Problem
+from robotwright.hrdf.model import HRDF
+
+LOG = logging.getLogger("robotwright.parsers")
+
+
+@dataclass
+class ParseResult:
+    """The outcome of a parse.
+
+    Attributes:
+        hrdf: the robot.
+        warnings: every element dropped or approximated, in document order.
+        source: the file parsed.
+    """
+
+    hrdf: HRDF
+    warnings: list[Problem] = field(default_factory=list)
+    source: str = ""
+
+    def __iter__(self):  # allows ``hrdf, warnings = parse_..._with_warnings(...)``
+        return iter((self.hrdf, self.warnings))
+
+
+class Reporter:
+    """Collects warnings for one source file."""
+
+    def __init__(self, file: str) -> None:
+        self.file = file
+        self.problems: list[Problem] = []
+
+    def warn(self, message: str, element: str | None = None) -> None:
+        self.problems.append(Problem(self.file, message, element=element, severity="warning"))
+
+    def error(self, message: str, element: str | None = None) -> Problem:
+        return Problem(self.file, message, element=element)
+
+    def finish(self, strict: bool, emit: bool = True) -> list[Problem]:
+        """Raise under ``strict`` when anything was reported; else log each warning
+        on the ``robotwright.parsers`` logger and return them."""
+        if strict and self.problems:
+            raise ConversionError(
+                [Problem(p.file, p.message, element=p.element) for p in self.problems],
+                summary=f"strict conversion of {self.file}: {len(self.problems)} element(s) "
+                "would be dropped or approximated",
+            )
+        if emit:
+            for p in self.problems:
+                LOG.warning("%s", p)
+        return list(self.problems)

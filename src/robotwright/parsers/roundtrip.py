@@ -1,0 +1,395 @@
+"""Round-trip fidelity: source -> HRDF -> our MJCF (and our URDF), compared with the
+source compiled by MuJoCo, or with an independent URDF library when MuJoCo refuses it.
+
+Used by ``robotwright roundtrip SOURCE`` and by the real-robot tests. Tolerances:
+
+- MJCF path: masses and inertia tensors relative 1e-9, centres of mass 1e-9 m, joint
+  axes and ranges 1e-9, forward kinematics of every body and site 1e-9 (m and rad) at
+  ``configs`` random configurations (uniform inside joint ranges, [-pi, pi] for
+  unlimited hinges, [-1, 1] m for unlimited slides, uniform rotations for ball/free).
+- URDF path (our URDF loaded by MuJoCo): total mass and FK 1e-6.
+
+Mimic joints are set from the joint they follow (``offset + multiplier * q``) in both
+models, since forward kinematics does not apply equality constraints.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from robotwright.hrdf.model import HRDF
+from robotwright.parsers import inertia as inr
+from robotwright.parsers.reference import (
+    RobotView,
+    mimic_map,
+    quat_angle,
+    urdf_mujoco_view,
+    urdf_yourdfpy_view,
+    view_from_model,
+)
+
+TOL_EXACT = 1e-9
+TOL_URDF = 1e-6
+
+
+@dataclass
+class Row:
+    """One line of the fidelity table."""
+
+    check: str
+    value: str
+    ok: bool
+    note: str = ""
+
+
+@dataclass
+class RoundTripReport:
+    """The fidelity table of one robot."""
+
+    source: str
+    reference: str
+    rows: list[Row] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    error: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None and all(r.ok for r in self.rows)
+
+    def failures(self) -> list[Row]:
+        return [r for r in self.rows if not r.ok]
+
+    def table(self) -> str:
+        lines = [f"source:    {self.source}", f"reference: {self.reference}"]
+        if self.error:
+            lines.append(f"ERROR: {self.error}")
+        width = max((len(r.check) for r in self.rows), default=10)
+        for r in self.rows:
+            mark = "ok  " if r.ok else "FAIL"
+            note = f"  ({r.note})" if r.note else ""
+            lines.append(f"  {mark} {r.check:<{width}}  {r.value}{note}")
+        lines.append(f"warnings:  {len(self.warnings)}")
+        lines.append("result:    " + ("PASS" if self.ok else "FAIL"))
+        return "\n".join(lines)
+
+
+def random_configs(
+    view: RobotView, n: int, seed: int = 0, mimic: dict | None = None
+) -> list[dict[str, Any]]:
+    """``n`` random joint configurations of ``view`` (see the module docstring)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(n):
+        q: dict[str, Any] = {}
+        for j in view.joints:
+            if j.type in ("hinge", "slide"):
+                if j.range is not None:
+                    q[j.name] = float(rng.uniform(j.range[0], j.range[1]))
+                else:
+                    lim = np.pi if j.type == "hinge" else 1.0
+                    q[j.name] = float(rng.uniform(-lim, lim))
+            else:
+                quat = rng.normal(size=4)
+                quat /= np.linalg.norm(quat)
+                q[j.name] = (
+                    quat if j.type == "ball" else np.concatenate([rng.uniform(-1, 1, 3), quat])
+                )
+        for name, (src, mult, off) in (mimic or {}).items():
+            if src in q and name in q:
+                q[name] = off + mult * q[src]
+        out.append(q)
+    return out
+
+
+def _rel(a: float, b: float) -> float:
+    scale = max(abs(a), abs(b))
+    return 0.0 if scale == 0 else abs(a - b) / scale
+
+
+def compare_views(
+    ref: RobotView,
+    ours: RobotView,
+    *,
+    tol: float = TOL_EXACT,
+    configs: int = 50,
+    mimic: dict | None = None,
+    full: bool = True,
+) -> list[Row]:
+    """Rows comparing ``ours`` with ``ref``. ``full=False`` checks total mass and FK only."""
+    rows: list[Row] = []
+    our_frames = set(ours.bodies) | set(ours.sites)
+    missing = [b for b in ref.bodies if b not in our_frames]
+    as_sites = [b for b in ref.bodies if b not in ours.bodies and b in ours.sites]
+    extra = [b for b in ours.bodies if b not in ref.bodies]
+    note = f"{len(as_sites)} as sites" if as_sites else ""
+    if missing or extra:
+        note = f"missing {missing[:5]} extra {extra[:5]}"
+    rows.append(
+        Row(
+            "bodies (ref/ours)",
+            f"{len(ref.bodies)}/{len(ours.bodies)}",
+            not missing and not extra,
+            note,
+        )
+    )
+    tm_ref, tm_ours = sum(ref.mass.values()), sum(ours.mass.values())
+    rows.append(
+        Row(
+            "total mass (kg)",
+            f"{tm_ref:.6g} rel.err {_rel(tm_ref, tm_ours):.1e}",
+            _rel(tm_ref, tm_ours) <= tol,
+        )
+    )
+
+    if full and not missing:
+        # Group reference bodies by the body that holds them in ours (merged links).
+        groups: dict[str, list[str]] = {}
+        for b in ref.bodies:
+            owner = b if b in ours.mass else ours.site_body.get(b)
+            groups.setdefault(owner, []).append(b)
+        worst_m = worst_i = worst_c = 0.0
+        for owner, members in groups.items():
+            parts = [
+                (ref.mass[m], ref.inertia_world[m][0], ref.inertia_world[m][1])
+                for m in members
+                if ref.mass[m] > 0
+            ]
+            m_ref, c_ref, i_ref = (
+                inr.combine(parts) if parts else (0.0, np.zeros(3), np.zeros((3, 3)))
+            )
+            m_o = ours.mass[owner]
+            c_o, i_o = ours.inertia_world[owner]
+            worst_m = max(worst_m, _rel(m_ref, m_o))
+            if m_ref > 0:
+                worst_c = max(worst_c, float(np.abs(c_ref - c_o).max()))
+                scale = max(np.abs(i_ref).max(), np.abs(i_o).max())
+                if scale > 0:
+                    worst_i = max(worst_i, float(np.abs(i_ref - i_o).max() / scale))
+        rows.append(Row("body masses max rel.err", f"{worst_m:.1e}", worst_m <= tol))
+        rows.append(Row("inertia tensors max rel.err", f"{worst_i:.1e}", worst_i <= tol))
+        rows.append(Row("centres of mass max err (m)", f"{worst_c:.1e}", worst_c <= tol))
+
+        ours_j = {j.name: j for j in ours.joints}
+        bad_type, miss_j, worst_axis, worst_rng, bad_lim = [], [], 0.0, 0.0, []
+        for j in ref.joints:
+            o = ours_j.get(j.name)
+            if o is None:
+                miss_j.append(j.name)
+                continue
+            if o.type != j.type:
+                bad_type.append(j.name)
+                continue
+            if j.type in ("hinge", "slide"):
+                a1 = j.axis / np.linalg.norm(j.axis)
+                a2 = o.axis / np.linalg.norm(o.axis)
+                worst_axis = max(worst_axis, float(np.abs(a1 - a2).max()))
+            if (j.range is None) != (o.range is None):
+                bad_lim.append(j.name)
+            elif j.range is not None:
+                worst_rng = max(worst_rng, float(np.abs(np.subtract(j.range, o.range)).max()))
+        rows.append(
+            Row(
+                "joints (ref/ours)",
+                f"{len(ref.joints)}/{len(ours.joints)}",
+                not miss_j and len(ref.joints) == len(ours.joints),
+                f"missing {miss_j[:5]}" if miss_j else "",
+            )
+        )
+        rows.append(
+            Row("joint types equal", "yes" if not bad_type else f"no: {bad_type[:5]}", not bad_type)
+        )
+        rows.append(Row("joint axes max err", f"{worst_axis:.1e}", worst_axis <= tol))
+        rows.append(
+            Row(
+                "joint ranges max err",
+                f"{worst_rng:.1e}" + (f", limited differs: {bad_lim[:5]}" if bad_lim else ""),
+                worst_rng <= tol and not bad_lim,
+            )
+        )
+        if ref.kind == "mujoco":
+            rows.append(_compare_actuators(ref, ours, tol))
+            missing_sites = [s for s in ref.sites if s not in ours.sites]
+            rows.append(
+                Row(
+                    "sites kept",
+                    f"{len(ref.sites) - len(missing_sites)}/{len(ref.sites)}",
+                    not missing_sites,
+                    f"missing {missing_sites[:5]}" if missing_sites else "",
+                )
+            )
+            same = ref.sensors == ours.sensors
+            rows.append(
+                Row(
+                    "sensors equal (name, type, object)",
+                    f"{len(ref.sensors)}/{len(ours.sensors)}",
+                    same,
+                )
+            )
+
+    # Forward kinematics.
+    names = [b for b in ref.bodies if b in our_frames] + [s for s in ref.sites if s in ours.sites]
+    worst_p = worst_r = 0.0
+    unknown = [j.name for j in ref.joints if j.name not in {o.name for o in ours.joints}]
+    for q in random_configs(ref, configs, mimic=mimic):
+        a, b = ref.fk(q), ours.fk({k: v for k, v in q.items() if k not in unknown})
+        for n in names:
+            if n not in a:
+                continue
+            worst_p = max(worst_p, float(np.abs(a[n][0] - b[n][0]).max()))
+            worst_r = max(worst_r, quat_angle(a[n][1], b[n][1]))
+    rows.append(
+        Row(
+            f"FK {len(names)} frames x {configs} configs (m / rad)",
+            f"{worst_p:.1e} / {worst_r:.1e}",
+            worst_p <= tol and worst_r <= tol and not unknown,
+            f"joints unknown to ours: {unknown[:5]}" if unknown else "",
+        )
+    )
+    return rows
+
+
+def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
+    if len(ref.actuators) != len(ours.actuators):
+        return Row(
+            "actuators (order, type, gains, ranges)",
+            f"{len(ref.actuators)}/{len(ours.actuators)}",
+            False,
+        )
+    bad = []
+    for a, b in zip(ref.actuators, ours.actuators, strict=True):
+        same = a["name"] == b["name"] and a["type"] == b["type"] and a["joint"] == b["joint"]
+        for key in ("gear", "gainprm", "biasprm", "ctrlrange", "forcerange"):
+            x, y = a[key], b[key]
+            if (x is None) != (y is None):
+                same = False
+            elif x is not None:
+                x, y = np.atleast_1d(x), np.atleast_1d(y)
+                scale = max(float(np.abs(x).max()), 1e-300)
+                same = same and float(np.abs(x - y).max()) <= tol * max(scale, 1.0)
+        if not same:
+            bad.append(a["name"] or a["joint"])
+    return Row(
+        "actuators (order, type, gains, ranges)",
+        f"{len(ref.actuators)}/{len(ours.actuators)}",
+        not bad,
+        f"differ: {bad[:5]}" if bad else "",
+    )
+
+
+# -- whole round trips ----------------------------------------------------------------------
+def source_kind(path: Path) -> str:
+    ext = path.suffix.lower()
+    if ext == ".urdf":
+        return "urdf"
+    if ext == ".xml" or ext == ".mjcf":
+        return "mjcf"
+    raise ValueError(f"{path}: expected a .urdf or .xml (MJCF) file")
+
+
+def parse_source(path: Path, strict: bool = False, **options: Any):
+    """ParseResult of an MJCF or URDF file (by extension)."""
+    from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
+
+    if source_kind(path) == "urdf":
+        return urdf_to_hrdf_with_warnings(path, strict=strict, **options)
+    return mjcf_to_hrdf_with_warnings(path, strict=strict, **options)
+
+
+def our_mjcf_model(hrdf: HRDF) -> mujoco.MjModel:
+    """Our MJCF of ``hrdf`` compiled by MuJoCo (no scene)."""
+    import warnings
+
+    from robotwright.generators import MJCFHumanoidGenerator
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return MJCFHumanoidGenerator.from_hrdf(hrdf).to_model(add_scene=False)
+
+
+def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
+    """Our URDF of ``hrdf`` loaded by MuJoCo (every link kept, inertia from <inertial>)."""
+    import warnings
+
+    from robotwright.generators import URDFHumanoidGenerator
+
+    with tempfile.TemporaryDirectory(prefix="robotwright-rt-") as tmp:
+        out = Path(tmp) / "robot.urdf"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            URDFHumanoidGenerator.from_hrdf(hrdf).export(out)
+        from robotwright.parsers.reference import urdf_for_mujoco
+
+        text = urdf_for_mujoco(out)
+        return mujoco.MjModel.from_xml_string(text)
+
+
+def reference_view(path: Path, **options: Any) -> RobotView:
+    """The source as MuJoCo compiles it; for a URDF MuJoCo refuses, yourdfpy's view."""
+    if source_kind(path) == "mjcf":
+        return view_from_model(
+            mujoco.MjModel.from_xml_path(str(path)), root=options.get("root_body")
+        )
+    compiler = {
+        k: options[k] for k in ("balance_inertia", "bound_mass", "bound_inertia") if k in options
+    }
+    try:
+        return urdf_mujoco_view(path, options.get("package_map"), **compiler)
+    except ValueError as exc:
+        view = urdf_yourdfpy_view(path)
+        view.kind = f"yourdfpy (MuJoCo refuses the source: {str(exc).splitlines()[0][:120]})"
+        return view
+
+
+def roundtrip(
+    source: str | os.PathLike, *, configs: int = 50, urdf: bool = True, **options: Any
+) -> RoundTripReport:
+    """The fidelity table of one MJCF or URDF file (see the module docstring)."""
+    path = Path(source)
+    report = RoundTripReport(str(path), "")
+    try:
+        result = parse_source(path, **options)
+    except Exception as exc:  # the table reports any failure with its reason
+        report.error = f"parse failed: {type(exc).__name__}: {exc}"
+        return report
+    report.warnings = [str(w) for w in result.warnings]
+    try:
+        ref = reference_view(path, **options)
+    except Exception as exc:
+        report.error = f"no reference: {type(exc).__name__}: {exc}"
+        return report
+    report.reference = ref.kind
+    mimic = mimic_map(path)
+    try:
+        ours = view_from_model(our_mjcf_model(result.hrdf))
+    except Exception as exc:
+        report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
+        return report
+    for r in compare_views(ref, ours, configs=configs, mimic=mimic):
+        r.check = "MJCF: " + r.check
+        report.rows.append(r)
+    if urdf:
+        try:
+            ours_u = view_from_model(our_urdf_model(result.hrdf))
+        except ImportError:
+            report.rows.append(Row("URDF: generator", "not available", False))
+            return report
+        except Exception as exc:
+            report.rows.append(
+                Row(
+                    "URDF: our URDF loads in MuJoCo",
+                    f"no: {type(exc).__name__}: {str(exc)[:200]}",
+                    False,
+                )
+            )
+            return report
+        for r in compare_views(ref, ours_u, tol=TOL_URDF, configs=configs, mimic=mimic, full=False):
+            r.check = "URDF: " + r.check
+            report.rows.append(r)
+    return report

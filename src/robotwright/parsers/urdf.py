@@ -1,0 +1,705 @@
+"""URDF -> HRDF.
+
+Frames: a URDF joint's ``<origin>`` is the child link frame in the parent link frame;
+it becomes the child body's ``pos``/``quat`` and the joint sits at the body origin
+(``pos`` 0) with its ``<axis>`` in the child frame, as MuJoCo's own URDF importer does.
+Inertia tensors (``<inertial><origin rpy>`` honoured) are diagonalised exactly.
+
+Visual geoms go to group 2 without contacts (contype = conaffinity = 0), collision geoms
+to group 3 with contype = conaffinity = 1, so the two stay apart.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from robotwright.errors import ConversionError, Problem
+from robotwright.hrdf.model import (
+    HRDF,
+    Actuator,
+    Body,
+    Joint,
+    MeshGeom,
+    Meta,
+    SimpleGeom,
+    Site,
+)
+from robotwright.parsers import inertia as inr
+from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
+from robotwright.parsers.meshes import HEAVY_FACES, MeshConversionError, MeshStore
+from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
+from robotwright.parsers.report import ParseResult, Reporter
+from robotwright.parsers.xmlsafe import describe, parse_xml
+
+VISUAL_GROUP = 2
+COLLISION_GROUP = 3
+_KNOWN_TOP = {"link", "joint", "material"}
+_JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
+
+
+@dataclass(frozen=True)
+class URDFOptions:
+    """How a URDF is turned into HRDF.
+
+    Attributes:
+        fixed_joints: ``"keep"`` (a body per link, default), ``"merge"`` (a link on a
+            fixed joint is merged into its parent: mass, centre of mass and inertia
+            combined exactly, geoms re-posed, the link frame kept as a site named after
+            it), or ``"site"`` (only massless leaf links on fixed joints become sites).
+        package_map: ``{"package name": folder}`` tried first for ``package://`` URIs.
+        mesh_root: folder relative and ``file://`` mesh paths must stay inside
+            (default: see :func:`robotwright.parsers.packages.robot_root`).
+        work_dir: folder where meshes are staged/converted (default: a new temp folder).
+        actuators: ``"none"`` (default; URDF has no actuators) or ``"motor"`` (one torque
+            motor per moving joint with an effort limit: peak_torque = effort,
+            peak_velocity = velocity, ctrl_range = +-effort).
+        balance_inertia: repair A + B < C principal moments as MuJoCo's
+            ``balanceinertia`` does (each repaired link is reported).
+        bound_mass: raise body masses below this (kg) to it, as MuJoCo's ``boundmass``.
+        bound_inertia: raise principal moments below this (kg m^2) to it, as MuJoCo's
+            ``boundinertia``.
+        floating_base: give the root body a free joint (URDF has no floating base unless
+            a ``floating`` joint attaches it to a ``world`` link).
+    """
+
+    fixed_joints: FixedPolicy = "keep"
+    package_map: Mapping[str, str | os.PathLike] | None = None
+    mesh_root: Path | None = None
+    work_dir: Path | None = None
+    actuators: Literal["none", "motor"] = "none"
+    balance_inertia: bool = False
+    bound_mass: float | None = None
+    bound_inertia: float | None = None
+    floating_base: bool = False
+
+    def __post_init__(self) -> None:
+        if self.fixed_joints not in FIXED_POLICIES:
+            raise ValueError(
+                f"fixed_joints={self.fixed_joints!r}: expected one of {list(FIXED_POLICIES)}"
+            )
+        if self.actuators not in ("none", "motor"):
+            raise ValueError(f"actuators={self.actuators!r}: expected 'none' or 'motor'")
+        for name in ("bound_mass", "bound_inertia"):
+            value = getattr(self, name)
+            if value is not None and not value >= 0:
+                raise ValueError(f"{name}={value!r}: expected None or >= 0")
+
+
+def _floats(text: str | None, n: int, default: tuple[float, ...], what: str, rep) -> np.ndarray:
+    if text is None:
+        return np.array(default, dtype=float)
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != n:
+        raise ConversionError(
+            [Problem(rep.file, f"{what} = {text!r}: expected {n} numbers")],
+        )
+    return np.array(values, dtype=float)
+
+
+@dataclass
+class _Pose:
+    pos: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    rot: np.ndarray = field(default_factory=lambda: np.eye(3))
+
+    def compose(self, other: _Pose) -> _Pose:
+        return _Pose(self.pos + self.rot @ other.pos, self.rot @ other.rot)
+
+    @property
+    def quat(self) -> tuple[float, float, float, float]:
+        return inr.mat_to_quat(self.rot)
+
+
+def _origin(elem: ET.Element | None, rep: Reporter, where: str) -> _Pose:
+    if elem is None:
+        return _Pose()
+    xyz = _floats(elem.get("xyz"), 3, (0, 0, 0), f"{where} <origin xyz>", rep)
+    rpy = _floats(elem.get("rpy"), 3, (0, 0, 0), f"{where} <origin rpy>", rep)
+    return _Pose(xyz, inr.quat_to_mat(inr.rpy_to_quat(rpy)))
+
+
+def _t(v: np.ndarray | tuple) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+@dataclass
+class _LinkData:
+    """A link converted to body-frame quantities, before the fixed-joint policy."""
+
+    name: str
+    mass: float
+    com: np.ndarray
+    tensor: np.ndarray  # about the com, link frame
+    geoms: list[tuple[str, _Pose, dict]]  # kind ("visual"/"collision"), pose, fields
+    has_inertial: bool
+
+
+def _link_inertial(link: ET.Element, rep: Reporter) -> tuple[float, np.ndarray, np.ndarray, bool]:
+    inertial = link.find("inertial")
+    where = describe(link)
+    if inertial is None:
+        return 0.0, np.zeros(3), np.zeros((3, 3)), False
+    pose = _origin(inertial.find("origin"), rep, where)
+    mass_el = inertial.find("mass")
+    mass = 0.0
+    if mass_el is not None:
+        try:
+            mass = float(mass_el.get("value", "0"))
+        except ValueError as exc:
+            raise ConversionError(
+                [
+                    Problem(
+                        rep.file, f"mass {mass_el.get('value')!r}: expected a number", element=where
+                    )
+                ]
+            ) from exc
+    i_el = inertial.find("inertia")
+    tensor = np.zeros((3, 3))
+    if i_el is not None:
+        try:
+            v = {k: float(i_el.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        except ValueError as exc:
+            raise ConversionError(
+                [Problem(rep.file, "inertia: expected numbers ixx..izz", element=where)]
+            ) from exc
+        local = np.array(
+            [
+                [v["ixx"], v["ixy"], v["ixz"]],
+                [v["ixy"], v["iyy"], v["iyz"]],
+                [v["ixz"], v["iyz"], v["izz"]],
+            ]
+        )
+        tensor = pose.rot @ local @ pose.rot.T
+    return mass, pose.pos, tensor, True
+
+
+class _URDFReader:
+    def __init__(self, path: Path, options: URDFOptions, rep: Reporter) -> None:
+        self.path = path
+        self.opt = options
+        self.rep = rep
+        self.store = MeshStore(options.work_dir) if options.work_dir else MeshStore()
+        self.materials: dict[str, tuple[float, float, float, float]] = {}
+        self.unresolved: list[Problem] = []
+        self.mesh_names: dict[tuple[str, tuple[float, float, float]], str] = {}
+        self.mesh_name_used: set[str] = set()
+        self.heavy: dict[str, int] = {}
+
+    # -- geometry -------------------------------------------------------------------------
+    def _material(self, elem: ET.Element | None, where: str) -> tuple | None:
+        if elem is None:
+            return None
+        color = elem.find("color")
+        if elem.find("texture") is not None:
+            self.rep.warn("material texture dropped (HRDF geoms carry a colour only)", where)
+        if color is not None:
+            rgba = _floats(
+                color.get("rgba"), 4, (0.5, 0.5, 0.5, 1), f"{where} <color rgba>", self.rep
+            )
+            return tuple(float(x) for x in np.clip(rgba, 0.0, 1.0))
+        name = elem.get("name")
+        if name is not None and name in self.materials:
+            return self.materials[name]
+        return None
+
+    def _mesh_name(self, staged_rel: str, scale: tuple[float, float, float]) -> str:
+        key = (staged_rel, scale)
+        if key not in self.mesh_names:
+            stem = Path(staged_rel).stem
+            name, k = stem, 1
+            while name in self.mesh_name_used:
+                name, k = f"{stem}_{k}", k + 1
+            self.mesh_name_used.add(name)
+            self.mesh_names[key] = name
+        return self.mesh_names[key]
+
+    def _geom(self, elem: ET.Element, kind: str, link: str) -> tuple[str, _Pose, dict] | None:
+        where = f'<link name="{link}"> <{kind}' + (
+            f' name="{elem.get("name")}">' if elem.get("name") else ">"
+        )
+        pose = _origin(elem.find("origin"), self.rep, where)
+        geometry = elem.find("geometry")
+        shape = None if geometry is None else next(iter(geometry), None)
+        if shape is None:
+            self.rep.warn(f"{kind} without <geometry> dropped", where)
+            return None
+        fields: dict = {"geom_name": elem.get("name")}
+        if kind == "visual":
+            rgba = self._material(elem.find("material"), where)
+            if rgba is not None:
+                fields["rgba"] = rgba
+        tag = shape.tag
+
+        def num(attr: str) -> float:
+            try:
+                return float(shape.get(attr, ""))
+            except ValueError as exc:
+                raise ConversionError(
+                    [Problem(self.rep.file, f"<{tag} {attr}>: expected a number", element=where)]
+                ) from exc
+
+        if tag == "box":
+            size = _floats(shape.get("size"), 3, (0, 0, 0), f"{where} <box size>", self.rep)
+            fields.update(type="box", size=_t(size / 2.0))
+        elif tag == "sphere":
+            fields.update(type="sphere", size=(num("radius"), 0.0, 0.0))
+        elif tag in ("cylinder", "capsule"):
+            fields.update(type=tag, size=(num("radius"), num("length") / 2.0, 0.0))
+        elif tag == "mesh":
+            uri = shape.get("filename")
+            if not uri:
+                self.rep.warn("mesh without filename dropped", where)
+                return None
+            scale = _t(_floats(shape.get("scale"), 3, (1, 1, 1), f"{where} <mesh scale>", self.rep))
+            try:
+                path = resolve_uri(uri, self.path, self.opt.package_map, self.opt.mesh_root)
+                if any(v < 0 for v in scale):
+                    signs = tuple(-1.0 if v < 0 else 1.0 for v in scale)
+                    staged = self.store.add_mirrored(path, signs)
+                    scale = tuple(abs(v) for v in scale)
+                    self.rep.warn(
+                        f"mesh '{uri}' with negative scale: mirrored copy written "
+                        f"({staged.rel}), scale {scale} kept",
+                        where,
+                    )
+                else:
+                    staged = self.store.add(path)
+            except UnresolvedMesh as exc:
+                self.unresolved.append(Problem(self.rep.file, str(exc), element=where))
+                return None
+            except MeshConversionError as exc:
+                if "holds no triangles" in str(exc):
+                    self.rep.warn(f"{kind} dropped: {exc}", where)
+                else:
+                    self.unresolved.append(Problem(self.rep.file, str(exc), element=where))
+                return None
+            if staged.converted and not staged.rel.endswith("_mirrored.stl"):
+                self.rep.warn(
+                    f"mesh '{uri}' converted to STL (its materials/textures are dropped)", where
+                )
+            if staged.faces is not None and staged.faces > HEAVY_FACES:
+                self.heavy[uri] = staged.faces
+            fields.update(
+                mesh=True, name=self._mesh_name(staged.rel, scale), file=staged.rel, scale=scale
+            )
+        else:
+            self.rep.warn(f"unknown geometry <{tag}> dropped", where)
+            return None
+        return kind, pose, fields
+
+    # -- links --------------------------------------------------------------------------
+    def link_data(self, link: ET.Element) -> _LinkData:
+        name = link.get("name", "")
+        mass, com, tensor, has = _link_inertial(link, self.rep)
+        geoms = []
+        for kind in ("visual", "collision"):
+            for elem in link.findall(kind):
+                g = self._geom(elem, kind, name)
+                if g is not None:
+                    geoms.append(g)
+        return _LinkData(name, mass, com, tensor, geoms, has)
+
+
+def _make_geom(body: str, kind: str, pose: _Pose, fields: dict) -> MeshGeom | SimpleGeom:
+    common = {
+        "body": body,
+        "pos": _t(pose.pos),
+        "quat": pose.quat,
+        "group": VISUAL_GROUP if kind == "visual" else COLLISION_GROUP,
+        "contact_type": 0 if kind == "visual" else 1,
+        "contact_affinity": 0 if kind == "visual" else 1,
+        "geom_name": fields.get("geom_name"),
+    }
+    if "rgba" in fields:
+        common["rgba"] = fields["rgba"]
+    if fields.get("mesh"):
+        return MeshGeom(name=fields["name"], file=fields["file"], scale=fields["scale"], **common)
+    return SimpleGeom(name="", type=fields["type"], size=fields["size"], **common)
+
+
+def parse_urdf(
+    path: str | os.PathLike, options: URDFOptions | None = None, *, strict: bool = False
+) -> ParseResult:
+    """Parse a URDF file into an HRDF (see :class:`URDFOptions`).
+
+    Raises:
+        ConversionError: malformed or unsafe XML, an invalid tree, unresolved meshes
+            (all listed in one error), or, with ``strict=True``, any warning.
+    """
+    path = Path(path)
+    opt = options or URDFOptions()
+    rep = Reporter(str(path))
+    root = parse_xml(path)
+    if root.tag != "robot":
+        raise ConversionError([Problem(str(path), f"root element <{root.tag}>: expected <robot>")])
+    reader = _URDFReader(path, opt, rep)
+    errors: list[Problem] = []
+
+    for mat in root.findall("material"):
+        rgba = reader._material(mat, describe(mat))
+        if rgba is not None and mat.get("name"):
+            reader.materials[mat.get("name")] = rgba
+    dropped = Counter(child.tag for child in root if child.tag not in _KNOWN_TOP)
+    for tag, count in sorted(dropped.items()):
+        rep.warn(f"{count} top-level <{tag}> element(s) dropped (not robot structure)")
+
+    links: dict[str, ET.Element] = {}
+    for link in root.findall("link"):
+        name = link.get("name")
+        if not name:
+            errors.append(Problem(str(path), "link without a name", element="<link>"))
+        elif name in links:
+            errors.append(Problem(str(path), "duplicate link name", element=describe(link)))
+        else:
+            links[name] = link
+    joints: list[ET.Element] = []
+    parent_of: dict[str, ET.Element] = {}
+    seen_joint: set[str] = set()
+    for j in root.findall("joint"):
+        where = describe(j)
+        jname, jtype = j.get("name"), j.get("type")
+        par = j.find("parent")
+        chi = j.find("child")
+        if not jname:
+            errors.append(Problem(str(path), "joint without a name", element=where))
+            continue
+        if jname in seen_joint:
+            errors.append(Problem(str(path), "duplicate joint name", element=where))
+            continue
+        seen_joint.add(jname)
+        if jtype not in _JOINT_TYPES:
+            errors.append(
+                Problem(
+                    str(path),
+                    f"type {jtype!r}: expected one of {sorted(_JOINT_TYPES)}",
+                    element=where,
+                )
+            )
+            continue
+        if par is None or chi is None:
+            errors.append(
+                Problem(str(path), "expected <parent link> and <child link>", element=where)
+            )
+            continue
+        p, c = par.get("link"), chi.get("link")
+        for role, ln in (("parent", p), ("child", c)):
+            if ln not in links:
+                errors.append(
+                    Problem(str(path), f"{role} link {ln!r} is not defined", element=where)
+                )
+        if c in parent_of:
+            errors.append(Problem(str(path), f"link '{c}' has two parent joints", element=where))
+            continue
+        if p in links and c in links:
+            parent_of[c] = j
+            joints.append(j)
+    roots = [n for n in links if n not in parent_of]
+    if not errors and not links:
+        errors.append(Problem(str(path), "the robot has no links"))
+    elif not errors and len(roots) != 1:
+        errors.append(
+            Problem(str(path), f"expected exactly one root link, found {roots or 'none (cycle)'}")
+        )
+    if errors:
+        raise ConversionError(errors, summary=f"invalid URDF {path}")
+
+    children: dict[str, list[ET.Element]] = {n: [] for n in links}
+    for j in joints:
+        children[j.find("parent").get("link")].append(j)
+
+    # Depth-first order from the root (document order of joints among siblings).
+    order: list[str] = []
+    stack = [roots[0]]
+    while stack:
+        n = stack.pop()
+        order.append(n)
+        stack.extend(reversed([j.find("child").get("link") for j in children[n]]))
+    if len(order) != len(links):
+        raise ConversionError([Problem(str(path), "the joints do not form a tree (cycle)")])
+
+    data = {n: reader.link_data(links[n]) for n in order}
+    if reader.unresolved:
+        raise ConversionError(
+            reader.unresolved, summary=f"{len(reader.unresolved)} mesh(es) of {path} not resolved"
+        )
+    for uri, faces in sorted(reader.heavy.items()):
+        rep.warn(f"mesh '{uri}' has {faces} faces (> {HEAVY_FACES}): MuJoCo refuses such STLs")
+
+    # A massless, geometry-free root link (usually "world") only anchors the robot: its
+    # single child becomes the root, placed at the joint origin.
+    root_name = roots[0]
+    root_pose = _Pose()
+    free_root = opt.floating_base
+    free_name: str | None = None
+    dropped_root: tuple[str, str] | None = None
+    r = data[root_name]
+    if (not r.has_inertial or r.mass == 0.0) and not r.geoms and len(children[root_name]) == 1:
+        j = children[root_name][0]
+        if j.get("type") in ("fixed", "floating"):
+            child = j.find("child").get("link")
+            root_pose = _origin(j.find("origin"), rep, describe(j))
+            if j.get("type") == "floating":
+                free_root, free_name = True, j.get("name")
+            rep.warn(
+                f"massless root link '{root_name}' dropped; '{child}' is the root, placed at "
+                f"the pose of {j.get('type')} joint '{j.get('name')}'",
+                describe(links[root_name]),
+            )
+            order.remove(root_name)
+            dropped_root = (root_name, child)
+            root_name = child
+            parent_of.pop(child)
+            joints.remove(j)
+
+    mimic_eq: list[str] = []
+    mimic_pairs: list[tuple[str, str]] = []
+    sites: list[Site] = []
+    if dropped_root is not None and dropped_root[0] != "world":
+        # Keep the dropped root's frame as a site on the new root (MuJoCo's convention
+        # makes only a root link called "world" the world itself).
+        inv = _Pose(-root_pose.rot.T @ root_pose.pos, root_pose.rot.T)
+        sites.append(
+            Site(name=dropped_root[0], body=dropped_root[1], pos=_t(inv.pos), quat=inv.quat)
+        )
+    hrdf_joints: list[Joint] = []
+    actuators: list[Actuator] = []
+    # owner[link] = (body name, pose of the link frame in the owner body frame)
+    owner: dict[str, tuple[str, _Pose]] = {}
+    bodies: dict[str, dict] = {}
+    body_order: list[str] = []
+    dropped_limits: list[str] = []
+    for name in order:
+        d = data[name]
+        j = parent_of.get(name)
+        if j is None:
+            pose, jtype, parent_body = root_pose, "root", None
+        else:
+            pose = _origin(j.find("origin"), rep, describe(j))
+            jtype = j.get("type")
+            parent_body, parent_pose = owner[j.find("parent").get("link")]
+            pose = parent_pose.compose(pose)
+        if jtype == "floating":
+            raise ConversionError(
+                [
+                    Problem(
+                        str(path),
+                        "floating joint below the root: HRDF allows a free joint on the root only",
+                        element=describe(j),
+                    )
+                ]
+            )
+        if jtype == "planar":
+            raise ConversionError(
+                [
+                    Problem(
+                        str(path),
+                        "planar joints are not supported (no HRDF equivalent)",
+                        element=describe(j),
+                    )
+                ]
+            )
+        massless = not d.has_inertial or d.mass == 0.0
+        leaf = not children[name]
+        as_site = jtype == "fixed" and (
+            opt.fixed_joints == "merge" or (opt.fixed_joints == "site" and massless and leaf)
+        )
+        if as_site:
+            owner[name] = (parent_body, pose)
+            target = bodies[parent_body]
+            if d.mass > 0:
+                target["parts"].append(
+                    (d.mass, pose.pos + pose.rot @ d.com, pose.rot @ d.tensor @ pose.rot.T)
+                )
+            for kind, gpose, fields in d.geoms:
+                target["geoms"].append((kind, pose.compose(gpose), fields))
+            sites.append(Site(name=name, body=parent_body, pos=_t(pose.pos), quat=pose.quat))
+            continue
+        owner[name] = (name, _Pose())
+        bodies[name] = {
+            "parent": parent_body,
+            "pose": pose,
+            "parts": [(d.mass, d.com, d.tensor)] if d.mass > 0 else [],
+            "geoms": list(d.geoms),
+            "declared": d.has_inertial,
+        }
+        body_order.append(name)
+        if j is None:
+            if free_root:
+                hrdf_joints.append(Joint(name=free_name, body=name, type="free"))
+            continue
+        if jtype == "fixed":
+            continue
+        where = describe(j)
+        axis = _floats(
+            (j.find("axis").get("xyz") if j.find("axis") is not None else None),
+            3,
+            (1, 0, 0),
+            f"{where} <axis>",
+            rep,
+        )
+        if np.linalg.norm(axis) < 1e-12:
+            raise ConversionError([Problem(str(path), "axis is zero", element=where)])
+        limit = j.find("limit")
+        rng = None
+        if jtype in ("revolute", "prismatic"):
+            if limit is None or limit.get("lower") is None and limit.get("upper") is None:
+                rep.warn(f"{jtype} joint without <limit lower upper>: kept unlimited", where)
+            else:
+                rng = (float(limit.get("lower", "0")), float(limit.get("upper", "0")))
+                if rng[0] == rng[1]:
+                    rep.warn(
+                        f"lower = upper = {rng[0]}: limit ignored, joint kept unlimited "
+                        "(as MuJoCo's URDF importer does)",
+                        where,
+                    )
+                    rng = None
+        dyn = j.find("dynamics")
+        damping = float(dyn.get("damping", "0")) if dyn is not None else 0.0
+        friction = float(dyn.get("friction", "0")) if dyn is not None else 0.0
+        hrdf_joints.append(
+            Joint(
+                name=j.get("name"),
+                body=name,
+                type="slide" if jtype == "prismatic" else "hinge",
+                axis=_t(axis),
+                range=rng,
+                dynamic_friction=friction,
+                viscous_friction=damping,
+            )
+        )
+        effort = float(limit.get("effort", "0")) if limit is not None else 0.0
+        velocity = float(limit.get("velocity", "0")) if limit is not None else 0.0
+        if opt.actuators == "motor" and effort > 0:
+            actuators.append(
+                Actuator(
+                    joint=j.get("name"),
+                    name=j.get("name"),
+                    type="motor",
+                    peak_torque=effort,
+                    peak_velocity=velocity if velocity > 0 else None,
+                    ctrl_range=(-effort, effort),
+                )
+            )
+        elif effort > 0 or velocity > 0:
+            dropped_limits.append(j.get("name"))
+        for tag in ("safety_controller", "calibration"):
+            if j.find(tag) is not None:
+                rep.warn(f"<{tag}> dropped (no HRDF equivalent)", where)
+        mimic = j.find("mimic")
+        if mimic is not None:
+            mult = float(mimic.get("multiplier", "1"))
+            off = float(mimic.get("offset", "0"))
+            mimic_pairs.append((j.get("name"), mimic.get("joint")))
+            mimic_eq.append(
+                f'    <joint joint1="{j.get("name")}" joint2="{mimic.get("joint")}" '
+                f'polycoef="{off!r} {mult!r} 0 0 0"/>'
+            )
+    if dropped_limits:
+        rep.warn(
+            f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept (HRDF joints "
+            "carry no force limit; pass actuators='motor' to keep them as motors): "
+            + ", ".join(dropped_limits)
+        )
+
+    hrdf_bodies: list[Body] = []
+    index = {n: i for i, n in enumerate(body_order)}
+    geoms_mesh: list[MeshGeom] = []
+    geoms_simple: list[SimpleGeom] = []
+    for name in body_order:
+        b = bodies[name]
+        mass, com, tensor = (
+            inr.combine(b["parts"]) if b["parts"] else (0.0, np.zeros(3), np.zeros((3, 3)))
+        )
+        if len(b["parts"]) == 1:
+            mass, com, tensor = b["parts"][0]
+        diag, iquat = inr.diagonalize(tensor)
+        where = f'<link name="{name}">'
+        if mass > 0 and not inr.is_physical(diag):
+            if opt.balance_inertia and min(diag) > 0:
+                fixed = inr.balance(diag)
+                rep.warn(f"principal moments {diag} violate A + B >= C: balanced to {fixed}", where)
+                diag = fixed
+            else:
+                rep.warn(
+                    f"non-physical inertia: principal moments {diag} (negative or A + B < C)", where
+                )
+        if opt.bound_mass is not None and mass < opt.bound_mass:
+            rep.warn(f"mass {mass} raised to bound_mass {opt.bound_mass}", where)
+            mass = opt.bound_mass
+        if opt.bound_inertia is not None and min(diag) < opt.bound_inertia:
+            new = tuple(max(v, opt.bound_inertia) for v in diag)
+            rep.warn(f"principal moments {diag} raised to bound_inertia: {new}", where)
+            diag = new
+        pose = b["pose"]
+        hrdf_bodies.append(
+            Body(
+                name=name,
+                parent=-1 if b["parent"] is None else index[b["parent"]],
+                pos=_t(pose.pos),
+                quat=pose.quat,
+                mass=float(mass),
+                inertial_pos=_t(com),
+                inertial_quat=iquat,
+                diag_inertia=diag,
+            )
+        )
+        for kind, gpose, fields in b["geoms"]:
+            g = _make_geom(name, kind, gpose, fields)
+            (geoms_mesh if isinstance(g, MeshGeom) else geoms_simple).append(g)
+    for i, g in enumerate(geoms_simple):
+        geoms_simple[i] = _replace_name(g, f"geom_{i}", "name")
+    # Geom names must be unique in MJCF; URDF repeats them freely.
+    seen_names: Counter[str] = Counter()
+    for table in (geoms_mesh, geoms_simple):
+        for i, g in enumerate(table):
+            if g.geom_name is None:
+                continue
+            seen_names[g.geom_name] += 1
+            if seen_names[g.geom_name] > 1:
+                new_name = f"{g.geom_name}_{seen_names[g.geom_name] - 1}"
+                rep.warn(f"geom name '{g.geom_name}' repeated: renamed '{new_name}'")
+                table[i] = _replace_name(g, new_name, "geom_name")
+    moving = {j.name for j in hrdf_joints}
+    kept = []
+    for line, (follower, leader) in zip(mimic_eq, mimic_pairs, strict=True):
+        if leader in moving:
+            kept.append(line)
+        else:
+            rep.warn(
+                f"mimic of joint '{leader}' dropped: no moving joint of that name",
+                f'<joint name="{follower}">',
+            )
+    mimic_eq = kept
+    extra = None
+    if mimic_eq:
+        extra = "<mujoco>\n  <equality>\n" + "\n".join(mimic_eq) + "\n  </equality>\n</mujoco>\n"
+    hrdf = HRDF(
+        name=root.get("name") or path.stem,
+        bodies=hrdf_bodies,
+        joints=hrdf_joints,
+        actuators=actuators,
+        meshes=geoms_mesh,
+        simple_geoms=geoms_simple,
+        sites=sites,
+        meta=Meta(simulator_config=None, body_name_config=None),
+        mjcf_extra=extra,
+        root_dir=reader.store.root,
+    )
+    warnings = rep.finish(strict)
+    return ParseResult(hrdf, warnings, str(path))
+
+
+def _replace_name(g, name: str, field_name: str):
+    from dataclasses import replace
+
+    return replace(g, **{field_name: name})
