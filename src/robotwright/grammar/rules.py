@@ -84,6 +84,12 @@ class Grammar:
     source: str = "<memory>"
     _cache: dict = field(default_factory=dict, compare=False, repr=False)
 
+    def __getstate__(self) -> dict:
+        # Caches are rebuilt on demand; leaving them out keeps worker pickles small.
+        state = dict(self.__dict__)
+        state["_cache"] = {}
+        return state
+
     @property
     def start_state(self) -> NodeState:
         return NodeState(self.start, True, False)

@@ -77,7 +77,9 @@ class _Evaluator:
                 todo.append(d)
                 seen.add(h)
         assert self.executor is not None
-        for d, ev in zip(todo, self.executor.map(self.fn, todo, chunksize=max(1, len(todo) // 32))):
+        # A few chunks per worker: fewer pickles of the grammar, still balanced.
+        chunk = max(1, len(todo) // (4 * (self.workers or os.cpu_count() or 1)))
+        for d, ev in zip(todo, self.executor.map(self.fn, todo, chunksize=chunk)):
             self.cache[d.hash()] = ev
             self.order.append(ev)
         return [self.cache.get(d.hash()) for d in designs]
