@@ -6,12 +6,13 @@ adds the HRDF input: ``load(hrdf)``, ``from_hrdf``, ``from_hrdf_path``, ``from_r
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any, TypeVar
 
 from robotwright.errors import GeneratorError, HRDFError
 from robotwright.generators.base import GeneratorBase
-from robotwright.hrdf.model import HRDF
+from robotwright.hrdf.model import HRDF, MeshGeom
 
 T = TypeVar("T", bound="HRDFMixin")
 
@@ -30,6 +31,7 @@ class HRDFMixin:
             raise TypeError(f"{type(self).__name__}: HRDFMixin needs a GeneratorBase subclass")
         super().__init__(**kwargs)
         self.hrdf = None
+        self._mesh_abs: dict[tuple[str | None, str], Path] = {}
 
     def _load(self, hrdf: HRDF | None = None, **kwargs: Any) -> None:
         """Take ``hrdf`` after checking it (every problem listed in one :class:`HRDFError`)."""
@@ -48,6 +50,7 @@ class HRDFMixin:
         if errors:
             raise HRDFError(errors, f"robot '{hrdf.name}' cannot be generated")
         self.hrdf = hrdf
+        self._mesh_abs = {}
         self._on_hrdf_loaded(hrdf)
 
     def _on_hrdf_loaded(self, hrdf: HRDF) -> None:
@@ -55,6 +58,24 @@ class HRDFMixin:
 
     def _clean(self) -> None:
         self.hrdf = None
+        self._mesh_abs = {}
+
+    def mesh_abspath(self, mesh: MeshGeom) -> Path:
+        """Absolute path of a mesh geom's file (normalised, cached per load)."""
+        key = (mesh.file, mesh.name)
+        path = self._mesh_abs.get(key)
+        if path is None:
+            path = Path(os.path.abspath(self.loaded_hrdf.mesh_path(mesh)))
+            self._mesh_abs[key] = path
+        return path
+
+    def mesh_sources(self) -> list[tuple[str, Path]]:
+        """``(robot name, absolute path)`` of each distinct mesh file."""
+        hrdf = self.loaded_hrdf
+        seen: dict[Path, None] = {}
+        for m in hrdf.meshes:
+            seen.setdefault(self.mesh_abspath(m), None)
+        return [(hrdf.name, p) for p in seen]
 
     @property
     def loaded_hrdf(self) -> HRDF:

@@ -119,13 +119,6 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
     def _model_name(self) -> str:
         return self.hrdf.name if self.hrdf is not None else "robot"
 
-    def mesh_sources(self) -> list[tuple[str, Path]]:
-        hrdf = self.loaded_hrdf
-        seen: dict[Path, None] = {}
-        for m in hrdf.meshes:
-            seen.setdefault(hrdf.mesh_path(m).resolve(), None)
-        return [(hrdf.name, p) for p in seen]
-
     # -- generation ---------------------------------------------------------------------
     def _generate(
         self,
@@ -177,7 +170,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         names: list[str] = []
         checked: set[Path] = set()
         for row, m in enumerate(hrdf.meshes):
-            path = hrdf.mesh_path(m).resolve()
+            path = self.mesh_abspath(m)
             if path not in checked:
                 if not path.is_file():
                     raise GeneratorError(

@@ -273,11 +273,15 @@ class MJCFGeneratorBase(GeneratorBase):
         meshes = [] if asset is None else [m for m in asset.findall("mesh") if m.get("file")]
         if not meshes:
             return
-        paths = [self._mesh_file(Path(m.get("file", ""))) for m in meshes]
-        common = Path(os.path.commonpath([p.parent for p in paths]))
-        for elem, path in zip(meshes, paths, strict=True):
-            elem.set("file", Path(os.path.relpath(path, common)).as_posix())
-        self.get_elem("compiler").set("meshdir", self._reference(common, relative))
+        files = [m.get("file", "") for m in meshes]
+        if self._mesh_copy:
+            files = [str(self._mesh_file(Path(f))) for f in files]
+        common = os.path.commonpath({os.path.dirname(f) for f in files})
+        head = common.rstrip("/") + "/"
+        for elem, f in zip(meshes, files, strict=True):
+            rel = f[len(head) :] if f.startswith(head) else os.path.relpath(f, common)
+            elem.set("file", rel.replace(os.sep, "/"))
+        self.get_elem("compiler").set("meshdir", self._reference(Path(common), relative))
 
     def _order_sections(self) -> None:
         """Drop empty top-level sections and put the rest in :data:`SECTION_ORDER`."""

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import replace
-from pathlib import Path
 
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
@@ -75,13 +74,6 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
 
     def _robot_name(self) -> str:
         return self.hrdf.name if self.hrdf is not None else "robot"
-
-    def mesh_sources(self) -> list[tuple[str, Path]]:
-        hrdf = self.loaded_hrdf
-        seen: dict[Path, None] = {}
-        for m in hrdf.meshes:
-            seen.setdefault(hrdf.mesh_path(m).resolve(), None)
-        return [(hrdf.name, p) for p in seen]
 
     def _generate(
         self,
@@ -127,8 +119,12 @@ class _RobotWriter:
         for_mujoco: bool,
         relative: bool,
         losses: list[Problem],
+        robot_gen: URDFHumanoidGenerator | None = None,
     ) -> None:
         self.gen, self.hrdf, self.prefix = gen, hrdf, prefix
+        owner = robot_gen if robot_gen is not None else gen
+        assert isinstance(owner, URDFHumanoidGenerator)
+        self.mesh_path = owner.mesh_abspath
         self.for_mujoco, self.relative, self.losses = for_mujoco, relative, losses
         self.materials: dict[tuple[float, ...], str] = {}
 
@@ -464,7 +460,7 @@ class _RobotWriter:
         pos = _sub(g.pos, off)
         name = g.geom_name
         if isinstance(g, MeshGeom):
-            path = self.gen._mesh_file(self.hrdf.mesh_path(g).resolve())
+            path = self.gen._mesh_file(self.mesh_path(g))
             attrs = {"filename": self.gen._reference(path, self.relative)}
             if g.scale != (1.0, 1.0, 1.0):
                 attrs["scale"] = fmt_vec(g.scale)

@@ -9,14 +9,17 @@ always gives the same bytes.
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
+from functools import lru_cache
 from pathlib import Path
 
 XML_HEADER = '<?xml version="1.0" encoding="utf-8"?>\n'
 
 
+@lru_cache(maxsize=1 << 16)
 def fmt_float(value: float) -> str:
     """Shortest exact text for ``value`` (``1.0`` -> ``"1"``, ``-0.0`` -> ``"0"``)."""
     v = float(value)
@@ -28,9 +31,16 @@ def fmt_float(value: float) -> str:
     return text
 
 
+@lru_cache(maxsize=1 << 14)
+def _fmt_tuple(values: tuple[float, ...]) -> str:
+    return " ".join([fmt_float(v) for v in values])
+
+
 def fmt_vec(values: Iterable[float]) -> str:
     """Space-separated :func:`fmt_float` values."""
-    return " ".join(fmt_float(v) for v in values)
+    if type(values) is tuple:
+        return _fmt_tuple(values)
+    return " ".join([fmt_float(v) for v in values])
 
 
 def prefixed(prefix: str | None, name: str) -> str:
@@ -38,10 +48,58 @@ def prefixed(prefix: str | None, name: str) -> str:
     return f"{prefix}_{name}" if prefix else name
 
 
+_NEEDS_ESCAPE = re.compile(r'[&<>"\n\r\t]')
+_ESCAPES = {
+    "&": "&amp;",
+    "<": "&lt;",
+    ">": "&gt;",
+    '"': "&quot;",
+    "\n": "&#10;",
+    "\r": "&#13;",
+    "\t": "&#09;",
+}
+
+
+def _attr(value: str) -> str:
+    if _NEEDS_ESCAPE.search(value) is None:
+        return value
+    return _NEEDS_ESCAPE.sub(lambda m: _ESCAPES[m.group(0)], value)
+
+
+def _text(value: str) -> str:
+    return value.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
 def to_xml_string(root: ET.Element) -> str:
-    """The element as an indented document with an XML header (2-space indent)."""
-    ET.indent(root, space="  ", level=0)
-    return XML_HEADER + ET.tostring(root, encoding="unicode") + "\n"
+    """The element as an indented document (2 spaces per level) with an XML header.
+
+    A small serializer for the trees generators build (no namespaces, no mixed content):
+    several times faster than ``ElementTree.tostring`` and byte-stable. Element text is
+    kept; whitespace-only text and tails are replaced by the indentation.
+    """
+    out: list[str] = [XML_HEADER]
+    append = out.append
+
+    def write(el: ET.Element, indent: str) -> None:
+        attrs = "".join([f' {k}="{_attr(v)}"' for k, v in el.attrib.items()])
+        text = el.text if el.text is not None and el.text.strip() else None
+        if len(el) == 0 and text is None:
+            append(f"{indent}<{el.tag}{attrs} />\n")
+            return
+        if len(el) == 0:
+            append(f"{indent}<{el.tag}{attrs}>{_text(text or '')}</{el.tag}>\n")
+            return
+        append(f"{indent}<{el.tag}{attrs}>\n")
+        if text is not None:
+            append(f"{indent}  {_text(text)}\n")
+        child_indent = indent + "  "
+        for child in el:
+            if isinstance(child.tag, str):
+                write(child, child_indent)
+        append(f"{indent}</{el.tag}>\n")
+
+    write(root, "")
+    return "".join(out)
 
 
 def write_text_atomic(path: Path, text: str) -> None:

@@ -1,0 +1,188 @@
+"""Time robotwright's generators against hurodes on the same HRDF, in one run.
+
+Tasks (same robot folder for both tools, output written to a temporary folder):
+
+1. ``load+mjcf``: read the HRDF folder and export MJCF to a file.
+2. ``urdf``: export URDF (robot already loaded).
+3. ``composite``: build a two-robot MJCF composite and export it (robots already loaded).
+
+hurodes runs in its own interpreter (``--hurodes-python``); its robot folder is copied
+under a temporary ``$HURODES_ASSETS_PATH/robots`` because hurodes only reads robots there.
+
+Usage::
+
+    python benchmarks/generators.py --hurodes-python /work/hurodes-venv/bin/python
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+DEFAULT_ROBOT = HERE.parent.parent / "shared" / "fixtures" / "hurodes" / "g1_29"
+
+HURODES_WORKER = r"""
+import contextlib, io, json, sys, time
+from pathlib import Path
+from hurodes import ROBOTS_PATH
+from hurodes.hrdf.hrdf import HRDF
+from hurodes.generators.mjcf_generator.mjcf_humanoid_generator import MJCFHumanoidGenerator
+from hurodes.generators.mjcf_generator.mjcf_generator_composite import MJCFGeneratorComposite
+from hurodes.generators.urdf_generator.urdf_humanoid_generator import URDFHumanoidGenerator
+
+name, out, repeat = sys.argv[1], Path(sys.argv[2]), int(sys.argv[3])
+path = ROBOTS_PATH / name
+times = {"load+mjcf": [], "urdf": [], "composite": []}
+sink = io.StringIO()
+hrdf = HRDF.from_dir(path)
+for _ in range(repeat):
+    with contextlib.redirect_stdout(sink):
+        t = time.perf_counter()
+        MJCFHumanoidGenerator.from_hrdf(HRDF.from_dir(path)).export(out / "h.xml")
+        times["load+mjcf"].append(time.perf_counter() - t)
+        gen = URDFHumanoidGenerator.from_hrdf(hrdf)
+        t = time.perf_counter()
+        gen.export(out / "h.urdf")
+        times["urdf"].append(time.perf_counter() - t)
+        gens = {"a": MJCFHumanoidGenerator.from_hrdf(hrdf), "b": MJCFHumanoidGenerator.from_hrdf(hrdf)}
+        t = time.perf_counter()
+        MJCFGeneratorComposite(gens).export(out / "hc.xml")
+        times["composite"].append(time.perf_counter() - t)
+print(json.dumps(times))
+"""
+
+
+def time_ours(robot: Path, out: Path, repeat: int) -> dict[str, list[float]]:
+    from robotwright.generators import (
+        MJCFGeneratorComposite,
+        MJCFHumanoidGenerator,
+        Placement,
+        URDFHumanoidGenerator,
+    )
+    from robotwright.hrdf import HRDF
+
+    times: dict[str, list[float]] = {"load+mjcf": [], "urdf": [], "composite": []}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        hrdf = HRDF.from_dir(robot)
+        for _ in range(repeat):
+            t = time.perf_counter()
+            MJCFHumanoidGenerator.from_hrdf_path(robot).export(out / "r.xml")
+            times["load+mjcf"].append(time.perf_counter() - t)
+            gen = URDFHumanoidGenerator.from_hrdf(hrdf)
+            t = time.perf_counter()
+            gen.export(out / "r.urdf")
+            times["urdf"].append(time.perf_counter() - t)
+            gens = {
+                "a": MJCFHumanoidGenerator.from_hrdf(hrdf),
+                "b": MJCFHumanoidGenerator.from_hrdf(hrdf),
+            }
+            t = time.perf_counter()
+            MJCFGeneratorComposite(gens, {"b": Placement((1.5, 0.0, 0.0))}).export(out / "rc.xml")
+            times["composite"].append(time.perf_counter() - t)
+    return times
+
+
+def prepare_robot(robot: Path, assets: Path, peak_velocity: float) -> tuple[Path, int]:
+    """Copy ``robot`` to ``assets/robots/<name>`` (where hurodes looks) and fill empty
+    ``peak_velocity`` cells, which hurodes' URDF export cannot do without. Both tools
+    then read this same copy. Returns the copy and the number of cells filled."""
+    import csv
+
+    dst = assets / "robots" / robot.name
+    shutil.copytree(robot, dst, ignore=shutil.ignore_patterns("exported"))
+    table = dst / "actuator.csv"
+    filled = 0
+    if table.is_file():
+        with table.open(newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+            fields = list(rows[0].keys()) if rows else []
+        for row in rows:
+            if "peak_velocity" in row and not row["peak_velocity"]:
+                row["peak_velocity"] = repr(peak_velocity)
+                filled += 1
+        with table.open("w", newline="", encoding="utf-8") as fh:
+            writer = csv.DictWriter(fh, fieldnames=fields, lineterminator="\n")
+            writer.writeheader()
+            writer.writerows(rows)
+    return dst, filled
+
+
+def time_hurodes(
+    python: str, robot: Path, assets: Path, out: Path, repeat: int
+) -> dict[str, list[float]]:
+    if True:
+        env = dict(os.environ, HURODES_ASSETS_PATH=str(assets))
+        proc = subprocess.run(
+            [python, "-c", HURODES_WORKER, robot.name, str(out), str(repeat)],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        if proc.returncode != 0:
+            raise SystemExit(f"hurodes worker failed:\n{proc.stderr}")
+        return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--robot", type=Path, default=DEFAULT_ROBOT, help="HRDF folder")
+    parser.add_argument("--hurodes-python", default=None, help="python of a hurodes venv")
+    parser.add_argument("--repeat", type=int, default=30)
+    parser.add_argument(
+        "--peak-velocity",
+        type=float,
+        default=30.0,
+        help="rad/s written into empty peak_velocity cells of the benchmark copy",
+    )
+    parser.add_argument(
+        "--out-dir",
+        type=Path,
+        default=Path("/dev/shm") if Path("/dev/shm").is_dir() else None,
+        help="where both tools write their files (default: /dev/shm when present, so the "
+        "disk's write latency, the same for both, does not hide the generators' time)",
+    )
+    args = parser.parse_args(argv)
+    robot = args.robot.resolve()
+    if not (robot / "meta.yaml").is_file():
+        raise SystemExit(f"{robot}: not an HRDF folder")
+    with tempfile.TemporaryDirectory(dir=args.out_dir) as tmp:
+        out = Path(tmp)
+        copy, filled = prepare_robot(robot, out / "assets", args.peak_velocity)
+        ours = time_ours(copy, out, args.repeat)
+        theirs = None
+        if args.hurodes_python:
+            theirs = time_hurodes(args.hurodes_python, copy, out / "assets", out, args.repeat)
+    print(f"robot: {robot}  repeats: {args.repeat}  python: {sys.version.split()[0]}")
+    print(f"output folder: {tmp} (medians of wall time per task)")
+    if filled:
+        print(
+            f"note: {filled} empty peak_velocity cell(s) set to {args.peak_velocity} rad/s "
+            "in the copy both tools read (hurodes' URDF export needs them)"
+        )
+    header = f"{'task':<12} {'robotwright ms':>15} {'hurodes ms':>12} {'speed-up':>9}"
+    print(header)
+    print("-" * len(header))
+    for task, values in ours.items():
+        mine = statistics.median(values) * 1e3
+        if theirs is None:
+            print(f"{task:<12} {mine:>15.2f} {'-':>12} {'-':>9}")
+            continue
+        other = statistics.median(theirs[task]) * 1e3
+        print(f"{task:<12} {mine:>15.2f} {other:>12.2f} {other / mine:>8.1f}x")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
