@@ -13,7 +13,9 @@ Contenders, timed per frame on the same poses and directions:
   robotwright warp      engine "warp" (mujoco-warp BVH; CPU device here, CUDA when present)
   mujoco-lidar cpu/warp MjLidarWrapper backends, when the package is installed (no labels)
 
-Prints medians of --repeats frames and the ratios to raw mj_multiRay.
+Contenders run interleaved (one frame each, in turn) so load from other processes hits
+them alike; prints medians of --repeats frames, the ratio to raw mj_multiRay and the
+fraction of rays that hit something within 40 m (a check that all do the same work).
 Run: python benchmarks/lidar.py [--repeats 7] [--envs 1 16] [--scenes plane hfield]
 """
 
@@ -104,18 +106,8 @@ def make_envs(model: mujoco.MjModel, n: int) -> list[mujoco.MjData]:
     return datas
 
 
-def median_time(fn, repeats: int) -> float:
-    fn()  # warm-up (JIT compile, caches)
-    fn()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
-
-
-def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float]]:
+def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float, float]]:
+    """(label, median seconds per frame, fraction of rays that hit) for every contender."""
     model = build_scene(kind)
     datas = make_envs(model, num_envs)
     pattern = LivoxPatternCfg(num_rays=NUM_RAYS)
@@ -125,28 +117,45 @@ def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float
     world_dirs = [
         np.ascontiguousarray(dirs_s @ d.site_xmat[site].reshape(3, 3).T).ravel() for d in datas
     ]
-    geomid = np.empty(NUM_RAYS, dtype=np.int32)
-    dist = np.empty(NUM_RAYS)
+    raw_ids = np.empty((num_envs, NUM_RAYS), dtype=np.int32)
+    raw_dist = np.empty((num_envs, NUM_RAYS))
 
-    def raw() -> None:
-        for d, v in zip(datas, world_dirs, strict=True):
+    def raw() -> float:
+        for e, (d, v) in enumerate(zip(datas, world_dirs, strict=True)):
             mujoco.mj_multiRay(
-                model, d, d.site_xpos[site], v, None, 1, robot, geomid, dist, None, NUM_RAYS, 40.0
+                model,
+                d,
+                d.site_xpos[site],
+                v,
+                None,
+                1,
+                robot,
+                raw_ids[e],
+                raw_dist[e],
+                None,
+                NUM_RAYS,
+                40.0,
             )
+        return float(((raw_ids >= 0) & (raw_dist <= 40.0)).mean())
 
-    results = [("raw mj_multiRay (1 thread, no labels)", median_time(raw, repeats))]
+    contenders = [("raw mj_multiRay (1 thread, no labels)", raw)]
     common = dict(prim_path="lidar", pattern_cfg=pattern, max_distance=40.0, return_mesh_ids=True)
     ncpu = os.cpu_count() or 1
-    for label, extra in [
-        ("robotwright mujoco, 1 thread, labels", dict(engine="mujoco", num_threads=1)),
-        (f"robotwright mujoco, {ncpu} threads, labels", dict(engine="mujoco", num_threads=ncpu)),
-    ]:
-        sensor = SemanticLidarSensor(SemanticLidarCfg(**common, **extra), model, datas)
-        results.append((label, median_time(sensor.update, repeats)))
+    engines = [("mujoco, 1 thread", dict(engine="mujoco", num_threads=1))]
+    engines.append((f"mujoco, {ncpu} threads", dict(engine="mujoco", num_threads=ncpu)))
     if warp_available():
-        sensor = SemanticLidarSensor(SemanticLidarCfg(**common, engine="warp"), model, datas)
-        dev = sensor._engine.device
-        results.append((f"robotwright warp ({dev}), labels", median_time(sensor.update, repeats)))
+        engines.append(("warp", dict(engine="warp")))
+    for label, extra in engines:
+        sensor = SemanticLidarSensor(SemanticLidarCfg(**common, **extra), model, datas)
+        if extra["engine"] == "warp":
+            label = f"warp ({sensor._engine.device})"
+
+        def ours(sensor: SemanticLidarSensor = sensor) -> float:
+            sensor.update()
+            sensor.get_semantic_labels()
+            return float(sensor.data.hit_mask.mean())
+
+        contenders.append((f"robotwright {label}, labels", ours))
     try:
         from mujoco_lidar import MjLidarWrapper
     except ImportError:
@@ -159,29 +168,36 @@ def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float
             model, "lidar", backend="cpu", cutoff_dist=40.0, args={"bodyexclude": robot}
         )
 
-        def ml_cpu() -> None:
-            for d in datas:
-                cpu.trace_rays(d, theta, phi)
+        def ml_cpu() -> float:
+            hits = [cpu.trace_rays(d, theta, phi) >= 0 for d in datas]
+            return float(np.mean(hits))
 
-        results.append(("mujoco-lidar cpu (no labels)", median_time(ml_cpu, repeats)))
+        contenders.append(("mujoco-lidar cpu (no labels)", ml_cpu))
         if warp_available():
-            wrp = MjLidarWrapper(
-                model,
-                "lidar",
-                backend="warp",
-                cutoff_dist=40.0,
-                args={"bodyexclude": robot, "device": "cpu"},
-            )
+            args = {"bodyexclude": robot, "device": "cpu"}
+            wrp = MjLidarWrapper(model, "lidar", backend="warp", cutoff_dist=40.0, args=args)
             xpos = np.stack([d.geom_xpos for d in datas])
             xmat = np.stack([d.geom_xmat for d in datas])
             spos = np.stack([d.site_xpos[site] for d in datas])
             srot = np.stack([d.site_xmat[site].reshape(3, 3) for d in datas])
 
-            def ml_warp() -> None:
-                wrp.trace_rays_batch(xpos, xmat, spos, srot, theta, phi)
+            def ml_warp() -> float:
+                dist, _ = wrp.trace_rays_batch(xpos, xmat, spos, srot, theta, phi)
+                return float(((dist > 0) & (dist < 40.0)).mean())
 
-            results.append(("mujoco-lidar warp (cpu, no labels)", median_time(ml_warp, repeats)))
-    return results
+            contenders.append(("mujoco-lidar warp (cpu, no labels)", ml_warp))
+    hits = {}
+    for label, fn in contenders:  # warm-up: JIT compile, caches
+        fn()
+        hits[label] = fn()
+    # Interleave the contenders so that load from other processes hits them alike.
+    times: dict[str, list[float]] = {label: [] for label, _ in contenders}
+    for _ in range(repeats):
+        for label, fn in contenders:
+            t0 = time.perf_counter()
+            fn()
+            times[label].append(time.perf_counter() - t0)
+    return [(label, statistics.median(times[label]), hits[label]) for label, _ in contenders]
 
 
 def main() -> None:
@@ -192,19 +208,20 @@ def main() -> None:
     ap.add_argument("--envs", type=int, nargs="+", default=[1, 16])
     ap.add_argument("--scenes", nargs="+", default=["plane", "hfield"], choices=["plane", "hfield"])
     args = ap.parse_args()
-    print(
-        f"mujoco {mujoco.__version__}, {os.cpu_count()} CPU cores, {NUM_RAYS} rays per frame per env"
-    )
+    print(f"mujoco {mujoco.__version__}, {os.cpu_count()} CPU cores, {NUM_RAYS} rays/frame/env")
+    print(f"load average before: {os.getloadavg()[0]:.2f}")
     for kind in args.scenes:
         for n in args.envs:
             print(f"\nscene={kind} envs={n}  (median of {args.repeats} frames)")
             results = bench_scene(kind, n, args.repeats)
             base = results[0][1]
-            for label, t in results:
+            for label, t, hit in results:
                 mrays = n * NUM_RAYS / t / 1e6
                 print(
-                    f"  {label:45s} {t * 1e3:9.2f} ms/frame {mrays:8.2f} Mrays/s  x{base / t:5.2f} vs raw"
+                    f"  {label:40s} {t * 1e3:9.2f} ms/frame {mrays:7.2f} Mrays/s"
+                    f"  x{base / t:6.2f} vs raw  hits {hit:6.1%}"
                 )
+    print(f"\nload average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
