@@ -228,3 +228,12 @@ class Ref(AttrType):
 
     def equal(self, a: Any, b: Any) -> bool:
         return a is b if not isinstance(a, str) else a == b
+
+
+class Extras(AttrType):
+    """A dict of Python-side data a Thing carries (copied deeply, never written to MJCF)."""
+
+    def convert(self, value: Any, owner: Any, name: str) -> Any:
+        if not isinstance(value, dict):
+            raise self.fail(owner, name, value, "a dict")
+        return value

@@ -36,7 +36,7 @@ import copy as _copy
 from collections.abc import Iterator
 from typing import Any, ClassVar
 
-from robotwright.things.attrs import Ref, Text, ThingAttributeError
+from robotwright.things.attrs import Extras, Ref, Text, ThingAttributeError
 from robotwright.things.registry import REGISTRY, next_version
 
 _REGISTRIES: tuple[tuple[str, str, str | None, type], ...] = (
@@ -74,6 +74,8 @@ class BaseThing(metaclass=ThingType):
     Args:
         name: the user's name. It may be enumerated to resolve clashes (see module doc).
         parent: a Thing to attach to right away.
+        extras: (keyword) a dict of Python-side data carried along and copied deeply,
+            never written to MJCF (the HRDF bridge keeps HRDF-only columns there).
         **kwargs: values for any attribute in ``_BLUEPRINT_ATTR``; unknown names raise
             ``TypeError`` (a misspelt attribute is never silently ignored).
     """
@@ -89,7 +91,7 @@ class BaseThing(metaclass=ThingType):
     #: Namespaces this Thing may be attached to (empty: any that accepts its kind).
     _TARGET_KINDS: ClassVar[frozenset[str]] = frozenset()
 
-    _NEW_BLUEPRINTS_ATTR: ClassVar[dict[str, Any]] = {"name": Text()}
+    _NEW_BLUEPRINTS_ATTR: ClassVar[dict[str, Any]] = {"name": Text(), "extras": Extras()}
     _NEW_NO_COPY_VALS: ClassVar[set[str]] = set()
 
     _MUJOCO_ATTR: ClassVar[dict[str, Any]]
@@ -118,6 +120,8 @@ class BaseThing(metaclass=ThingType):
             defaults = cls._init_defaults()
         # Validated defaults are immutable (read-only arrays), so instances may share them.
         state.update(defaults)
+        # Python-side data (e.g. HRDF columns MuJoCo has no field for); never in MJCF.
+        state["extras"] = {}
         attrs = cls._MUJOCO_ATTR
         for key, value in kwargs.items():
             spec = attrs.get(key)
