@@ -7,7 +7,7 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from lidar_scenes import RaysPattern, forward, random_envs
+from lidar_scenes import ANALYTIC_XML, RaysPattern, forward, random_envs
 
 from robotwright.errors import SensorError
 from robotwright.sensors import GridPatternCfg, LidarCfg, LidarSensor, LivoxPatternCfg
@@ -277,3 +277,30 @@ def test_env_ids_out_of_range(analytic_model):
 def test_data_from_another_model_is_rejected(analytic_model, clutter_model):
     with pytest.raises(SensorError, match="expected an MjData of this model"):
         LidarSensor(LidarCfg(prim_path="lidar_site"), analytic_model, forward(clutter_model)[0])
+
+
+def test_threads_split_envs_and_chunks_identically(clutter_model):
+    datas = random_envs(clutter_model, 3, seed=5)
+    pattern = LivoxPatternCfg(num_rays=5000)
+    out = []
+    for threads in (1, 2, 4):
+        cfg = LidarCfg(prim_path="lidar", pattern_cfg=pattern, num_threads=threads)
+        s = LidarSensor(cfg, clutter_model, datas)
+        s.update()
+        out.append((s.get_distances(), s._raw_geom_ids.copy()))
+    for dist, ids in out[1:]:
+        np.testing.assert_array_equal(dist, out[0][0])
+        np.testing.assert_array_equal(ids, out[0][1])
+
+
+def test_sensor_on_world_body_excludes_nothing():
+    spec = mujoco.MjSpec.from_string(ANALYTIC_XML)
+    spec.worldbody.add_site(name="world_site", pos=[0, 0, 0])
+    model = spec.compile()
+    s = LidarSensor(
+        LidarCfg(prim_path="world_site", pattern_cfg=RaysPattern(AXES)), model, forward(model)
+    )
+    assert s.robot_body_ids().size == 0 and s.hittable_geom_mask.all()
+    s.update()
+    # The torso (0.1 m box around the origin) is hit from inside on every ray.
+    np.testing.assert_allclose(s.get_distances()[0], 0.1, atol=1e-9)
