@@ -138,3 +138,21 @@ def test_world_copy_is_independent():
     assert clone.timestep == 0.005 and world.timestep == 0.002
     clone.find("pivot").range = [-1, 1]
     assert world.model.jnt_limited[0] == 0 and clone.model.jnt_limited[0] == 1
+
+
+def test_changing_a_shared_asset_rebuilds_and_shape_helpers_validate():
+    from robotwright.things import Material
+
+    red = Material("paint", rgba=[1, 0, 0, 1])
+    rod = Capsule("rod", radius=0.02, half_length=0.1, material=red)
+    world = World()
+    world.attach(Body("b").attach(rod, rod.copy()))
+    assert world.model.nmat == 1  # copies share the asset object
+    model = world.model
+    red.rgba = [0, 1, 0, 1]
+    assert world.model is not model
+    np.testing.assert_allclose(world.model.mat_rgba[0], [0, 1, 0, 1])
+    rod.half_length = 0.3
+    assert world.model.geom_size[0][1] == pytest.approx(0.3)
+    with pytest.raises(ThingAttributeError, match=r"Capsule 'rod' .*\.size"):
+        rod.radius = -1.0

@@ -23,6 +23,7 @@ from robotwright.things.base import BaseThing, ThingType
 from robotwright.things.body import Body
 from robotwright.things.cameras import Camera
 from robotwright.things.geoms import Box, Capsule, Cylinder, Ellipsoid, Geom, Mesh, Plane, Sphere
+from robotwright.things.hrdf_bridge import hrdf_to_body, hrdf_to_world, things_to_hrdf
 from robotwright.things.joints import Ball, Free, Hinge, Joint, Slide
 from robotwright.things.lights import Light
 from robotwright.things.registry import REGISTRY
@@ -121,4 +122,7 @@ __all__ = [
     "Velocimeter",
     "Velocity",
     "World",
+    "hrdf_to_body",
+    "hrdf_to_world",
+    "things_to_hrdf",
 ]

@@ -2,8 +2,7 @@
 
 Assets are not part of the kinematic tree: geoms and sites refer to them, copies of a
 geom share the same asset object, and the World writes each referenced asset once in
-``<asset>``. Changing an asset after a build does not trigger a rebuild by itself; call
-``world.rebuild()`` (or change anything in the tree).
+``<asset>``. Changing an asset makes every World rebuild on its next use.
 """
 
 from __future__ import annotations

@@ -37,7 +37,7 @@ from collections.abc import Iterator
 from typing import Any, ClassVar
 
 from robotwright.things.attrs import Extras, Ref, Text, ThingAttributeError
-from robotwright.things.registry import REGISTRY, next_version
+from robotwright.things.registry import REGISTRY, bump_asset_epoch, next_version
 
 _REGISTRIES: tuple[tuple[str, str, str | None, type], ...] = (
     ("_MUJOCO_ATTR", "_NEW_MUJOCO_ATTR", "_DEL_MUJOCO_ATTR", dict),
@@ -260,6 +260,8 @@ class BaseThing(metaclass=ThingType):
     def _touch(self) -> None:
         root = self.root
         object.__setattr__(root, "_version", next_version())
+        if getattr(self, "_ASSET_KIND", None):
+            bump_asset_epoch()
 
     # ----------------------------------------------------------------- names
     @property

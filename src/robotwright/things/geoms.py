@@ -114,7 +114,12 @@ class Sphere(Geom):
 
     @property
     def radius(self) -> float:
+        """Radius (m), ``size[0]``."""
         return float(self.size[0])
+
+    @radius.setter
+    def radius(self, value: float) -> None:
+        self.size = [value, *self.size[1:]]
 
 
 class Capsule(Geom):
@@ -133,6 +138,24 @@ class Capsule(Geom):
         if radius is not None or half_length is not None:
             kwargs["size"] = [radius or 0.0, half_length or 0.0, 0.0]
         super().__init__(name=name, parent=parent, **kwargs)
+
+    @property
+    def radius(self) -> float:
+        """Radius (m), ``size[0]``."""
+        return float(self.size[0])
+
+    @radius.setter
+    def radius(self, value: float) -> None:
+        self.size = [value, *self.size[1:]]
+
+    @property
+    def half_length(self) -> float:
+        """Half length of the cylindrical part along local z (m), ``size[1]``."""
+        return float(self.size[1])
+
+    @half_length.setter
+    def half_length(self, value: float) -> None:
+        self.size = [self.size[0], value, self.size[2]]
 
 
 class Cylinder(Capsule):

@@ -40,3 +40,16 @@ _VERSIONS = itertools.count(1)
 
 def next_version() -> int:
     return next(_VERSIONS)
+
+
+# Assets (materials, textures) live outside any tree; a change to one bumps this epoch so
+# every World rebuilds on its next use.
+_ASSET_EPOCH = [0]
+
+
+def bump_asset_epoch() -> None:
+    _ASSET_EPOCH[0] += 1
+
+
+def asset_epoch() -> int:
+    return _ASSET_EPOCH[0]

@@ -14,6 +14,7 @@ import numpy as np
 from robotwright.errors import RobotwrightError
 from robotwright.things.attrs import Choice, Flag, Integer, Real, Vector
 from robotwright.things.base import BaseThing
+from robotwright.things.registry import asset_epoch
 from robotwright.things.xml_writer import write_mjcf
 
 OPTION_ATTR: dict[str, Any] = {
@@ -132,6 +133,7 @@ class World(BaseThing):
         object.__setattr__(self, "extra_xml", dict(kwargs.pop("extra_xml", {})))
         object.__setattr__(self, "_built", None)
         object.__setattr__(self, "_built_version", None)
+        object.__setattr__(self, "_built_epoch", None)
         super().__init__(name=name, parent=parent, **kwargs)
 
     @property
@@ -198,7 +200,7 @@ class World(BaseThing):
 
     def to_xml_string(self) -> str:
         """The MJCF text of this World (files referenced by their paths as stored)."""
-        if self._built is not None and self._built_version == self._version:
+        if not self._stale():
             return self._built_text  # the text the current model was compiled from
         return write_mjcf(self)[0]
 
@@ -266,8 +268,15 @@ class World(BaseThing):
         return world_from_path(path, strict=strict)
 
     # ------------------------------------------------------------------ simulation
+    def _stale(self) -> bool:
+        return (
+            self._built is None
+            or self._built_version != self._version
+            or self._built_epoch != asset_epoch()
+        )
+
     def _ensure_built(self) -> tuple[mujoco.MjModel, mujoco.MjData, dict[int, int]]:
-        if self._built is None or self._built_version != self._version:
+        if self._stale():
             self.rebuild()
         model, data, index = self._built
         if data is None:  # created on first use, so that compiling alone stays cheap
@@ -293,13 +302,14 @@ class World(BaseThing):
                 index[thing_id] = i
         object.__setattr__(self, "_built", (model, None, index))
         object.__setattr__(self, "_built_version", self._version)
+        object.__setattr__(self, "_built_epoch", asset_epoch())
         object.__setattr__(self, "_built_text", text)
         object.__setattr__(self, "_spec", spec)
 
     @property
     def model(self) -> mujoco.MjModel:
         """The compiled ``MjModel`` (rebuilt when the tree changed)."""
-        if self._built is None or self._built_version != self._version:
+        if self._stale():
             self.rebuild()
         return self._built[0]
 
