@@ -18,6 +18,7 @@ from robotwright.errors import RobotwrightError
 _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.hrdf.cli",
     "robotwright.demo",
+    "robotwright.parsers.cli",
     "robotwright.sensors.cli",
     "robotwright.grammar.cli",
     "robotwright.generators.cli",

@@ -98,7 +98,9 @@ class MeshStore:
         if source in self.staged:
             return self.staged[source]
         ext = source.suffix.lower()
-        if ext in MUJOCO_MESH_EXTENSIONS:
+        # MuJoCo reads binary STL only: an ASCII STL is converted like other formats.
+        ascii_stl = ext == ".stl" and stl_face_count(source) is None
+        if ext in MUJOCO_MESH_EXTENSIONS and not ascii_stl:
             name = self._unique(_safe_stem(source), ext)
             dest = self.root / "meshes" / name
             # A hard link costs nothing and, unlike a symlink, resolves inside the

@@ -127,7 +127,8 @@ def compare_views(
     our_frames = set(ours.bodies) | set(ours.sites)
     missing = [b for b in ref.bodies if b not in our_frames]
     as_sites = [b for b in ref.bodies if b not in ours.bodies and b in ours.sites]
-    extra = [b for b in ours.bodies if b not in ref.bodies]
+    # URDF has no sites: our URDF carries each site as a massless link.
+    extra = [b for b in ours.bodies if b not in ref.bodies and b not in ref.sites]
     note = f"{len(as_sites)} as sites" if as_sites else ""
     if missing or extra:
         note = f"missing {missing[:5]} extra {extra[:5]}"
@@ -234,7 +235,7 @@ def compare_views(
             )
 
     # Forward kinematics.
-    names = [b for b in ref.bodies if b in our_frames] + [s for s in ref.sites if s in ours.sites]
+    names = [b for b in ref.bodies if b in our_frames] + [s for s in ref.sites if s in our_frames]
     worst_p = worst_r = 0.0
     unknown = [j.name for j in ref.joints if j.name not in {o.name for o in ours.joints}]
     for q in random_configs(ref, configs, mimic=mimic):

@@ -640,6 +640,13 @@ def parse_urdf(
             new = tuple(max(v, opt.bound_inertia) for v in diag)
             rep.warn(f"principal moments {diag} raised to bound_inertia: {new}", where)
             diag = new
+        if mass <= 0 or min(diag) <= 0:
+            rep.warn(
+                f"massless or zero-inertia body (mass {mass}, moments {diag}): HRDF checks "
+                "need mass > 0 and moments > 0; fixed_joints='merge' folds fixed links into "
+                "their parent, bound_mass/bound_inertia raise them",
+                where,
+            )
         pose = b["pose"]
         hrdf_bodies.append(
             Body(

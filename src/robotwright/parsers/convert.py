@@ -1,0 +1,73 @@
+"""Convert between MJCF, URDF and HRDF folders (type by extension, or folder = HRDF).
+
+Outputs are written atomically by the writers (HRDF folder: all or nothing; MJCF/URDF:
+temporary file then rename) with meshes copied next to the output, so the result loads
+on its own.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from pathlib import Path
+from typing import Any
+
+from robotwright.errors import ConversionError, Problem
+from robotwright.hrdf.model import HRDF
+
+
+def file_kind(path: Path, *, existing: bool) -> str:
+    """``"urdf"``, ``"mjcf"`` or ``"hrdf"`` from the extension (a folder is HRDF)."""
+    ext = path.suffix.lower()
+    if ext == ".urdf":
+        return "urdf"
+    if ext in (".xml", ".mjcf"):
+        return "mjcf"
+    if (existing and path.is_dir()) or (not existing and ext == ""):
+        return "hrdf"
+    raise ConversionError(
+        [Problem(str(path), "expected a .urdf file, a .xml (MJCF) file or an HRDF folder")]
+    )
+
+
+def load_any(path: Path, *, strict: bool = False, **options: Any) -> tuple[HRDF, list[Problem]]:
+    """Read a robot from any supported source; returns it and the parse warnings."""
+    from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
+
+    kind = file_kind(path, existing=True)
+    if kind == "hrdf":
+        return HRDF.from_dir(path), []
+    parse = urdf_to_hrdf_with_warnings if kind == "urdf" else mjcf_to_hrdf_with_warnings
+    result = parse(path, strict=strict, **options)
+    return result.hrdf, result.warnings
+
+
+def convert(
+    src: str | os.PathLike,
+    dst: str | os.PathLike,
+    *,
+    strict: bool = False,
+    overwrite: bool = False,
+    **options: Any,
+) -> list[str]:
+    """Convert ``src`` to ``dst``; returns every warning (parser and writer) as text.
+
+    ``options`` go to the parser (see ``URDFOptions`` / ``MJCFOptions``).
+    """
+    src_p, dst_p = Path(src), Path(dst)
+    out_kind = file_kind(dst_p, existing=False)
+    if dst_p.exists() and not overwrite:
+        raise FileExistsError(f"{dst_p} exists (pass overwrite=True / --overwrite)")
+    hrdf, problems = load_any(src_p, strict=strict, **options)
+    messages = [str(p) for p in problems]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        if out_kind == "hrdf":
+            hrdf.save(dst_p, overwrite=overwrite)
+        else:
+            from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
+
+            gen_cls = MJCFHumanoidGenerator if out_kind == "mjcf" else URDFHumanoidGenerator
+            gen_cls.from_hrdf(hrdf).export(dst_p, copy_meshes=True, strict=strict)
+    messages += [str(w.message) for w in caught]
+    return messages

@@ -1,0 +1,142 @@
+"""Round-trip fidelity on real robots (data installed from PyPI; skipped when absent).
+
+Every example-robot-data URDF is parsed with ``fixed_joints="merge"`` (HRDF needs
+mass > 0 on every body, and URDFs mark frames with massless fixed links; merged links
+stay as sites and their FK is compared), written as our MJCF and URDF and compared with
+MuJoCo's import of the source (or yourdfpy where MuJoCo refuses it). Robots that cannot
+round-trip exactly are strict expected failures with the reason (docs/parsers.md).
+"""
+
+from __future__ import annotations
+
+import logging
+import sysconfig
+from pathlib import Path
+
+import pytest
+
+from robotwright.parsers.roundtrip import roundtrip
+
+pytestmark = pytest.mark.realdata
+logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
+
+ERD = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data/robots"
+PURELIB = Path(sysconfig.get_paths()["purelib"])
+TESTDATA = Path(__file__).resolve().parents[2] / ".testdata/mjlab/mjlab/asset_zoo/robots"
+# Mesh-heavy corpus: 10 configurations per robot keeps the corpus near a minute on
+# 2 cores; tolerances are the same as for 50.
+CORPUS_CONFIGS = 10
+
+HEAVY = "an STL has over 200k faces, which MuJoCo refuses (no decimation applied by default)"
+MASSLESS = "massless or zero-inertia moving link: HRDF requires mass > 0 and inertia > 0"
+EXPECTED_FAILURES: dict[str, str] = {
+    "alex_description/urdf/alex_nub_hands.urdf": "visual mesh 'nub' has too small a volume: MuJoCo refuses to compile it",
+    "alex_description/urdf/alex_psyonic_hands.urdf": "mimic joints name a joint ('index_q1') that does not exist; the mimic is dropped, yourdfpy still couples them",
+    "b1_description/urdf/b1-z1.urdf": HEAVY,
+    "b1_description/urdf/b1.urdf": HEAVY,
+    "go1_description/urdf/go1.urdf": HEAVY,
+    "human_description/robots/human.urdf": MASSLESS,
+    "icub_description/robots/icub.urdf": MASSLESS,
+    "icub_description/robots/icub_reduced.urdf": MASSLESS,
+    "romeo_description/urdf/romeo.urdf": MASSLESS,
+    "romeo_description/urdf/romeo_small.urdf": "non-physical inertia (A + B < C) that HRDF refuses (balance_inertia=True repairs it)",
+    "romeo_description/urdf/romeo_laas_small.urdf": "meshes point to file:///usr/Romeo/..., absent",
+    "ur_description/urdf/ur3.urdf": "the file holds an empty <robot>",
+}
+
+
+def _corpus() -> list:
+    if not ERD.is_dir():
+        return [
+            pytest.param(None, marks=pytest.mark.skip(reason=f"example-robot-data absent: {ERD}"))
+        ]
+    params = []
+    for path in sorted(ERD.rglob("*.urdf")):
+        rel = path.relative_to(ERD).as_posix()
+        marks = []
+        if rel in EXPECTED_FAILURES:
+            marks.append(pytest.mark.xfail(reason=EXPECTED_FAILURES[rel], strict=True))
+        params.append(pytest.param(rel, marks=marks, id=rel))
+    return params
+
+
+@pytest.mark.parametrize("rel", _corpus())
+def test_example_robot_data_roundtrip(rel: str) -> None:
+    report = roundtrip(ERD / rel, configs=CORPUS_CONFIGS, fixed_joints="merge")
+    assert report.ok, report.table()
+
+
+def test_expected_failures_exist() -> None:
+    if not ERD.is_dir():
+        pytest.skip(f"example-robot-data absent: {ERD}")
+    missing = [k for k in EXPECTED_FAILURES if not (ERD / k).is_file()]
+    assert not missing
+
+
+@pytest.mark.parametrize("robot", ["unitree_g1/xmls/g1.xml", "unitree_go1/xmls/go1.xml"])
+def test_mjlab_mjcf_roundtrip(robot: str) -> None:
+    path = TESTDATA / robot
+    if not path.is_file():
+        pytest.skip(f"mjlab data not fetched (python tools/fetch_test_data.py): {path}")
+    report = roundtrip(path, configs=50)
+    assert report.ok, report.table()
+    assert "MJCF: sensors equal (name, type, object)" in report.table()
+
+
+DM = PURELIB / "dm_control" / "suite"
+DM_EXPECTED = {
+    "fish.xml": "a tendon-driven actuator: HRDF actuators drive joints only",
+    "point_mass.xml": "tendon-driven actuators: HRDF actuators drive joints only",
+    "swimmer.xml": "a sensor reads a site of a body outside the robot (dropped)",
+    "ball_in_cup.xml": "a tendon ties the cup to the ball, which is not part of the robot",
+    "dog.xml": "keyframes hold the ball's qpos too (the ball is not part of the robot)",
+    "finger.xml": "sensors read the spinner/target outside the robot (dropped)",
+    "manipulator.xml": "a tendon-driven gripper actuator: HRDF actuators drive joints only",
+    "stacker.xml": "a tendon-driven gripper actuator: HRDF actuators drive joints only",
+    "quadruped.xml": "tendon-driven actuators; URDF: site names equal body names",
+    "cheetah.xml": "URDF: several joints on one body need massless links, which MuJoCo refuses",
+    "hopper.xml": "URDF: several joints on one body need massless links, which MuJoCo refuses",
+    "walker.xml": "URDF: several joints on one body need massless links, which MuJoCo refuses",
+    "humanoid.xml": "URDF: site names equal body names (URDF writes sites as links)",
+    "humanoid_CMU.xml": "URDF: site 'root' equals a body name (URDF writes sites as links)",
+}
+DM_ROOT = {
+    "ball_in_cup.xml": "cup",
+    "dog.xml": "torso",
+    "finger.xml": "proximal",
+    "manipulator.xml": "upper_arm",
+    "quadruped.xml": "torso",
+    "stacker.xml": "upper_arm",
+}
+
+
+def _dm() -> list:
+    if not DM.is_dir():
+        return [pytest.param(None, marks=pytest.mark.skip(reason=f"dm_control absent: {DM}"))]
+    out = []
+    for p in sorted(DM.glob("*.xml")):
+        if p.name == "lqr.xml":  # generated at run time, the file holds no body
+            continue
+        marks = (
+            [pytest.mark.xfail(reason=DM_EXPECTED[p.name], strict=True)]
+            if p.name in DM_EXPECTED
+            else []
+        )
+        out.append(pytest.param(p.name, marks=marks, id=p.name))
+    return out
+
+
+@pytest.mark.parametrize("name", _dm())
+def test_dm_control_suite_roundtrip(name: str) -> None:
+    opts = {"root_body": DM_ROOT[name]} if name in DM_ROOT else {}
+    report = roundtrip(DM / name, configs=20, **opts)
+    assert report.ok, report.table()
+
+
+def test_jvrc_dae_meshes_roundtrip() -> None:
+    path = PURELIB / "jvrc_description" / "urdf" / "jvrc1.urdf"
+    if not path.is_file():
+        pytest.skip(f"jvrc-description absent: {path}")
+    report = roundtrip(path, configs=20, fixed_joints="merge")
+    assert report.ok, report.table()
+    assert any("converted to STL" in w for w in report.warnings)
