@@ -22,7 +22,7 @@ class ThingAttributeError(RobotwrightError, ValueError):
 
 def fmt_float(value: float) -> str:
     """Shortest text that reads back as the same float (``1.0`` -> ``"1"``)."""
-    text = repr(float(value))
+    text = repr(value if type(value) is float else float(value))
     if text.endswith(".0"):
         text = text[:-2]
     return "0" if text == "-0" else text
@@ -196,16 +196,15 @@ class Vector(AttrType):
                 vals.pop()
         if self.integer:
             return " ".join(str(int(v)) for v in vals)
-        return " ".join(fmt_float(v) for v in vals)
+        return " ".join(map(fmt_float, np.asarray(vals, dtype=float).tolist()))
 
     def equal(self, a: Any, b: Any) -> bool:
         if a is None or b is None:
             return a is b
         if a.shape != b.shape:
             return False
-        if a.dtype == b.dtype:
-            return a.tobytes() == b.tobytes() or bool(np.array_equal(a, b))
-        return bool(np.array_equal(a, b))
+        # Small vectors: comparing Python lists is much cheaper than numpy calls.
+        return bool(a.tolist() == b.tolist())
 
 
 class Ref(AttrType):

@@ -216,7 +216,7 @@ class BaseThing(metaclass=ThingType):
                     f"{self._label()}.attach: a {type(thing).__name__} measures or drives a "
                     f"{' or '.join(sorted(thing._TARGET_KINDS))}, not a {type(self).__name__}"
                 )
-            if thing is self or self in thing.walk():
+            if any(node is thing for node in self.path):
                 raise ThingAttributeError(
                     f"{self._label()}.attach: {thing._label()} is this Thing or one of its "
                     "ancestors; attaching it would make a cycle"

@@ -80,8 +80,10 @@ class _Writer:
         requested: list[BaseThing] = list(getattr(self.root, "assets", []))
         seen = {a.ID for a in requested}
         mesh_keys: list[tuple[tuple, str]] = []
+        mesh_things: list[BaseThing] = []
         for thing in self.root.walk():
             if isinstance(thing, Mesh):
+                mesh_things.append(thing)
                 key = tuple(
                     (k, _hashable(getattr(thing, k))) for k in Mesh._ASSET_ATTR if k != "mesh"
                 )
@@ -114,9 +116,8 @@ class _Writer:
                 self.mesh_assets[key] = unique_meshes[ident]
         self.mesh_of_geom = {gid: unique_meshes[ident] for gid, ident in self.mesh_of_geom.items()}
         self._mesh_geoms: dict[str, BaseThing] = {}
-        for thing in self.root.walk():
-            if isinstance(thing, Mesh):
-                self._mesh_geoms.setdefault(self.mesh_of_geom[thing.ID], thing)
+        for geom in mesh_things:
+            self._mesh_geoms.setdefault(self.mesh_of_geom[geom.ID], geom)
 
     def write_assets(self) -> None:
         from robotwright.things.geoms import Mesh
