@@ -17,7 +17,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shutil
 import statistics
@@ -26,13 +25,15 @@ import sys
 import tempfile
 import time
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 DEFAULT_ROBOT = HERE.parent.parent / "shared" / "fixtures" / "hurodes" / "g1_29"
 
 HURODES_WORKER = r"""
-import contextlib, io, json, sys, time
+import contextlib, io, sys, time
+from collections.abc import Callable
 from pathlib import Path
 from hurodes import ROBOTS_PATH
 from hurodes.hrdf.hrdf import HRDF
@@ -40,29 +41,36 @@ from hurodes.generators.mjcf_generator.mjcf_humanoid_generator import MJCFHumano
 from hurodes.generators.mjcf_generator.mjcf_generator_composite import MJCFGeneratorComposite
 from hurodes.generators.urdf_generator.urdf_humanoid_generator import URDFHumanoidGenerator
 
-name, out, repeat = sys.argv[1], Path(sys.argv[2]), int(sys.argv[3])
+name, out = sys.argv[1], Path(sys.argv[2])
 path = ROBOTS_PATH / name
-times = {"load+mjcf": [], "urdf": [], "composite": []}
-sink = io.StringIO()
 hrdf = HRDF.from_dir(path)
-for _ in range(repeat):
+sink = io.StringIO()
+
+def load_mjcf():
+    MJCFHumanoidGenerator.from_hrdf(HRDF.from_dir(path)).export(out / "h.xml")
+
+urdf_gen = URDFHumanoidGenerator.from_hrdf(hrdf)
+def urdf():
+    urdf_gen.export(out / "h.urdf")
+
+def composite():
+    gens = {"a": MJCFHumanoidGenerator.from_hrdf(hrdf), "b": MJCFHumanoidGenerator.from_hrdf(hrdf)}
+    MJCFGeneratorComposite(gens).export(out / "hc.xml")
+
+tasks = {"load+mjcf": load_mjcf, "urdf": urdf, "composite": composite}
+print("ready", flush=True)
+for line in sys.stdin:
+    task = line.strip()
     with contextlib.redirect_stdout(sink):
         t = time.perf_counter()
-        MJCFHumanoidGenerator.from_hrdf(HRDF.from_dir(path)).export(out / "h.xml")
-        times["load+mjcf"].append(time.perf_counter() - t)
-        gen = URDFHumanoidGenerator.from_hrdf(hrdf)
-        t = time.perf_counter()
-        gen.export(out / "h.urdf")
-        times["urdf"].append(time.perf_counter() - t)
-        gens = {"a": MJCFHumanoidGenerator.from_hrdf(hrdf), "b": MJCFHumanoidGenerator.from_hrdf(hrdf)}
-        t = time.perf_counter()
-        MJCFGeneratorComposite(gens).export(out / "hc.xml")
-        times["composite"].append(time.perf_counter() - t)
-print(json.dumps(times))
+        tasks[task]()
+        dt = time.perf_counter() - t
+    print(repr(dt), flush=True)
 """
 
 
-def time_ours(robot: Path, out: Path, repeat: int) -> dict[str, list[float]]:
+def our_tasks(robot: Path, out: Path) -> dict[str, Callable[[], object]]:
+    """The three tasks on our side, as callables."""
     from robotwright.generators import (
         MJCFGeneratorComposite,
         MJCFHumanoidGenerator,
@@ -71,26 +79,23 @@ def time_ours(robot: Path, out: Path, repeat: int) -> dict[str, list[float]]:
     )
     from robotwright.hrdf import HRDF
 
-    times: dict[str, list[float]] = {"load+mjcf": [], "urdf": [], "composite": []}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        hrdf = HRDF.from_dir(robot)
-        for _ in range(repeat):
-            t = time.perf_counter()
-            MJCFHumanoidGenerator.from_hrdf_path(robot).export(out / "r.xml")
-            times["load+mjcf"].append(time.perf_counter() - t)
-            gen = URDFHumanoidGenerator.from_hrdf(hrdf)
-            t = time.perf_counter()
-            gen.export(out / "r.urdf")
-            times["urdf"].append(time.perf_counter() - t)
-            gens = {
-                "a": MJCFHumanoidGenerator.from_hrdf(hrdf),
-                "b": MJCFHumanoidGenerator.from_hrdf(hrdf),
-            }
-            t = time.perf_counter()
-            MJCFGeneratorComposite(gens, {"b": Placement((1.5, 0.0, 0.0))}).export(out / "rc.xml")
-            times["composite"].append(time.perf_counter() - t)
-    return times
+    hrdf = HRDF.from_dir(robot)
+    urdf_gen = URDFHumanoidGenerator.from_hrdf(hrdf)
+
+    def composite() -> object:
+        gens = {
+            "a": MJCFHumanoidGenerator.from_hrdf(hrdf),
+            "b": MJCFHumanoidGenerator.from_hrdf(hrdf),
+        }
+        return MJCFGeneratorComposite(gens, {"b": Placement((1.5, 0.0, 0.0))}).export(
+            out / "rc.xml"
+        )
+
+    return {
+        "load+mjcf": lambda: MJCFHumanoidGenerator.from_hrdf_path(robot).export(out / "r.xml"),
+        "urdf": lambda: urdf_gen.export(out / "r.urdf"),
+        "composite": composite,
+    }
 
 
 def prepare_robot(robot: Path, assets: Path, peak_velocity: float) -> tuple[Path, int]:
@@ -118,21 +123,41 @@ def prepare_robot(robot: Path, assets: Path, peak_velocity: float) -> tuple[Path
     return dst, filled
 
 
-def time_hurodes(
-    python: str, robot: Path, assets: Path, out: Path, repeat: int
-) -> dict[str, list[float]]:
-    if True:
+class HurodesWorker:
+    """hurodes in its own interpreter, timing one task per request (same process
+    throughout, so imports and caches are warm as on our side)."""
+
+    def __init__(self, python: str, robot: Path, assets: Path, out: Path) -> None:
         env = dict(os.environ, HURODES_ASSETS_PATH=str(assets))
-        proc = subprocess.run(
-            [python, "-c", HURODES_WORKER, robot.name, str(out), str(repeat)],
+        self.proc = subprocess.Popen(
+            [python, "-c", HURODES_WORKER, robot.name, str(out)],
             env=env,
-            capture_output=True,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
             text=True,
-            check=False,
         )
-        if proc.returncode != 0:
-            raise SystemExit(f"hurodes worker failed:\n{proc.stderr}")
-        return json.loads(proc.stdout.strip().splitlines()[-1])
+        assert self.proc.stdout is not None and self.proc.stdin is not None
+        if self.proc.stdout.readline().strip() != "ready":
+            raise SystemExit(
+                f"hurodes worker failed:\n{self.proc.stderr.read() if self.proc.stderr else ''}"
+            )
+
+    def time(self, task: str) -> float:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(task + "\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline()
+        if not line:
+            raise SystemExit(
+                f"hurodes worker died:\n{self.proc.stderr.read() if self.proc.stderr else ''}"
+            )
+        return float(line)
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=30)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -157,13 +182,31 @@ def main(argv: list[str] | None = None) -> int:
     robot = args.robot.resolve()
     if not (robot / "meta.yaml").is_file():
         raise SystemExit(f"{robot}: not an HRDF folder")
+    ours: dict[str, list[float]] = {}
+    theirs: dict[str, list[float]] | None = {} if args.hurodes_python else None
     with tempfile.TemporaryDirectory(dir=args.out_dir) as tmp:
         out = Path(tmp)
         copy, filled = prepare_robot(robot, out / "assets", args.peak_velocity)
-        ours = time_ours(copy, out, args.repeat)
-        theirs = None
-        if args.hurodes_python:
-            theirs = time_hurodes(args.hurodes_python, copy, out / "assets", out, args.repeat)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            tasks = our_tasks(copy, out)
+            worker = (
+                HurodesWorker(args.hurodes_python, copy, out / "assets", out)
+                if args.hurodes_python
+                else None
+            )
+            try:
+                # Interleave the two tools task by task, so a busy machine slows both alike.
+                for _ in range(args.repeat):
+                    for task, fn in tasks.items():
+                        t = time.perf_counter()
+                        fn()
+                        ours.setdefault(task, []).append(time.perf_counter() - t)
+                        if worker is not None and theirs is not None:
+                            theirs.setdefault(task, []).append(worker.time(task))
+            finally:
+                if worker is not None:
+                    worker.close()
     print(f"robot: {robot}  repeats: {args.repeat}  python: {sys.version.split()[0]}")
     print(f"output folder: {tmp} (medians of wall time per task)")
     if filled:

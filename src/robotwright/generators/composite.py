@@ -249,7 +249,11 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
         robots: list[_Robot] = []
         for key, gen in self.generators.items():
             child_prefix = prefixed(prefix, key) if use_keys_as_prefix else prefix
-            gen.generate(prefix=child_prefix, add_scene=False, relative_mesh_path=False)
+            gen._check_names = False
+            try:
+                gen.generate(prefix=child_prefix, add_scene=False, relative_mesh_path=False)
+            finally:
+                gen._check_names = True
             robots.append(_Robot(key, child_prefix, gen.xml_root))
         if self._own_simulator_config is None:
             self.simulator_config = next(

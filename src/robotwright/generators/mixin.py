@@ -33,8 +33,11 @@ class HRDFMixin:
         self.hrdf = None
         self._mesh_abs: dict[tuple[str | None, str], Path] = {}
 
-    def _load(self, hrdf: HRDF | None = None, **kwargs: Any) -> None:
-        """Take ``hrdf`` after checking it (every problem listed in one :class:`HRDFError`)."""
+    def _load(self, hrdf: HRDF | None = None, *, validate: bool = True, **kwargs: Any) -> None:
+        """Take ``hrdf`` after checking it (every problem listed in one :class:`HRDFError`).
+
+        ``validate=False`` skips the check, for a robot that ``HRDF.from_dir`` has just
+        read (it runs the same checks)."""
         if kwargs:
             raise GeneratorError(
                 f"{type(self).__name__}.load(): unexpected argument(s) {sorted(kwargs)}; "
@@ -44,11 +47,12 @@ class HRDFMixin:
             raise GeneratorError(
                 f"{type(self).__name__}.load(): expected an HRDF robot, got {type(hrdf).__name__}"
             )
-        from robotwright.hrdf.validate import check_model
+        if validate:
+            from robotwright.hrdf.validate import check_model
 
-        errors = [p for p in check_model(hrdf, check_files=False) if p.severity == "error"]
-        if errors:
-            raise HRDFError(errors, f"robot '{hrdf.name}' cannot be generated")
+            errors = [p for p in check_model(hrdf, check_files=False) if p.severity == "error"]
+            if errors:
+                raise HRDFError(errors, f"robot '{hrdf.name}' cannot be generated")
         self.hrdf = hrdf
         self._mesh_abs = {}
         self._on_hrdf_loaded(hrdf)
@@ -94,10 +98,14 @@ class HRDFMixin:
     @classmethod
     def from_hrdf_path(cls: type[T], hrdf_path: str | Path, **kwargs: Any) -> T:
         """A generator loaded with the HRDF folder at ``hrdf_path`` (anywhere on disk)."""
-        return cls.from_hrdf(HRDF.from_dir(hrdf_path), **kwargs)
+        instance = cls(**kwargs)
+        instance.load(HRDF.from_dir(hrdf_path), validate=False)  # type: ignore[attr-defined]
+        return instance
 
     @classmethod
     def from_robot_name(cls: type[T], robot_name: str, **kwargs: Any) -> T:
         """A generator loaded with robot ``robot_name``: ``$HURODES_ASSETS_PATH/robots/<name>``,
         then the bundled robots."""
-        return cls.from_hrdf(HRDF.from_robot_name(robot_name), **kwargs)
+        instance = cls(**kwargs)
+        instance.load(HRDF.from_robot_name(robot_name), validate=False)  # type: ignore[attr-defined]
+        return instance

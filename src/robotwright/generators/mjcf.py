@@ -157,7 +157,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             self.add_scene(skybox=skybox)
         self._layout_meshes(relative_mesh_path)
         self._order_sections()
-        clashes = name_clashes(self.xml_root)
+        clashes = name_clashes(self.xml_root) if self._check_names else None
         if clashes:
             raise GeneratorError(f"robot '{hrdf.name}': names used twice in the MJCF: {clashes}")
         _report(hrdf, "MJCF", losses, strict)
@@ -187,7 +187,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                     n += 1
                 used.add(name)
                 by_key[key] = name
-                attrs = {"name": prefixed(prefix, name), "file": path.as_posix()}
+                attrs = {"name": prefixed(prefix, name), "file": str(path)}
                 if m.scale != (1.0, 1.0, 1.0):
                     attrs["scale"] = fmt_vec(m.scale)
                 ET.SubElement(asset, "mesh", attrs)

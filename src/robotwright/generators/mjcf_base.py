@@ -104,24 +104,29 @@ _UNPREFIXED_NAME_TAGS: frozenset[str] = frozenset()
 
 def name_clashes(root: ET.Element) -> dict[str, list[str]]:
     """Names used more than once within one MuJoCo namespace: ``{namespace: [names]}``."""
-    seen: dict[tuple[str, str], int] = {}
+    seen: set[tuple[str, str]] = set()
+    dups: set[tuple[str, str]] = set()
     for section in root:
+        tag = section.tag
+        body_like = tag in ("worldbody", "asset")
         for node in section.iter():
             name = node.get("name")
             if name is None or node is section:
                 continue
-            if section.tag in ("worldbody", "asset"):
+            if body_like:
                 ns = BODY_NAMESPACES.get(node.tag)
-            elif section.tag == "contact":
-                ns = node.tag
+                if ns is None:
+                    continue
             else:
-                ns = section.tag
-            if ns is not None:
-                seen[(ns, name)] = seen.get((ns, name), 0) + 1
+                ns = node.tag if tag == "contact" else tag
+            key = (ns, name)
+            if key in seen:
+                dups.add(key)
+            else:
+                seen.add(key)
     out: dict[str, list[str]] = {}
-    for (ns, name), count in sorted(seen.items()):
-        if count > 1:
-            out.setdefault(ns, []).append(name)
+    for ns, name in sorted(dups):
+        out.setdefault(ns, []).append(name)
     return out
 
 
@@ -136,6 +141,8 @@ class MJCFGeneratorBase(GeneratorBase):
     def __init__(self, simulator_config: SimulatorConfig | None = None, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.simulator_config = simulator_config
+        # A composite checks names once on the merged tree, not in each robot.
+        self._check_names = True
 
     def _xml_root_init(self) -> ET.Element:
         return ET.Element("mujoco", {"model": self._model_name()})

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import replace
+from pathlib import Path
 
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
@@ -127,6 +128,7 @@ class _RobotWriter:
         self.mesh_path = owner.mesh_abspath
         self.for_mujoco, self.relative, self.losses = for_mujoco, relative, losses
         self.materials: dict[tuple[float, ...], str] = {}
+        self.mesh_refs: dict[Path, str] = {}
 
     def p(self, name: str) -> str:
         return prefixed(self.prefix, name)
@@ -434,18 +436,11 @@ class _RobotWriter:
         inertial = ET.SubElement(link, "inertial")
         _origin(inertial, _sub(b.inertial_pos, off))
         ET.SubElement(inertial, "mass", {"value": fmt_float(b.mass)})
-        t = inertia_tensor(b.diag_inertia, b.inertial_quat)
+        t = inertia_tensor(tuple(b.diag_inertia), tuple(b.inertial_quat))
         ET.SubElement(
             inertial,
             "inertia",
-            {
-                "ixx": fmt_float(t[0][0]),
-                "ixy": fmt_float(t[0][1]),
-                "ixz": fmt_float(t[0][2]),
-                "iyy": fmt_float(t[1][1]),
-                "iyz": fmt_float(t[1][2]),
-                "izz": fmt_float(t[2][2]),
-            },
+            dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), map(fmt_float, t), strict=True)),
         )
         for g, table, row in geoms:
             self._geom(link, g, off, table, row)
@@ -460,8 +455,12 @@ class _RobotWriter:
         pos = _sub(g.pos, off)
         name = g.geom_name
         if isinstance(g, MeshGeom):
-            path = self.gen._mesh_file(self.mesh_path(g))
-            attrs = {"filename": self.gen._reference(path, self.relative)}
+            src = self.mesh_path(g)
+            ref = self.mesh_refs.get(src)
+            if ref is None:
+                ref = self.gen._reference(self.gen._mesh_file(src), self.relative)
+                self.mesh_refs[src] = ref
+            attrs = {"filename": ref}
             if g.scale != (1.0, 1.0, 1.0):
                 attrs["scale"] = fmt_vec(g.scale)
             self._shape(link, tag, name, pos, g.quat, "mesh", attrs, g.rgba)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from functools import lru_cache
 from typing import Any
 
 from robotwright.generators.base import GeneratorBase
@@ -39,6 +40,7 @@ def rotate(q: Quat, v: Vec3) -> Vec3:
     )
 
 
+@lru_cache(maxsize=4096)
 def quat_to_rpy(q: Quat) -> Vec3:
     """URDF roll-pitch-yaw (fixed axes X, Y, Z: R = Rz(yaw) Ry(pitch) Rx(roll)), radians."""
     if q == (1.0, 0.0, 0.0, 0.0):
@@ -52,12 +54,17 @@ def quat_to_rpy(q: Quat) -> Vec3:
     return (math.atan2(r[2][1], r[2][2]), math.asin(sp), math.atan2(r[1][0], r[0][0]))
 
 
-def inertia_tensor(diag: Vec3, q: Quat) -> list[list[float]]:
-    """Full inertia tensor ``R diag(I) R^T`` of principal moments ``diag`` in frame ``q``."""
+@lru_cache(maxsize=4096)
+def inertia_tensor(diag: Vec3, q: Quat) -> tuple[float, float, float, float, float, float]:
+    """Full inertia tensor ``R diag(I) R^T`` of principal moments ``diag`` in frame ``q``,
+    as URDF's ``(ixx, ixy, ixz, iyy, iyz, izz)``."""
     r = quat_to_matrix(q)
-    return [
-        [sum(r[i][k] * diag[k] * r[j][k] for k in range(3)) for j in range(3)] for i in range(3)
-    ]
+    a, b, c = diag
+
+    def e(i: int, j: int) -> float:
+        return r[i][0] * a * r[j][0] + r[i][1] * b * r[j][1] + r[i][2] * c * r[j][2]
+
+    return (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2))
 
 
 class URDFGeneratorBase(GeneratorBase):

@@ -81,7 +81,11 @@ def to_xml_string(root: ET.Element) -> str:
     append = out.append
 
     def write(el: ET.Element, indent: str) -> None:
-        attrs = "".join([f' {k}="{_attr(v)}"' for k, v in el.attrib.items()])
+        items = el.attrib.items()
+        if _NEEDS_ESCAPE.search("".join(el.attrib.values())) is None:
+            attrs = "".join([f' {k}="{v}"' for k, v in items])
+        else:
+            attrs = "".join([f' {k}="{_attr(v)}"' for k, v in items])
         text = el.text if el.text is not None and el.text.strip() else None
         if len(el) == 0 and text is None:
             append(f"{indent}<{el.tag}{attrs} />\n")
