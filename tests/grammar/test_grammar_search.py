@@ -6,6 +6,7 @@ import math
 import random
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy as np
 import pytest
 
 from robotwright.grammar import derive
@@ -23,9 +24,10 @@ from robotwright.grammar.objectives import (
     Reach,
     WorkspaceVolume,
     evaluate,
+    hull_volume,
     make_constraint,
 )
-from robotwright.grammar.search import beam_search, random_search
+from robotwright.grammar.search import beam_search, mcts_search, random_search
 
 from .helpers import default_data, load_variant
 
@@ -46,12 +48,22 @@ def test_objectives_on_a_hand_computed_design():
     assert Reach()(ctx) == pytest.approx(math.hypot(0.484, 0.047), abs=1e-9)
     assert DoFCount()(ctx) == 2.0
     assert Mass()(ctx) == pytest.approx(build_hrdf(g, PLANAR).total_mass, rel=1e-9)
-    # planar arm: tool points lie in the plane z = 0.047, so at most one voxel layer
-    # of an annulus of outer radius 0.484 m.
-    vol = WorkspaceVolume(voxel=0.02)(ctx)
+    # planar arm: tool points lie in the plane z = 0.047, so the hull has no volume
+    # and the voxels form at most one layer of a disc of radius 0.484 m.
+    assert WorkspaceVolume()(ctx) == 0.0
+    vol = WorkspaceVolume(voxel=0.02, method="voxel")(ctx)
     assert 0 < vol <= math.pi * 0.5**2 * 0.02 * 2
     assert JointLimitsFeasible()(ctx) is None and NoSelfCollision()(ctx) is None
     assert MaxMass(0.1)(ctx) is not None and DoFRange(low=3)(ctx) is not None
+
+
+def test_hull_volume_of_known_shapes():
+    cube = np.array([[x, y, z] for x in (0, 2) for y in (0, 1) for z in (0, 0.5)], dtype=float)
+    assert hull_volume(cube) == pytest.approx(1.0, rel=1e-9)
+    rng = np.random.default_rng(0)
+    inside = rng.uniform(0, 1, (200, 3)) * [2, 1, 0.5]
+    assert hull_volume(np.vstack([cube, inside])) == pytest.approx(1.0, rel=1e-9)
+    assert hull_volume(cube[:3]) == 0.0
 
 
 def test_self_collision_is_detected_by_mujoco():
@@ -120,3 +132,22 @@ def test_default_executor_is_a_process_pool():
     assert res.n_evaluated == 4
     d = derive.sample(g, 2, random.Random(0))
     assert evaluate(g, d, (DoFCount(),)).values["dof"] >= 1
+
+
+def test_mcts_respects_budget_is_reproducible_and_beats_random_on_workspace():
+    g = default_grammar()
+    obj = WorkspaceVolume(samples=256)
+    kw = dict(budget=120, max_links=3, seed=2)
+    with ThreadPoolExecutor(2) as ex:
+        a = mcts_search(g, [obj], [NoSelfCollision()], executor=ex, batch=4, **kw)
+        b = mcts_search(g, [obj], [NoSelfCollision()], executor=ex, batch=4, **kw)
+        r = random_search(g, [obj], [NoSelfCollision()], executor=ex, **kw)
+    assert a.n_evaluated == 120 == len({e.design.hash() for e in a.evaluations})
+    assert [e.design.hash() for e in a.evaluations] == [e.design.hash() for e in b.evaluations]
+    mean_random = sum(e.score for e in r.evaluations if e.feasible) / sum(
+        e.feasible for e in r.evaluations
+    )
+    mean_mcts = sum(e.score for e in a.evaluations if e.feasible) / sum(
+        e.feasible for e in a.evaluations
+    )
+    assert mean_mcts > mean_random  # the tree concentrates on good designs

@@ -57,7 +57,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable",
     )
     q.add_argument("--budget", type=int, default=100, help="designs to evaluate")
-    q.add_argument("--method", default="beam", choices=["beam", "random"])
+    q.add_argument("--method", default="beam", choices=["beam", "mcts", "random"])
     q.add_argument("--beam-width", type=int, default=4)
     q.add_argument("--max-links", type=int, default=4)
     q.add_argument("--seed", type=int, default=0)
@@ -147,7 +147,7 @@ def _sample(args: argparse.Namespace) -> int:
 def _search(args: argparse.Namespace) -> int:
     from robotwright.grammar.export import export_design
     from robotwright.grammar.objectives import OBJECTIVES, make_constraint
-    from robotwright.grammar.search import beam_search, random_search
+    from robotwright.grammar.search import beam_search, mcts_search, random_search
 
     g = _grammar(args)
     try:
@@ -160,6 +160,8 @@ def _search(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     if args.method == "beam":
         res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
+    elif args.method == "mcts":
+        res = mcts_search(g, [objective], constraints, **kw)
     else:
         res = random_search(g, [objective], constraints, **kw)
     dt = time.perf_counter() - t0

@@ -86,10 +86,17 @@ class Reach:
 
 @dataclass(frozen=True)
 class WorkspaceVolume:
-    """Volume (m^3) of the voxels (edge ``voxel`` m) hit by sampled tool points."""
+    """Workspace volume (m^3) from sampled tool points.
+
+    ``method="hull"`` (default): volume of their convex hull, computed by MuJoCo's mesh
+    code (qhull); 0 when the points are coplanar (a planar arm). ``method="voxel"``:
+    number of voxels of edge ``voxel`` m that the points hit times the voxel volume, a
+    lower bound that saturates at ``samples`` voxels.
+    """
 
     samples: int = 2048
     voxel: float = 0.02
+    method: str = "hull"
     seed: int = 0
     name: str = "workspace"
     maximize: bool = True
@@ -97,11 +104,43 @@ class WorkspaceVolume:
     def __post_init__(self) -> None:
         if self.voxel <= 0 or self.samples < 1:
             raise ValueError("WorkspaceVolume: voxel must be > 0 m and samples >= 1")
+        if self.method not in ("hull", "voxel"):
+            raise ValueError(
+                f"WorkspaceVolume: method must be 'hull' or 'voxel', got {self.method!r}"
+            )
 
     def __call__(self, ctx: EvalContext) -> float:
         pts = ctx.tool_points(self.samples, self.seed)
-        cells = np.unique(np.floor(pts / self.voxel).astype(np.int64), axis=0)
-        return float(len(cells) * self.voxel**3)
+        if self.method == "voxel":
+            cells = np.unique(np.floor(pts / self.voxel).astype(np.int64), axis=0)
+            return float(len(cells) * self.voxel**3)
+        return hull_volume(pts)
+
+
+def hull_volume(points: np.ndarray) -> float:
+    """Convex hull volume (m^3) of ``points`` (N, 3): MuJoCo builds the hull of a mesh
+    with these vertices and, at density 1, its mass is the hull's volume."""
+    pts = np.unique(np.round(np.asarray(points, dtype=float), 9), axis=0)
+    if len(pts) < 4:
+        return 0.0
+    # Points on a plane or a line span no volume (and qhull rejects them).
+    sv = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    if sv[2] <= 1e-9 * max(sv[0], 1e-300):
+        return 0.0
+    spec = mujoco.MjSpec()
+    mesh = spec.add_mesh(name="workspace", uservert=pts.ravel().tolist())
+    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+    body = spec.worldbody.add_body(name="hull")
+    body.add_freejoint()
+    body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="workspace", density=1.0)
+    try:
+        model = spec.compile()
+    except ValueError as exc:
+        # Coplanar or collinear points span no volume; anything else is a real error.
+        if any(w in str(exc) for w in ("coplanar", "collinear", "volume")):
+            return 0.0
+        raise
+    return float(model.body_mass[1])
 
 
 @dataclass(frozen=True)

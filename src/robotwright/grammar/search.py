@@ -178,3 +178,118 @@ def beam_search(
             if progress is not None:
                 progress(len(ev.order), _best(ev.order))
         return SearchResult(_best(ev.order), ev.order)
+
+
+class _Node:
+    """A node of the MCTS decision tree: one partial derivation."""
+
+    __slots__ = ("partial", "children", "untried", "visits", "total", "best")
+
+    def __init__(self, partial: Partial, decisions: list[tuple]) -> None:
+        self.partial = partial
+        self.children: list[_Node] = []
+        self.untried = decisions
+        self.visits = 0
+        self.total = 0.0
+        self.best = 0.0
+
+
+def _decisions(p: Partial, rng: random.Random) -> list[tuple]:
+    out: list[tuple] = []
+    for rule, n in options(p):
+        out += [(None, 0)] if rule is None else [(rule, i) for i in range(n)]
+    rng.shuffle(out)
+    return out
+
+
+def mcts_search(
+    grammar: Grammar,
+    objectives: Sequence[Objective],
+    constraints: Sequence[Constraint] = (),
+    *,
+    budget: int = 100,
+    max_links: int = 4,
+    exploration: float = 0.5,
+    batch: int | None = None,
+    seed: int = 0,
+    executor: Executor | None = None,
+    workers: int | None = None,
+) -> SearchResult:
+    """Monte Carlo tree search (UCT) over the decisions of canonical derivations.
+
+    Each iteration walks down by UCT (value = mix of the mean and best normalised score
+    below a node), expands one untried decision, completes it uniformly at random and
+    evaluates the design. ``batch`` leaves are chosen per round (with a virtual visit
+    so they differ) and evaluated together through the executor. Scores are normalised
+    to [0, 1] by the range seen so far; infeasible designs count as 0.
+    """
+    import math
+
+    if budget < 1:
+        raise ValueError("budget must be >= 1")
+    rng = random.Random(seed)
+    counter = Counter(grammar)
+    start = Partial.start(grammar)
+    root = _Node(start, _decisions(start, rng))
+    lo, hi = math.inf, -math.inf
+
+    def norm(score: float) -> float:
+        if not math.isfinite(score) or hi <= lo:
+            return 0.0 if not math.isfinite(score) else 0.5
+        return (score - lo) / (hi - lo)
+
+    def value(n: _Node) -> float:
+        return 0.5 * (n.total / n.visits) + 0.5 * n.best if n.visits else 0.0
+
+    with _Evaluator(grammar, objectives, constraints, budget, executor, workers) as ev:
+        k = batch or max(1, 2 * (ev.workers or os.cpu_count() or 1))
+        stalls = 0
+        while ev.left > 0 and stalls < 50 and (root.untried or root.children):
+            paths: list[list[_Node]] = []
+            designs: list[Design] = []
+            for _ in range(min(k, ev.left)):
+                node, path = root, [root]
+                while not node.untried and node.children:
+                    ln = math.log(node.visits + 1)
+                    node = max(
+                        node.children,
+                        key=lambda c: value(c) + exploration * math.sqrt(ln / (c.visits + 1)),
+                    )
+                    path.append(node)
+                while node.untried:
+                    rule, i = node.untried.pop()
+                    p = node.partial
+                    child_p = (
+                        p.stop() if rule is None else p.apply(rule, choices_at(grammar, rule, i))
+                    )
+                    if counter.feasible(child_p, max_links):
+                        child = _Node(child_p, _decisions(child_p, rng))
+                        node.children.append(child)
+                        node, path = child, path + [child]
+                        break
+                for n in path:
+                    n.visits += 1  # virtual visit: spreads a batch over different leaves
+                q = node.partial
+                if q.complete:
+                    designs.append(q.design())
+                elif counter.feasible(q, max_links):
+                    while not q.complete:
+                        q = random_step(q, max_links, rng, counter)
+                    designs.append(q.design())
+                else:
+                    designs.append(None)  # type: ignore[arg-type]
+                paths.append(path)
+            before = len(ev.order)
+            results = ev.run([d for d in designs if d is not None])
+            stalls = stalls + 1 if len(ev.order) == before else 0
+            it = iter(results)
+            scores = [(next(it) if d is not None else None) for d in designs]
+            for r in scores:
+                if r is not None and math.isfinite(r.score):
+                    lo, hi = min(lo, r.score), max(hi, r.score)
+            for path, r in zip(paths, scores):
+                s = norm(r.score) if r is not None else 0.0
+                for n in path:
+                    n.total += s
+                    n.best = max(n.best, s)
+        return SearchResult(_best(ev.order), ev.order)
