@@ -148,3 +148,26 @@ def test_demo_limb_is_deterministic():
         demo_limb(3).meta.extra["grammar"]["design_hash"]
         != demo_limb(4).meta.extra["grammar"]["design_hash"]
     )
+
+
+def test_composite_mount_matches_hrdf_mount():
+    from robotwright.generators import MJCFHumanoidGenerator
+    from robotwright.grammar.mount import mount_scene
+
+    robot = HRDF.from_robot_name("mini_humanoid")
+    limb = demo_limb(1)
+    half = math.sqrt(0.5)
+    quat = (half, 0.0, -half, 0.0)
+    merged = MJCFHumanoidGenerator.from_hrdf(
+        mount_on(robot, limb, "back_mount", quat=quat)
+    ).to_model()
+    scene = mount_scene(robot, limb, "back_mount", quat=quat).to_model()
+    assert scene.nq == merged.nq and scene.nu == merged.nu
+    assert scene.body_mass.sum() == pytest.approx(merged.body_mass.sum(), rel=1e-9)
+    dm, ds = mujoco.MjData(merged), mujoco.MjData(scene)
+    mujoco.mj_kinematics(merged, dm)
+    mujoco.mj_kinematics(scene, ds)
+    for site in limb.sites:
+        np.testing.assert_allclose(
+            ds.site(f"srl_{site.name}").xpos, dm.site(f"srl_{site.name}").xpos, atol=1e-6
+        )

@@ -184,3 +184,45 @@ def mount_on(
         mjcf_extra=robot.mjcf_extra,
         root_dir=robot.root_dir,
     )
+
+
+def oriented(limb: HRDF, pos: Vec3 = (0.0, 0.0, 0.0), quat: Quat = (1.0, 0.0, 0.0, 0.0)) -> HRDF:
+    """A copy of ``limb`` whose root body is moved by ``pos``/``quat`` (m; w, x, y, z)."""
+    root = limb.root_index
+    bodies = list(limb.bodies)
+    b = bodies[root]
+    p, q = _compose(pos, quat, b.pos, b.quat)
+    bodies[root] = dataclasses.replace(b, pos=p, quat=q)
+    return dataclasses.replace(limb, bodies=bodies)
+
+
+def mount_scene(
+    robot: HRDF,
+    limb: HRDF,
+    at: str,
+    *,
+    pos: Vec3 = (0.0, 0.0, 0.0),
+    quat: Quat = (1.0, 0.0, 0.0, 0.0),
+    robot_key: str = "robot",
+    limb_key: str = "srl",
+):
+    """The same mount as :func:`mount_on`, made by the generators' composite: an
+    ``MJCFGeneratorComposite`` holding both robots, the limb attached at site or body
+    ``at`` of the robot (names prefixed ``<robot_key>_`` and ``<limb_key>_``).
+
+    The composite's placement turns about z only, so the limb's orientation ``quat``
+    is applied to the limb's root body first.
+    """
+    from robotwright.generators import (
+        MJCFGeneratorComposite,
+        MJCFHumanoidGenerator,
+        Placement,
+    )
+
+    return MJCFGeneratorComposite(
+        {
+            robot_key: MJCFHumanoidGenerator.from_hrdf(robot),
+            limb_key: MJCFHumanoidGenerator.from_hrdf(oriented(limb, pos, quat)),
+        },
+        placements={limb_key: Placement(parent=robot_key, frame=at)},
+    )
