@@ -171,3 +171,22 @@ def test_composite_mount_matches_hrdf_mount():
         np.testing.assert_allclose(
             ds.site(f"srl_{site.name}").xpos, dm.site(f"srl_{site.name}").xpos, atol=1e-6
         )
+
+
+def test_all_one_link_designs_compile_as_mjcf_and_urdf():
+    from xml.etree.ElementTree import tostring
+
+    from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
+
+    g = default_grammar()
+    designs = list(derive.enumerate_designs(g, 1))
+    assert len(designs) == 192
+    for d in designs:
+        hrdf = build_hrdf(g, d)
+        mjcf = MJCFHumanoidGenerator.from_hrdf(hrdf).generate(add_scene=False)
+        urdf = URDFHumanoidGenerator.from_hrdf(hrdf).generate(add_mujoco_tag=True)
+        m = mujoco.MjModel.from_xml_string(tostring(mjcf, encoding="unicode"))
+        u = mujoco.MjModel.from_xml_string(tostring(urdf, encoding="unicode"))
+        assert m.nq == u.nq == hrdf.dof
+        assert m.body_mass.sum() == pytest.approx(hrdf.total_mass, rel=1e-9)
+        assert u.body_mass.sum() == pytest.approx(hrdf.total_mass, rel=1e-6)
