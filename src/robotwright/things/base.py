@@ -211,7 +211,8 @@ class BaseThing(metaclass=ThingType):
                     f"{self._label()}.attach: a {type(thing).__name__} cannot be attached to a "
                     f"{type(self).__name__} (accepts: {', '.join(sorted(self._CHILD_KINDS))})"
                 )
-            if thing._TARGET_KINDS and self._NAMESPACE not in thing._TARGET_KINDS:
+            kind = self._NAMESPACE or getattr(self, "_TARGET_AS", None)
+            if thing._TARGET_KINDS and kind not in thing._TARGET_KINDS:
                 raise ThingAttributeError(
                     f"{self._label()}.attach: a {type(thing).__name__} measures or drives a "
                     f"{' or '.join(sorted(thing._TARGET_KINDS))}, not a {type(self).__name__}"

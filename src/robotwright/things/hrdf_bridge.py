@@ -338,7 +338,8 @@ def things_to_hrdf(
                 problems.append(
                     Problem(
                         world._label(),
-                        f"{thing._label()} is part of the scene, not of the robot; not kept",
+                        f"{getattr(thing, 'xml', None) or thing._label()} belongs to the world "
+                        "(scene), not to the robot's tree; not kept",
                     )
                 )
     else:
@@ -384,7 +385,7 @@ def things_to_hrdf(
             continue
         if ns == "raw":
             problems.append(
-                Problem(thing._label(), "a verbatim MJCF element has no HRDF table; not kept")
+                Problem(thing._label(), f"{thing.xml}: verbatim MJCF has no HRDF table; not kept")
             )
             continue
         _check_unmapped(thing, problems)

@@ -120,7 +120,9 @@ class World(BaseThing):
 
     _NAMESPACE = None
     _TAG = "worldbody"
-    _CHILD_KINDS = frozenset({"body", "geom", "site", "camera", "light", "raw"})
+    _CHILD_KINDS = frozenset({"body", "geom", "site", "camera", "light", "raw", "sensor"})
+    #: Sensors attached to the World measure MuJoCo's world body.
+    _TARGET_AS = "body"
     _NEW_MUJOCO_ATTR = {**OPTION_ATTR, **_COMPILER_ATTR}
     _NEW_BLUEPRINTS_ATTR = {**OPTION_ATTR, **_COMPILER_ATTR}
     _NEW_DEFAULT_VALS = {**_OPTION_DEFAULTS, **_COMPILER_DEFAULTS}

@@ -462,7 +462,11 @@ class _Reader:
         if (
             cls is None
             or target is None
-            or (cls._TARGET_KINDS and target._NAMESPACE not in cls._TARGET_KINDS)
+            or (
+                cls._TARGET_KINDS
+                and (target._NAMESPACE or getattr(target, "_TARGET_AS", None))
+                not in cls._TARGET_KINDS
+            )
         ):
             self._carry(world, "sensor", ss, carried, f"{tag} sensor on a {objtype}")
             return
@@ -605,6 +609,7 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
             "<extension>/<custom>", "plugins and custom numeric/text/tuple data are not kept"
         )
 
+    reader.by_name[("body", "world")] = world
     reader.read_assets(world)
     reader.read_body_children(spec.worldbody, world)
 

@@ -224,10 +224,10 @@ class _Writer:
 
     def sensor_xml(self, sensor: Any) -> str:
         parent = sensor._parent
-        target = self.names[parent.ID]
+        target = "world" if parent is self.root else self.names[parent.ID]
         if sensor._TARGET_ATTR == "objname":
             attrs = self.attrs(sensor, skip={"objtype", "reftype", "refname"})
-            objtype = sensor.objtype or parent._NAMESPACE
+            objtype = sensor.objtype or parent._NAMESPACE or "body"
             extra = f'objtype="{objtype}" objname="{_q(target)}"'
             if sensor.refname is not None:
                 ref = sensor.refname
