@@ -22,6 +22,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.sensors.cli",
     "robotwright.grammar.cli",
     "robotwright.generators.cli",
+    "robotwright.things.cli",
 )
 
 
