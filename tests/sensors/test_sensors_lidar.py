@@ -304,3 +304,33 @@ def test_sensor_on_world_body_excludes_nothing():
     s.update()
     # The torso (0.1 m box around the origin) is hit from inside on every ray.
     np.testing.assert_allclose(s.get_distances()[0], 0.1, atol=1e-9)
+
+
+@pytest.mark.parametrize("engine", ["mujoco", pytest.param("warp", marks=pytest.mark.warp)])
+def test_ellipsoid_and_cylinder_distances(engine):
+    if engine == "warp":
+        pytest.importorskip("mujoco_warp", reason="robotwright[warp] not installed")
+    xml = """<mujoco><worldbody>
+      <site name="s" pos="0 0 0"/><site name="above" pos="0 3 2"/>
+      <geom name="ell" type="ellipsoid" size="0.5 1.0 0.3" pos="3 0 0"/>
+      <geom name="cyl" type="cylinder" size="0.4 0.5" pos="0 3 0"/>
+      <geom name="ell_tilted" type="ellipsoid" size="0.2 0.2 0.6" pos="-3 0 0" euler="0 90 0"/>
+    </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = forward(model)
+    side = LidarSensor(LidarCfg(prim_path="s", pattern_cfg=RaysPattern([(1, 0, 0), (0, 1, 0), (-1, 0, 0)]),
+                                engine=engine), model, data)  # fmt: skip
+    side.update()
+    # Ellipsoid x semi-axis 0.5; cylinder side r=0.4; tilted ellipsoid's long axis along x (0.6).
+    np.testing.assert_allclose(
+        side.get_distances()[0], [2.5, 2.6, 2.4], atol=1e-6 if engine == "mujoco" else 1e-5
+    )
+    top = LidarSensor(
+        LidarCfg(prim_path="above", pattern_cfg=RaysPattern([(0, 0, -1)]), engine=engine),
+        model,
+        data,
+    )
+    top.update()
+    np.testing.assert_allclose(
+        top.get_distances()[0, 0], 1.5, atol=1e-6 if engine == "mujoco" else 1e-5
+    )  # cap

@@ -328,6 +328,10 @@ class LidarSensor:
 
     def update(self) -> None:
         """Cast one frame of rays for every environment from the poses in its ``MjData``."""
+        self._update_buffers_impl(None)
+
+    def _update_buffers_impl(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
+        """Seed hook: cast and fill the buffers (every environment; ``env_ids`` kept for the API)."""
         self._frame += 1
         origins_s, dirs_s = self._pattern(self._frame)
         pos, mat = self.sensor_poses()

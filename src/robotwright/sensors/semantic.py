@@ -120,9 +120,10 @@ class SemanticLidarSensor(LidarSensor):
             self.mesh_id_to_semantic_class[int(g)] = cls_id
         self._label_lut = np.concatenate([[0], self.geom_semantic_class]).astype(np.int32)
 
-    def update(self) -> None:
-        super().update()
-        self._compute_semantic_labels(None)
+    def _update_buffers_impl(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
+        """Cast (parent), then turn hit geom ids into labels, as in the seed."""
+        super()._update_buffers_impl(env_ids)
+        self._compute_semantic_labels(env_ids)
 
     def _compute_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
         """Fill labels (and mesh ids) of ``env_ids`` (all when None) from the hit geom ids."""
