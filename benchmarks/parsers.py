@@ -1,6 +1,9 @@
 #!/usr/bin/env python
 """Parse time of the Unitree G1 MJCF (mjlab) and G1 URDF (example-robot-data): ours vs
 hurodes' parsers (run in their own interpreter via --hurodes-python), same files, one run.
+The URDF is given to both as a plain copy (relative mesh paths), since hurodes' URDF
+parser cannot resolve ``package://``. Timing covers the parse into an in-memory model
+(hurodes: ``parse()``; ours: ``*_to_hrdf``), not writing folders.
 
 Prints the median of --repeat runs for each side and the ratio hurodes / ours.
 Usage: python benchmarks/parsers.py --hurodes-python /work/hurodes-venv/bin/python
@@ -40,6 +43,21 @@ print(json.dumps(times))
 """
 
 
+def plain_urdf_copy(src: Path, dest_root: Path) -> Path:
+    """The G1 URDF as hurodes can read it: ``urdf/`` + ``meshes/`` folders (meshes copied)
+    and mesh file names relative (hurodes' URDF path cannot resolve ``package://``)."""
+    import re
+    import shutil
+
+    mesh_src = src.parent.parent / "meshes"
+    shutil.copytree(mesh_src, dest_root / "meshes")
+    (dest_root / "urdf").mkdir()
+    text = re.sub(r'filename="[^"]*/meshes/', 'filename="../meshes/', src.read_text())
+    out = dest_root / "urdf" / src.name
+    out.write_text(text)
+    return out
+
+
 def ours(kind: str, path: Path, repeat: int) -> list[float]:
     from robotwright.parsers import mjcf_to_hrdf, urdf_to_hrdf
 
@@ -67,7 +85,11 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=7)
     args = ap.parse_args()
     logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
-    for kind, path in (("mjcf", G1_MJCF), ("urdf", G1_URDF)):
+    import tempfile
+
+    tmp = tempfile.TemporaryDirectory(prefix="robotwright-bench-")
+    urdf = plain_urdf_copy(G1_URDF, Path(tmp.name)) if G1_URDF.is_file() else G1_URDF
+    for kind, path in (("mjcf", G1_MJCF), ("urdf", urdf)):
         if not path.is_file():
             print(f"{kind}: {path} absent, skipped")
             continue
@@ -81,6 +103,7 @@ def main() -> int:
                 ht = statistics.median(h)
                 line += f"; hurodes median {ht * 1e3:.1f} ms; hurodes/ours = {ht / ours_t:.2f}x"
         print(line)
+    tmp.cleanup()
     return 0
 
 

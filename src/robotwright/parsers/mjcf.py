@@ -136,11 +136,32 @@ def _actuator(model: mujoco.MjModel, i: int, rep: Reporter) -> Actuator | None:
     )
 
 
-def _carried_sections(spec: mujoco.MjSpec, rep: Reporter) -> list[ET.Element]:
-    """Tendon, equality and contact sections as MuJoCo writes them (``class`` refs removed:
-    MuJoCo writes resolved values, and our MJCF has no default classes)."""
-    if not any(len(getattr(spec, a)) for a in ("tendons", "equalities", "pairs", "excludes")):
-        return []
+def _excludes(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[ET.Element]:
+    """``<contact><exclude>`` rebuilt from the compiled model (signature = b1 << 16 | b2)."""
+    section = ET.Element("contact")
+    for e in range(model.nexclude):
+        sig = int(model.exclude_signature[e])
+        b1, b2 = sig >> 16, sig & 0xFFFF
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_EXCLUDE, e)
+        if b1 not in kept and b1 != 0 or b2 not in kept and b2 != 0:
+            rep.warn("contact exclude with a body outside the robot dropped", f"exclude #{e}")
+            continue
+        attrs = {"name": name} if name else {}
+        attrs |= {"body1": body_name(model, b1), "body2": body_name(model, b2)}
+        ET.SubElement(section, "exclude", attrs)
+    return [section] if len(section) else []
+
+
+def _carried_sections(
+    spec: mujoco.MjSpec, model: mujoco.MjModel, kept: set[int], rep: Reporter
+) -> list[ET.Element]:
+    """Tendon, equality and contact sections.
+
+    Contact excludes alone are rebuilt from the compiled model (exact and fast); otherwise
+    the sections are taken as MuJoCo writes them (``spec.to_xml``), with ``class``
+    references removed (reported: values inherited from a class are not carried)."""
+    if not any(len(getattr(spec, a)) for a in ("tendons", "equalities", "pairs")):
+        return _excludes(model, kept, rep)
     root = ET.fromstring(spec.to_xml())  # MuJoCo's own output: trusted text
     out = []
     for tag in EXTRA_SECTIONS:
@@ -482,7 +503,7 @@ def parse_mjcf(
     if model.nhfield or model.ntex:
         rep.warn(f"{model.nhfield} height field(s) and {model.ntex} texture(s) dropped")
 
-    extra_parts = _carried_sections(spec, rep)
+    extra_parts = _carried_sections(spec, model, kept, rep)
     if extra_sensors:
         section = ET.Element("sensor")
         section.extend(extra_sensors)
