@@ -108,3 +108,28 @@ def test_hfield_side_walls_differ():
     wrp = _scan(model, datas, "warp", RaysPattern([(1, 0, 0), (1, 0, -0.2)]), prim_path="s")
     np.testing.assert_allclose(ref.get_distances()[0, 0], 2.0, atol=1e-9)
     assert np.isinf(wrp.get_distances()[0, 0])  # documented limitation of the warp engine
+
+
+def test_mujoco_warp_data_input_matches_host_envs(clutter_model):
+    """Worlds simulated with mujoco-warp are scanned in place (no host MjData)."""
+    import mujoco_warp as mjw
+    import warp as wp
+
+    host = random_envs(clutter_model, 3, seed=2)
+    with wp.ScopedDevice("cpu"):
+        mw = mjw.put_model(clutter_model)
+        dw = mjw.put_data(clutter_model, host[0], nworld=3)
+        dw.qpos.assign(np.stack([d.qpos for d in host]).astype(np.float32))
+        mjw.kinematics(mw, dw)
+    pattern = LivoxPatternCfg(num_rays=5000)
+    on_device = _scan(clutter_model, dw, "warp", pattern, max_distance=30.0)
+    ref = _scan(clutter_model, host, "mujoco", pattern, max_distance=30.0)
+    np.testing.assert_allclose(on_device.data.pos_w, ref.data.pos_w, atol=1e-5)
+    same = on_device.get_mesh_ids() == ref.get_mesh_ids()
+    assert same.mean() >= 0.999
+    both = same & (ref.get_mesh_ids() >= 0)
+    np.testing.assert_allclose(
+        on_device.get_distances()[both], ref.get_distances()[both], atol=1e-5, rtol=0
+    )
+    with pytest.raises(Exception, match="set engine='warp'"):
+        _scan(clutter_model, dw, "mujoco", pattern)

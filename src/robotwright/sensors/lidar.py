@@ -124,6 +124,12 @@ def geom_paths(model: mujoco.MjModel, with_mesh: bool = True) -> list[str]:
     return paths
 
 
+def _is_warp_data(data: object) -> bool:
+    """True for a ``mujoco_warp.Data`` (checked by type, without importing warp)."""
+    cls = type(data)
+    return cls.__name__ == "Data" and cls.__module__.startswith("mujoco_warp")
+
+
 def _quat_to_mat(q: Sequence[float]) -> np.ndarray:
     mat = np.empty(9)
     mujoco.mju_quat2Mat(mat, np.asarray(q, dtype=np.float64))
@@ -136,9 +142,11 @@ class LidarSensor:
     Args:
         cfg: the sensor configuration.
         model: the compiled model (shared by every environment).
-        data: one ``MjData`` or a list of them, one per environment. :meth:`update`
-            reads the poses they hold (as left by ``mj_step``/``mj_forward``); it never
-            writes to them.
+        data: one ``MjData`` or a list of them, one per environment, or a
+            ``mujoco_warp.Data`` holding every environment on the warp device (with
+            ``engine="warp"``; then geom poses never leave the device). :meth:`update`
+            reads the poses they hold (as left by ``mj_step``/``mj_forward`` or
+            ``mujoco_warp.step``/``kinematics``); it never writes to them.
 
     Example:
         >>> sensor = LidarSensor(LidarCfg(prim_path="lidar_site"), model, data)
@@ -155,8 +163,24 @@ class LidarSensor:
             raise SensorError(f"cfg: expected a LidarCfg, got {type(cfg).__name__}")
         self.cfg = cfg
         self.model = model
-        self._datas: list[mujoco.MjData] = [data] if isinstance(data, mujoco.MjData) else list(data)
-        if not self._datas:
+        # A mujoco_warp.Data (all worlds on the warp device) or host MjData, one per env.
+        self._warp_data = data if _is_warp_data(data) else None
+        if self._warp_data is not None:
+            self._datas: list[mujoco.MjData] = []
+            self._num_envs = int(data.nworld)
+            if cfg.engine != "warp":
+                raise SensorError(
+                    "data is a mujoco_warp.Data: set engine='warp' (the mujoco engine needs MjData)"
+                )
+            if tuple(data.geom_xpos.shape) != (self._num_envs, model.ngeom):
+                raise SensorError(
+                    f"data: expected a mujoco_warp.Data of this model ({model.ngeom} geoms), "
+                    f"got geom_xpos of shape {tuple(data.geom_xpos.shape)}"
+                )
+        else:
+            self._datas = [data] if isinstance(data, mujoco.MjData) else list(data)
+            self._num_envs = len(self._datas)
+        if self._num_envs == 0:
             raise SensorError(
                 "data: expected one MjData or a non-empty list of them (one per environment)"
             )
@@ -197,7 +221,7 @@ class LidarSensor:
     # ------------------------------------------------------------------ set-up
     @property
     def num_envs(self) -> int:
-        return len(self._datas)
+        return self._num_envs
 
     @property
     def max_distance(self) -> float:
@@ -303,6 +327,16 @@ class LidarSensor:
     # ------------------------------------------------------------------ update
     def sensor_poses(self) -> tuple[np.ndarray, np.ndarray]:
         """Sensor positions ``(E, 3)`` [m] and rotation matrices ``(E, 3, 3)``, world frame."""
+        if self._warp_data is not None:
+            # Only the carrier's pose comes back from the device.
+            wd, i = self._warp_data, self._carrier_id
+            if self._carrier_kind == "body":
+                p = wd.xpos.numpy()[:, i].astype(np.float64)
+                r = wd.xmat.numpy()[:, i].astype(np.float64).reshape(-1, 3, 3)
+            else:
+                p = wd.site_xpos.numpy()[:, i].astype(np.float64)
+                r = wd.site_xmat.numpy()[:, i].astype(np.float64).reshape(-1, 3, 3)
+            return p + r @ self._offset_pos, r @ self._offset_mat
         pos = np.empty((self.num_envs, 3))
         mat = np.empty((self.num_envs, 3, 3))
         for e, d in enumerate(self._datas):
@@ -337,7 +371,13 @@ class LidarSensor:
         pos, mat = self.sensor_poses()
         rot = self._ray_rotation(mat)
         raw_dist, geom_ids = self._engine.cast(
-            self._datas, origins_s, dirs_s, rot, pos, self.cfg.max_distance, self._single_origin
+            self._warp_data if self._warp_data is not None else self._datas,
+            origins_s,
+            dirs_s,
+            rot,
+            pos,
+            self.cfg.max_distance,
+            self._single_origin,
         )
         self._apply_range_model(raw_dist, geom_ids)
         d = self._data

@@ -355,7 +355,7 @@ class WarpRayEngine:
         self.num_envs = int(num_envs)
         with wp.ScopedDevice(self.device):
             self._m = mjw.put_model(ray_model)
-            self._d = mjw.make_data(ray_model, nworld=self.num_envs)
+            self._d: Any = None  # device copy of host poses, made on first host-data cast
             self._rc = mjw.create_render_context(
                 ray_model,
                 nworld=self.num_envs,
@@ -393,7 +393,7 @@ class WarpRayEngine:
 
     def cast(
         self,
-        datas: Sequence[mujoco.MjData],
+        datas: Sequence[mujoco.MjData] | Any,
         origins_s: np.ndarray,
         directions_s: np.ndarray,
         rot: np.ndarray,
@@ -403,6 +403,9 @@ class WarpRayEngine:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Same contract as :meth:`MujocoRayEngine.cast` (rays cast in float32).
 
+        ``datas`` may also be a ``mujoco_warp.Data`` on this engine's device: its geom
+        poses are used in place (nothing uploaded but the pattern and the sensor poses).
+
         Only the pattern (``N`` rays) and one pose per environment are uploaded; the
         world rays of every environment are made on the device.
         """
@@ -411,11 +414,26 @@ class WarpRayEngine:
         if num_envs != self.num_envs:
             raise SensorError(f"warp engine built for {self.num_envs} environments, got {num_envs}")
         buf = self._alloc(num_rays)
-        geom_xpos = np.stack([d.geom_xpos for d in datas])
-        geom_xmat = np.stack([d.geom_xmat for d in datas])
+        on_device = not isinstance(datas, (list, tuple))
+        if on_device:
+            # A mujoco_warp.Data: its geom poses are already on the device.
+            dev_data = datas
+            if dev_data.geom_xpos.device != self.device:
+                raise SensorError(
+                    f"mujoco_warp.Data is on {dev_data.geom_xpos.device}, the sensor on {self.device}: "
+                    "set LidarCfg.device to match"
+                )
+        else:
+            if self._d is None:
+                with wp.ScopedDevice(self.device):
+                    self._d = mjw.make_data(self.model, nworld=self.num_envs)
+            dev_data = self._d
+            geom_xpos = np.stack([d.geom_xpos for d in datas])
+            geom_xmat = np.stack([d.geom_xmat for d in datas])
         with wp.ScopedDevice(self.device):
-            self._d.geom_xpos.assign(geom_xpos.astype(np.float32))
-            self._d.geom_xmat.assign(geom_xmat.astype(np.float32).reshape(num_envs, -1, 3, 3))
+            if not on_device:
+                self._d.geom_xpos.assign(geom_xpos.astype(np.float32))
+                self._d.geom_xmat.assign(geom_xmat.astype(np.float32).reshape(num_envs, -1, 3, 3))
             buf["pat_o"].assign(np.asarray(origins_s, dtype=np.float32))
             buf["pat_d"].assign(np.asarray(directions_s, dtype=np.float32))
             buf["rot"].assign(np.asarray(rot, dtype=np.float32))
@@ -426,10 +444,10 @@ class WarpRayEngine:
                 inputs=[buf["pat_o"], buf["pat_d"], buf["rot"], buf["pos"]],
                 outputs=[buf["pnt"], buf["vec"]],
             )
-            mjw.refit_bvh(self._m, self._d, self._rc)
+            mjw.refit_bvh(self._m, dev_data, self._rc)
             mjw.rays(
                 self._m,
-                self._d,
+                dev_data,
                 buf["pnt"],
                 buf["vec"],
                 self._geomgroup,
@@ -443,6 +461,9 @@ class WarpRayEngine:
             out_dist = buf["dist"].numpy().astype(np.float64)
             out_ids = buf["geomid"].numpy().astype(np.int32)
         if self.refine:
+            if on_device:  # float32 poses from the device; the refinement is still float64
+                geom_xpos = dev_data.geom_xpos.numpy().astype(np.float64)
+                geom_xmat = dev_data.geom_xmat.numpy().astype(np.float64).reshape(num_envs, -1, 9)
             refine_curved_hits(
                 self.model,
                 geom_xpos,
