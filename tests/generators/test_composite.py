@@ -218,3 +218,16 @@ def test_urdf_composite_loads_in_mujoco_and_yourdfpy(tmp_path):
         {"h": _gen("mini_humanoid"), "a1": _gen("arm6"), "a2": _gen("arm6")}
     ).to_model()
     assert m.body_mass.sum() == pytest.approx(mj.body_mass.sum(), abs=1e-6)
+
+
+def test_placement_full_orientation():
+    q = (math.cos(0.3), math.sin(0.3), 0.0, 0.0)  # 0.6 rad about x
+    comp = MJCFGeneratorComposite(
+        {"arm": _gen("arm6")}, placements={"arm": Placement((0, 0, 1), orientation=q)}
+    )
+    m = comp.to_model()
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(d.xquat[m.body("arm_base_link").id], q, atol=1e-12)
+    with pytest.raises(GeneratorError, match="not both"):
+        Placement(yaw=0.1, orientation=q)

@@ -21,12 +21,14 @@ class Placement:
         parent: key of another robot of the composite to attach to, or ``None`` (world).
         frame: name (unprefixed) of a site or body of ``parent`` to attach at; the robot's
             root is welded there (its free joint, if any, is dropped).
+        orientation: a full orientation (w, x, y, z) instead of ``yaw`` (normalised).
     """
 
     pos: Vec3 = (0.0, 0.0, 0.0)
     yaw: float = 0.0
     parent: str | None = None
     frame: str | None = None
+    orientation: Quat | None = None
 
     def __post_init__(self) -> None:
         if len(self.pos) != 3 or not all(math.isfinite(float(v)) for v in self.pos):
@@ -40,10 +42,23 @@ class Placement:
             )
         object.__setattr__(self, "pos", tuple(float(v) for v in self.pos))
         object.__setattr__(self, "yaw", float(self.yaw))
+        if self.orientation is not None:
+            q = tuple(float(v) for v in self.orientation)
+            norm = math.sqrt(sum(v * v for v in q)) if len(q) == 4 else 0.0
+            if len(q) != 4 or not math.isfinite(norm) or norm == 0.0:
+                raise GeneratorError(
+                    f"Placement.orientation {self.orientation!r}: expected a non-zero "
+                    "quaternion (w, x, y, z)"
+                )
+            if self.yaw != 0.0:
+                raise GeneratorError("Placement: give yaw or orientation, not both")
+            object.__setattr__(self, "orientation", tuple(v / norm for v in q))
 
     @property
     def quat(self) -> Quat:
-        """The yaw as a quaternion (w, x, y, z)."""
+        """The orientation as a quaternion (w, x, y, z): ``orientation``, else the yaw."""
+        if self.orientation is not None:
+            return self.orientation
         if self.yaw == 0.0:
             return (1.0, 0.0, 0.0, 0.0)
         return (math.cos(self.yaw / 2), 0.0, 0.0, math.sin(self.yaw / 2))
