@@ -53,7 +53,8 @@ class B:
     pos: tuple[float, float, float]
     joint: tuple[str, str, tuple[float, float, float], tuple[float, float]] | None
     geoms: list[G]
-    sites: list[tuple[str, tuple[float, float, float]]] = field(default_factory=list)
+    #: (name, pos) or (name, pos, quat) in the body frame.
+    sites: list[tuple] = field(default_factory=list)
 
 
 def _mjcf(bodies: list[B]) -> str:
@@ -144,8 +145,9 @@ def build(
                     contact_affinity=1 if g.collide else 0,
                 )
             )
-        for sname, spos in b.sites:
-            sites.append(Site(name=sname, body=b.name, pos=spos, size=(0.01, 0.0, 0.0)))
+        for sname, spos, *squat in b.sites:
+            quat = squat[0] if squat else (1.0, 0.0, 0.0, 0.0)
+            sites.append(Site(name=sname, body=b.name, pos=spos, quat=quat, size=(0.01, 0.0, 0.0)))
     if floating:
         joints.insert(0, Joint(name=None, body=bodies[0].name, type="free"))
     meta = Meta(
@@ -197,7 +199,9 @@ def humanoid() -> HRDF:
             (0.0, 0.0, 0.28),
             ("neck_pitch_joint", "hinge", (0.0, 1.0, 0.0), (-0.6, 0.6)),
             [G("sphere", (0.08, 0.0, 0.0), (0.0, 0.0, 0.08), 1.2, rgba=DARK)],
-            [("head_lidar", (0.0, 0.0, 0.17))],
+            # Mounted upside down (as on Unitree's G1): a Mid-360's -7..52 deg field of
+            # view then looks at the floor and obstacles around the robot, not the sky.
+            [("head_lidar", (0.0, 0.0, 0.17), (0.0, 1.0, 0.0, 0.0))],
         ),
     ]
     for side, s in (("left", 1.0), ("right", -1.0)):

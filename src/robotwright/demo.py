@@ -10,15 +10,19 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import mujoco
+
 from robotwright.hrdf.cli import format_info
 from robotwright.hrdf.io import HRDFWarning
 from robotwright.hrdf.model import HRDF
+from robotwright.things import Body, Box, Cylinder, Free, World
 
 DEFAULT_OUT = Path("robotwright_demo")
 
@@ -48,8 +52,142 @@ def step_hrdf(out: Path, ctx: dict[str, Any]) -> str:
     return "; ".join(lines)
 
 
+def step_export(out: Path, ctx: dict[str, Any]) -> str:
+    from robotwright.generators.tasks import export_robot
+
+    written = []
+    for name in ("mini_humanoid", "arm6"):
+        paths = export_robot(ctx[name], out / "robots")
+        model = mujoco.MjModel.from_xml_path(str(paths["mjcf"]))
+        from_urdf = mujoco.MjModel.from_xml_path(str(paths["urdf"]))
+        written.append(
+            f"{name}.xml ({model.nbody - 1} bodies, {model.nu} actuators) + {name}.urdf "
+            f"(MuJoCo mass {from_urdf.body_mass.sum():.2f} kg)"
+        )
+    return "; ".join(written)
+
+
+def step_limb(out: Path, ctx: dict[str, Any]) -> str:
+    from robotwright.grammar import default_grammar, demo_limb_design
+    from robotwright.grammar.build import build_hrdf
+    from robotwright.grammar.demo import BACKWARDS, write_mounted_limb
+    from robotwright.grammar.mount import mount_on
+
+    summary = write_mounted_limb(out / "srl", ctx["mini_humanoid"], seed=DEMO_SEED)
+    limb = build_hrdf(default_grammar(), demo_limb_design(DEMO_SEED))
+    ctx["wearer"] = mount_on(ctx["mini_humanoid"], limb, "back_mount", quat=BACKWARDS)
+    return (
+        f"design {summary['design_hash']}: {summary['limb_dof']} DoF, "
+        f"{summary['limb_mass_kg']:.2f} kg limb on {summary['mounted_on']} "
+        f"-> {summary['robot_dof']} DoF robot"
+    )
+
+
+def step_scene(out: Path, ctx: dict[str, Any]) -> str:
+    from robotwright.generators.tasks import compose_scene
+
+    scene_dir = out / "scene"
+    robots_xml = compose_scene(
+        {"h": ctx["wearer"], "arm": ctx["arm6"]},
+        scene_dir / "two_robots.xml",
+        placements={"h": (0.0, 0.0, 0.0, 0.0), "arm": (1.2, 0.8, 0.0, math.pi)},
+    )
+    world = furnish(World.from_xml_path(robots_xml))
+    scene = scene_dir / "semantic_scene.xml"
+    world.export(scene)
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    ctx["scene_model"], ctx["scene_data"] = model, data
+    return (
+        f"two_robots.xml (humanoid wearing the limb + arm) and semantic_scene.xml "
+        f"({model.nbody - 1} bodies, {model.ngeom} geoms, {model.nu} actuators, "
+        f"{data.ncon} contacts at t=0: props resting on floor and table)"
+    )
+
+
+def step_lidar(out: Path, ctx: dict[str, Any]) -> str:
+    from robotwright.sensors import scan_to_files
+
+    (out / "lidar").mkdir(parents=True, exist_ok=True)
+    summary = scan_to_files(
+        ctx["scene_model"],
+        ctx["scene_data"],
+        "h_head_lidar",
+        "mid360",
+        out / "lidar" / "scan.npz",
+        out / "lidar" / "scan.png",
+        semantic_class_mapping=DEMO_CLASSES,
+        title="Semantic LiDAR (Mid-360-like pattern) from the humanoid's head",
+    )
+    counts = ", ".join(f"{k} {v}" for k, v in summary["class_counts"].items() if v)
+    return f"{summary['num_hits']} of {summary['num_rays']} rays hit: {counts}"
+
+
+#: The seed's default classes, plus the other robot in the scene.
+DEMO_CLASSES: dict[str, list[str]] = {
+    "terrain": ["ground", "wall", "floor", "plane"],
+    "dynamic_obstacle": ["cracker_box", "sugar_box", "tomato_soup_can"],
+    "valuable": ["sofa", "armchair", "table", "chair", "desk"],
+    "robot": ["arm_"],
+}
+DEMO_SEED = 3
+
+
+def furnish(world: World) -> World:
+    """Add walls, boxes and furniture named so that each falls in one semantic class."""
+    wood, fabric, card = (0.55, 0.38, 0.22, 1.0), (0.25, 0.35, 0.6, 1.0), (0.85, 0.2, 0.15, 1.0)
+    grey = (0.8, 0.8, 0.78, 1.0)
+    for name, pos, size in (
+        ("wall_north", (0.5, 4.0, 1.0), (4.5, 0.05, 1.0)),
+        ("wall_south", (0.5, -3.0, 1.0), (4.5, 0.05, 1.0)),
+        ("wall_east", (5.0, 0.5, 1.0), (0.05, 3.5, 1.0)),
+        ("wall_west", (-4.0, 0.5, 1.0), (0.05, 3.5, 1.0)),
+    ):
+        world.attach(Body(name, pos=pos).attach(Box(f"{name}_geom", size=size, rgba=grey)))
+    table = Body("table", pos=(2.0, -1.2, 0.0))
+    table.attach(Box("table_top", pos=(0, 0, 0.72), size=(0.6, 0.4, 0.02), rgba=wood))
+    for i, (x, y) in enumerate(((0.55, 0.35), (0.55, -0.35), (-0.55, 0.35), (-0.55, -0.35))):
+        table.attach(Box(f"table_leg_{i}", pos=(x, y, 0.35), size=(0.025, 0.025, 0.35), rgba=wood))
+    sofa = Body("sofa", pos=(-2.2, 2.2, 0.0))
+    sofa.attach(
+        Box("sofa_seat", pos=(0, 0, 0.22), size=(0.9, 0.4, 0.22), rgba=fabric),
+        Box("sofa_back", pos=(0, 0.33, 0.6), size=(0.9, 0.08, 0.3), rgba=fabric),
+    )
+    chair = Body("chair", pos=(2.6, 1.8, 0.0))
+    chair.attach(
+        Box("chair_seat", pos=(0, 0, 0.45), size=(0.22, 0.22, 0.02), rgba=wood),
+        Box("chair_back", pos=(0, 0.2, 0.7), size=(0.22, 0.02, 0.25), rgba=wood),
+        Box("chair_post", pos=(0, 0, 0.22), size=(0.03, 0.03, 0.22), rgba=wood),
+    )
+    world.attach(table, sofa, chair)
+    for i, (x, y) in enumerate(((1.6, -0.3), (-1.5, -1.4), (0.6, 2.4))):
+        box = Body(f"cracker_box_{i}", pos=(x, y, 0.15))
+        box.attach(
+            Free(f"cracker_box_{i}_free"),
+            Box(f"cracker_box_{i}_geom", size=(0.08, 0.03, 0.15), rgba=card, mass=0.4),
+        )
+        world.attach(box)
+    can = Body("tomato_soup_can_0", pos=(-1.0, 0.9, 0.05))
+    can.attach(
+        Free("tomato_soup_can_0_free"),
+        Cylinder("tomato_soup_can_0_geom", size=(0.035, 0.05), rgba=card, mass=0.35),
+    )
+    sugar = Body("sugar_box_0", pos=(1.9, -1.1, 0.83))
+    sugar.attach(
+        Free("sugar_box_0_free"),
+        Box("sugar_box_0_geom", size=(0.045, 0.02, 0.09), rgba=(0.95, 0.9, 0.3, 1.0), mass=0.5),
+    )
+    world.attach(can, sugar)
+    return world
+
+
 STEPS: list[tuple[str, Callable[[Path, dict[str, Any]], str]]] = [
     ("bundled robots (HRDF)", step_hrdf),
+    ("export to MJCF and URDF (generators)", step_export),
+    ("grow a limb with the grammar and mount it", step_limb),
+    ("compose a scene and furnish it (composite + Things)", step_scene),
+    ("semantic LiDAR scan (sensors)", step_lidar),
 ]
 
 
@@ -58,16 +196,23 @@ def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
     out.mkdir(parents=True, exist_ok=True)
     ctx: dict[str, Any] = {}
     results: dict[str, str] = {}
+    notes: list[str] = []
     for i, (title, step) in enumerate(STEPS, 1):
         t0 = time.perf_counter()
         print(f"[{i}/{len(STEPS)}] {title} ...", flush=True)
-        results[title] = step(out, ctx)
-        print(f"      {results[title]} ({time.perf_counter() - t0:.1f} s)", flush=True)
+        # Conversion notes (values a format cannot hold) go to a file, not the terminal.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            results[title] = step(out, ctx)
+        notes += [f"[{title}] {w.category.__name__}: {w.message}" for w in caught]
+        note = f", {len(caught)} conversion note(s)" if caught else ""
+        print(f"      {results[title]} ({time.perf_counter() - t0:.1f} s{note})", flush=True)
     (out / "summary.json").write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
+    (out / "conversion_notes.txt").write_text("\n".join(notes) + "\n", encoding="utf-8")
     return results
 
 
 def _run(args: argparse.Namespace) -> int:
     run_demo(args.out)
-    print(f"demo written to {args.out.resolve()}")
+    print(f"demo written to {args.out.resolve()} (summary.json, conversion_notes.txt)")
     return 0
