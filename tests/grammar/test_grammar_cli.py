@@ -103,3 +103,21 @@ def test_search_and_export(tmp_path, capsys):
     assert main(["grammar", "export", str(out / "design.json"), "-o", str(again)]) == 0
     assert (again / "srl.xml").read_text() == (out / "srl.xml").read_text()
     assert main(["grammar", "search", "--constraint", "shiny", "--budget", "2"]) == 2
+
+
+def test_show_prints_tree_dh_and_dot(tmp_path, capsys):
+    design = tmp_path / "d.txt"
+    design.write_text(
+        "# grammar=srl\n"
+        "r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()\n"
+        "r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)\n"
+        "r4 @3: E=tool(length=0.08)\n"
+    )
+    assert main(["grammar", "show", str(design)]) == 0
+    out = capsys.readouterr().out
+    assert "2 DoF" in out and "  L:link(" in out and "joint2   hinge  a=0        alpha=1.571" in out
+    assert main(["grammar", "show", str(design), "--dot"]) == 0
+    assert capsys.readouterr().out.count("->") == 4
+    design.write_text("# grammar=srl\nr2 @0: C=universal(limit=1.5708)\n")
+    assert main(["grammar", "show", str(design)]) == 2
+    assert "step 0" in capsys.readouterr().err

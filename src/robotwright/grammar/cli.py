@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-from robotwright.errors import GrammarError
+from robotwright.errors import GrammarError, Problem
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -69,6 +69,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     q.set_defaults(func=_search)
 
+    q = gsub.add_parser("show", help="print a design: steps, tree, DH table per branch")
+    common(q)
+    q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
+    q.add_argument("--dot", action="store_true", help="print the design tree as Graphviz DOT only")
+    q.set_defaults(func=_show)
+
     q = gsub.add_parser("export", help="write the files of a design given as text or JSON")
     common(q)
     q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
@@ -112,6 +118,9 @@ def _check(args: argparse.Namespace) -> int:
 def _count(args: argparse.Namespace) -> int:
     from robotwright.grammar.derive import count, count_by_links, enumerate_designs
 
+    if args.max_links < 0:
+        print(f"error: --max-links must be >= 0, got {args.max_links}", file=sys.stderr)
+        return 2
     g = _grammar(args)
     total = count(g, args.max_links)
     print(f"designs with at most {args.max_links} link(s): {total}")
@@ -179,18 +188,59 @@ def _search(args: argparse.Namespace) -> int:
     return 0
 
 
-def _export(args: argparse.Namespace) -> int:
+def _read_design(path: Path):
     from robotwright.grammar.design import Design
+
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise GrammarError(
+            [Problem(str(path), f"cannot read design: {exc.strerror or exc}")]
+        ) from exc
+    src = str(path)
+    if text.lstrip().startswith("{"):
+        return Design.from_json(text, src)
+    return Design.from_text(text, src)
+
+
+def _show(args: argparse.Namespace) -> int:
+    from robotwright.grammar.build import build
+    from robotwright.grammar.derive import replay
+    from robotwright.grammar.design import to_dot
+
+    g = _grammar(args)
+    d = _read_design(args.design)
+    tree = replay(g, d, str(args.design))
+    if args.dot:
+        print(to_dot(tree, d.hash()), end="")
+        return 0
+    limb = build(g, d)
+    hrdf = limb.to_hrdf()
+    print(d.to_text(), end="")
+    print(f"{limb.dof} DoF, {hrdf.total_mass:.4f} kg, {len(limb.bodies)} bodies")
+    for n in tree.walk():
+        depth, p = 0, n.parent
+        while p is not None:
+            depth, p = depth + 1, p.parent
+        print(f"{'  ' * depth}{n.label()}")
+    for k, br in enumerate(limb.branches):
+        print(
+            f"branch {k} -> site '{br.site}': modified DH (a_i-1 m, alpha_i-1 rad, d_i m, theta_i rad)"
+        )
+        z0 = br.base_frame[:3, 3]
+        print(f"  frame 0 in the mount frame at ({z0[0]:.4g}, {z0[1]:.4g}, {z0[2]:.4g}) m")
+        for r in br.rows:
+            print(
+                f"  {r.name:8s} {r.type:6s} a={r.a:<8.4g} alpha={r.alpha:<8.4g} d={r.d:<8.4g} theta={r.theta:.4g}"
+            )
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
     from robotwright.grammar.export import export_design
 
     g = _grammar(args)
-    text = args.design.read_text(encoding="utf-8")
-    src = str(args.design)
-    d = (
-        Design.from_json(text, src)
-        if text.lstrip().startswith("{")
-        else Design.from_text(text, src)
-    )
+    d = _read_design(args.design)
     export_design(g, d, args.out, overwrite=True)
     print(f"{args.out}: {d.hash()}")
     return 0
