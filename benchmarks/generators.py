@@ -62,10 +62,12 @@ print("ready", flush=True)
 for line in sys.stdin:
     task = line.strip()
     with contextlib.redirect_stdout(sink):
+        c = time.process_time()
         t = time.perf_counter()
         tasks[task]()
         dt = time.perf_counter() - t
-    print(repr(dt), flush=True)
+        dc = time.process_time() - c
+    print(repr(dt), repr(dc), flush=True)
 """
 
 
@@ -143,7 +145,7 @@ class HurodesWorker:
                 f"hurodes worker failed:\n{self.proc.stderr.read() if self.proc.stderr else ''}"
             )
 
-    def time(self, task: str) -> float:
+    def time(self, task: str) -> tuple[float, float]:
         assert self.proc.stdin is not None and self.proc.stdout is not None
         self.proc.stdin.write(task + "\n")
         self.proc.stdin.flush()
@@ -152,7 +154,8 @@ class HurodesWorker:
             raise SystemExit(
                 f"hurodes worker died:\n{self.proc.stderr.read() if self.proc.stderr else ''}"
             )
-        return float(line)
+        wall, cpu = line.split()
+        return float(wall), float(cpu)
 
     def close(self) -> None:
         if self.proc.stdin is not None:
@@ -182,8 +185,8 @@ def main(argv: list[str] | None = None) -> int:
     robot = args.robot.resolve()
     if not (robot / "meta.yaml").is_file():
         raise SystemExit(f"{robot}: not an HRDF folder")
-    ours: dict[str, list[float]] = {}
-    theirs: dict[str, list[float]] | None = {} if args.hurodes_python else None
+    ours: dict[str, list[tuple[float, float]]] = {}
+    theirs: dict[str, list[tuple[float, float]]] | None = {} if args.hurodes_python else None
     with tempfile.TemporaryDirectory(dir=args.out_dir) as tmp:
         out = Path(tmp)
         copy, filled = prepare_robot(robot, out / "assets", args.peak_velocity)
@@ -199,9 +202,11 @@ def main(argv: list[str] | None = None) -> int:
                 # Interleave the two tools task by task, so a busy machine slows both alike.
                 for _ in range(args.repeat):
                     for task, fn in tasks.items():
+                        c = time.process_time()
                         t = time.perf_counter()
                         fn()
-                        ours.setdefault(task, []).append(time.perf_counter() - t)
+                        dt = time.perf_counter() - t
+                        ours.setdefault(task, []).append((dt, time.process_time() - c))
                         if worker is not None and theirs is not None:
                             theirs.setdefault(task, []).append(worker.time(task))
             finally:
@@ -214,16 +219,29 @@ def main(argv: list[str] | None = None) -> int:
             f"note: {filled} empty peak_velocity cell(s) set to {args.peak_velocity} rad/s "
             "in the copy both tools read (hurodes' URDF export needs them)"
         )
-    header = f"{'task':<12} {'robotwright ms':>15} {'hurodes ms':>12} {'speed-up':>9}"
+    header = (
+        f"{'task':<12} {'ours wall':>10} {'hurodes wall':>13} {'ratio':>6}"
+        f" {'ours cpu':>9} {'hurodes cpu':>12} {'ratio':>6}   (ms, medians)"
+    )
     print(header)
     print("-" * len(header))
     for task, values in ours.items():
-        mine = statistics.median(values) * 1e3
+        wall = statistics.median(v[0] for v in values) * 1e3
+        cpu = statistics.median(v[1] for v in values) * 1e3
         if theirs is None:
-            print(f"{task:<12} {mine:>15.2f} {'-':>12} {'-':>9}")
+            print(f"{task:<12} {wall:>10.2f} {'-':>13} {'-':>6} {cpu:>9.2f} {'-':>12} {'-':>6}")
             continue
-        other = statistics.median(theirs[task]) * 1e3
-        print(f"{task:<12} {mine:>15.2f} {other:>12.2f} {other / mine:>8.1f}x")
+        hw = statistics.median(v[0] for v in theirs[task]) * 1e3
+        hc = statistics.median(v[1] for v in theirs[task]) * 1e3
+        print(
+            f"{task:<12} {wall:>10.2f} {hw:>13.2f} {hw / wall:>5.1f}x"
+            f" {cpu:>9.2f} {hc:>12.2f} {hc / cpu:>5.1f}x"
+        )
+    if os.getloadavg()[0] > (os.cpu_count() or 1):
+        print(
+            f"note: load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores: wall "
+            "times include waiting for the CPU; the CPU-time columns do not"
+        )
     return 0
 
 
