@@ -137,3 +137,12 @@ def test_replay_rejects_bad_designs_with_step_and_field():
 def test_sample_with_impossible_budget_errors():
     with pytest.raises(GrammarError, match="at most 0 link"):
         derive.sample(default_grammar(), 0, random.Random(0))
+
+
+def test_feasibility_cache_does_not_depend_on_the_first_limit():
+    g = default_grammar()
+    c = derive.Counter(g)
+    p = Partial.start(g)
+    assert not c.feasible(p, 0)  # every design needs a link
+    assert c.feasible(p, 3)
+    assert c.min_links(g.start_state, 0) is None and c.min_links(g.start_state, 5) == 1

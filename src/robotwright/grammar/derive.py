@@ -170,6 +170,8 @@ class Counter:
         self.grammar = grammar
         self._g: dict[tuple[NodeState, int], int] = {}
         self._busy: set[tuple[NodeState, int]] = set()
+        # state -> (fewest links found or None, largest link count searched)
+        self._min: dict[NodeState, tuple[int | None, int]] = {}
 
     def g(self, state: NodeState, n: int) -> int:
         if n < 0:
@@ -208,12 +210,17 @@ class Counter:
         first, rest = states[0], tuple(states[1:])
         return sum(self.g(first, k) * self.conv(rest, n - k) for k in range(n + 1))
 
-    def min_links(self, state: NodeState, limit: int = 64) -> int | None:
-        """Fewest links that finish a node in ``state`` (None if none within ``limit``)."""
-        key = ("min", state)
-        if key not in self._g:
-            self._g[key] = next((n for n in range(limit + 1) if self.g(state, n) > 0), None)  # type: ignore[index]
-        return self._g[key]  # type: ignore[index]
+    def min_links(self, state: NodeState, limit: int) -> int | None:
+        """Fewest links that finish a node in ``state``, or None if more than ``limit``."""
+        found, searched = self._min.get(state, (None, -1))
+        if found is not None:
+            return found if found <= limit else None
+        for n in range(searched + 1, limit + 1):
+            if self.g(state, n) > 0:
+                self._min[state] = (n, n)
+                return n
+        self._min[state] = (None, max(searched, limit))
+        return None
 
     def feasible(self, partial: Partial, max_links: int) -> bool:
         """Whether some completion of ``partial`` has at most ``max_links`` links."""
@@ -385,7 +392,7 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
         if not head.keep:
             ch = next(it)
             node.symbol, node.component, node.params, node.rule = (
-                sym_of(ch),
+                ch.symbol,
                 ch.component,
                 ch.param_dict,
                 rule.name,
@@ -415,10 +422,6 @@ def replay(grammar: Grammar, design: Design, source: str = "<design>") -> Design
             ]
         )
     return nodes[0]
-
-
-def sym_of(choice: Choice) -> str:
-    return choice.symbol
 
 
 def _check_choice(grammar: Grammar, symbol: str, ch: Choice, fail) -> None:
