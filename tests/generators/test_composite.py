@@ -231,3 +231,13 @@ def test_placement_full_orientation():
     np.testing.assert_allclose(d.xquat[m.body("arm_base_link").id], q, atol=1e-12)
     with pytest.raises(GeneratorError, match="not both"):
         Placement(yaw=0.1, orientation=q)
+
+
+def test_nested_composite_and_outer_prefix():
+    inner = MJCFGeneratorComposite({"a": _gen("arm6"), "b": _gen("arm6")}, {"b": (0.5, 0, 0)})
+    outer = MJCFGeneratorComposite({"pair": inner, "h": _gen("mini_humanoid")}, {"pair": (0, 2, 0)})
+    m = outer.to_model(prefix="s")
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(d.xpos[m.body("s_pair_b_base_link").id], [0.5, 2.0, 0.0], atol=1e-12)
+    assert m.body("s_h_pelvis").id > 0

@@ -234,3 +234,11 @@ def test_bundled_robots_compile_and_step(name):
     for _ in range(200):
         mujoco.mj_step(m, d)
     assert np.isfinite(d.qpos).all()
+
+
+def test_unknown_imu_value_is_a_clear_error(synth_urdf_safe):
+    imu = ImuConfig("base", value=["linacc", "magnetic"])
+    meta = dataclasses.replace(synth_urdf_safe.meta, imu_config_list=[imu])
+    h = dataclasses.replace(synth_urdf_safe, meta=meta)
+    with pytest.raises(GeneratorError, match="IMU value 'magnetic'"):
+        MJCFHumanoidGenerator.from_hrdf(h).export()

@@ -144,3 +144,11 @@ def test_site_name_equal_to_body_name_is_an_error(synth_urdf_safe):
     bad = dataclasses.replace(synth_urdf_safe, sites=[site], sensors=[])
     with pytest.raises(GeneratorError, match=r"site/IMU name\(s\) \['link1'\] equal a body name"):
         URDFHumanoidGenerator.from_hrdf(bad).export()
+
+
+def test_urdf_prefix_names_links_joints_materials(synth_urdf_safe):
+    root = ET.fromstring(_export(synth_urdf_safe, prefix="r"))
+    names = [e.get("name") for e in root if e.tag in ("link", "joint", "material")]
+    assert all(n == "world" or n.startswith("r_") for n in names), names
+    refs = [e.get("link") for e in root.iter() if e.tag in ("parent", "child")]
+    assert all(r == "world" or r.startswith("r_") for r in refs)

@@ -147,7 +147,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         mesh_names = self._add_mesh_assets(hrdf, prefix)
         self._add_bodies(hrdf, prefix, mesh_names, losses)
         self._add_actuators(hrdf, prefix, losses)
-        self._add_sensors(hrdf, prefix)
+        self._add_sensors(hrdf, prefix, losses)
         extra = parse_mjcf_extra(hrdf)
         if extra is not None:
             prefix_tree(extra, prefix)
@@ -343,12 +343,17 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         for row, a in enumerate(hrdf.actuators):
             section.append(_actuator_elem(a, prefix, row, losses))
 
-    def _add_sensors(self, hrdf: HRDF, prefix: str | None) -> None:
+    def _add_sensors(self, hrdf: HRDF, prefix: str | None, losses: list[Problem]) -> None:
         section = self.get_elem("sensor")
         for imu, (name, _) in zip(hrdf.meta.imu_config_list or [], imu_sites(hrdf), strict=True):
             site = prefixed(prefix, name)
             for value in imu.value:
-                kind = IMU_SENSORS[value]
+                kind = IMU_SENSORS.get(value)
+                if kind is None:
+                    raise GeneratorError(
+                        f"robot '{hrdf.name}': meta.yaml imu_config_list: IMU value "
+                        f"'{value}': expected one of {sorted(IMU_SENSORS)}"
+                    )
                 attrs = {"name": prefixed(prefix, f"{name}_{value}")}
                 if kind == "framequat":
                     attrs |= {"objtype": "site", "objname": site}
@@ -363,6 +368,15 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                     attrs |= {"reftype": s.reftype, "refname": prefixed(prefix, s.refname)}
             else:
                 attrs[s.objtype] = prefixed(prefix, s.objname)
+                if s.reftype is not None or s.refname is not None:
+                    losses.append(
+                        Problem(
+                            "sensor.csv",
+                            f"sensor '{s.name}' ({s.type}): only frame sensors take a "
+                            "reference frame; reftype/refname dropped",
+                            column="reftype",
+                        )
+                    )
             if s.noise:
                 attrs["noise"] = fmt_float(s.noise)
             if s.cutoff:
