@@ -309,3 +309,18 @@ def test_unmodelled_sections_are_carried_and_keep_actuator_and_sensor_order():
     np.testing.assert_allclose(world.model.key_ctrl, original.key_ctrl)
     xml = world.to_xml_string()
     assert World.from_xml_string(xml).to_xml_string() == xml
+
+
+def test_inline_mesh_round_trips_and_foreign_references_are_clear_errors():
+    tet = Mesh("tet", vertex=[0, 0, 0, 0.1, 0, 0, 0, 0.1, 0, 0, 0, 0.1])
+    world = _world(Body("b").attach(tet))
+    assert world.model.nmesh == 1 and world.model.mesh_vertnum[0] == 4
+    xml = world.to_xml_string()
+    assert '<mesh name="tet" vertex=' in xml
+    assert World.from_xml_string(xml).to_xml_string() == xml
+    from robotwright.things import Camera, ThingAttributeError
+
+    outsider = Body("outsider")
+    world.attach(Body("c").attach(Camera(mode="targetbody", target=outsider)))
+    with pytest.raises(ThingAttributeError, match="Body 'outsider' .* not part of this World"):
+        world.to_xml_string()

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from typing import Any
 from xml.sax.saxutils import escape
 
+from robotwright.things.attrs import ThingAttributeError
 from robotwright.things.base import BaseThing
 
 _QUOTE = {'"': "&quot;"}
@@ -44,9 +45,14 @@ class _Writer:
     def ref_name(self, value: Any) -> str:
         if isinstance(value, str):
             return value
-        if value._NAMESPACE is None:
-            return self.asset_names[value.ID]
-        return self.names[value.ID]
+        table = self.asset_names if value._NAMESPACE is None else self.names
+        try:
+            return table[value.ID]
+        except KeyError:
+            raise ThingAttributeError(
+                f"{value._label()} is referred to but is not part of this World's tree "
+                "(attach it, or refer to it by name)"
+            ) from None
 
     def attrs(self, thing: BaseThing, skip: frozenset[str] | set[str] = frozenset()) -> str:
         parts: list[str] = []
@@ -88,7 +94,9 @@ class _Writer:
                     (k, _hashable(getattr(thing, k))) for k in Mesh._ASSET_ATTR if k != "mesh"
                 )
                 base = thing.mesh or (
-                    os.path.splitext(os.path.basename(thing.file))[0] if thing.file else "mesh"
+                    os.path.splitext(os.path.basename(thing.file))[0]
+                    if thing.file
+                    else thing._name or "mesh"
                 )
                 mesh_keys.append((key, base))
                 self.mesh_of_geom[thing.ID] = repr((key, base))
