@@ -54,3 +54,10 @@ def test_parse_robot_spec():
     assert parse_robot_spec("k=arm6@1,2,3")[0:2] == ("k", "arm6")
     key, robot, p = parse_robot_spec("/some/path@0,0,1,0.5")
     assert key is None and robot == "/some/path" and p.yaw == 0.5 and p.pos == (0, 0, 1)
+
+
+def test_export_prints_conversion_notes_as_warnings(tmp_path, capsys):
+    assert main(["export", "arm6", "--format", "urdf", "-o", str(tmp_path / "a.urdf")]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith("warning: robot 'arm6' to URDF:")
+    assert "capsule" in err

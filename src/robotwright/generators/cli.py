@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
+import warnings
 from pathlib import Path
 
 from robotwright.errors import GeneratorError
@@ -47,7 +49,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_compose)
 
 
+def _print_warnings(caught: list[warnings.WarningMessage]) -> None:
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
+
+
 def _export(args: argparse.Namespace) -> int:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        code = _export_quiet(args)
+    _print_warnings(caught)
+    return code
+
+
+def _export_quiet(args: argparse.Namespace) -> int:
     hrdf = load_robot(args.robot)
     out = Path(args.output)
     if args.format == "mjcf":
@@ -87,6 +102,14 @@ def parse_robot_spec(spec: str) -> tuple[str | None, str, Placement | None]:
 
 
 def _compose(args: argparse.Namespace) -> int:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        code = _compose_quiet(args)
+    _print_warnings(caught)
+    return code
+
+
+def _compose_quiet(args: argparse.Namespace) -> int:
     robots: list[tuple[str, object]] = []
     placements: dict[str, Placement] = {}
     used: dict[str, int] = {}
