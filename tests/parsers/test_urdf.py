@@ -91,7 +91,7 @@ def test_keep_policy_matches_mujoco_import_except_massless_tcp(arm: Path) -> Non
     ref = urdf_mujoco_view(arm)
     ours = view_from_model(our_mjcf_model(hrdf))
     mimic = {"finger_joint": ("rail", 2.5, 0.1)}
-    rows = compare_views(ref, ours, configs=20, mimic=mimic)
+    rows = compare_views(ref, ours, configs=20, mimic=mimic, collision_only=True)
     assert all(r.ok for r in rows if r.check != "actuators (order, type, gains, ranges)"), rows
 
 

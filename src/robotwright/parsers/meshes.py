@@ -79,7 +79,8 @@ class MeshStore:
         if key in self.staged:
             return self.staged[key]
         try:
-            mesh = trimesh.load(str(source), force="mesh")
+            # process=False: keep triangles exactly as in the file (no merging/cleaning)
+            mesh = trimesh.load(str(source), force="mesh", process=False)
         except Exception as exc:  # trimesh raises many types; name the file
             raise MeshConversionError(f"cannot read mesh {source}: {exc}") from exc
         mesh.apply_transform(np.diag([*signs, 1.0]))
@@ -142,7 +143,7 @@ def convert_to_stl(source: Path, dest: Path) -> int:
     import trimesh
 
     try:
-        loaded = trimesh.load(str(source), force="mesh")
+        loaded = trimesh.load(str(source), force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types; name the file and re-raise
         raise MeshConversionError(f"cannot read mesh {source}: {exc}") from exc
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:

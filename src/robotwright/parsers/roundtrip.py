@@ -121,6 +121,7 @@ def compare_views(
     configs: int = 50,
     mimic: dict | None = None,
     full: bool = True,
+    collision_only: bool = False,
 ) -> list[Row]:
     """Rows comparing ``ours`` with ``ref``. ``full=False`` checks total mass and FK only."""
     rows: list[Row] = []
@@ -233,6 +234,9 @@ def compare_views(
                     same,
                 )
             )
+            if ours.model is not None and ref.model is not None:
+                rows.append(compare_geoms(ref, ours, tol, collision_only))
+                rows.append(compare_extras(ref, ours, tol))
 
     # Forward kinematics.
     names = [b for b in ref.bodies if b in our_frames] + [s for s in ref.sites if s in our_frames]
@@ -254,6 +258,114 @@ def compare_views(
         )
     )
     return rows
+
+
+def _geom_records(model: mujoco.MjModel, bodies: set[str], collision_only: bool) -> list:
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    out = []
+    for g in range(model.ngeom):
+        b = model.body(int(model.geom_bodyid[g])).name or f"body_{int(model.geom_bodyid[g])}"
+        if b not in bodies:
+            continue
+        if collision_only and model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0:
+            continue
+        t = int(model.geom_type[g])
+        verts = int(model.mesh_vertnum[model.geom_dataid[g]]) if t == 7 else 0
+        out.append(
+            (
+                t,
+                verts,
+                model.geom_size[g].copy(),
+                data.geom_xpos[g].copy(),
+                data.geom_xmat[g].reshape(3, 3).copy(),
+            )
+        )
+    return out
+
+
+def compare_geoms(ref: RobotView, ours: RobotView, tol: float, collision_only: bool) -> Row:
+    """Each reference geom matched to the closest of ours with the same type (and mesh
+    vertex count): worst size, world position and orientation error at the zero pose."""
+    ref_bodies = set(ref.bodies)
+    our_bodies = set(ours.bodies)
+    a = _geom_records(ref.model, ref_bodies, collision_only)
+    b = _geom_records(ours.model, our_bodies, collision_only)
+    worst, unmatched = 0.0, 0
+    free = list(range(len(b)))
+    for t, verts, size, pos, rot in a:
+        best, best_k = None, None
+        for k in free:
+            t2, v2, size2, pos2, rot2 = b[k]
+            if t2 != t or v2 != verts:
+                continue
+            err = max(float(np.abs(size - size2).max()), float(np.abs(pos - pos2).max()))
+            if t not in (2,):  # a sphere has no orientation to compare
+                err = max(err, quat_angle(rot, rot2))
+            if best is None or err < best:
+                best, best_k = err, k
+        if best_k is None:
+            unmatched += 1
+            continue
+        free.remove(best_k)
+        worst = max(worst, best)
+    kind = "collision geoms" if collision_only else "geoms"
+    return Row(
+        f"{kind} (type, size, pose at q0)",
+        f"{len(a)}/{len(b)} max err {worst:.1e}"
+        + (f", {unmatched} unmatched" if unmatched else ""),
+        worst <= tol and unmatched == 0 and len(a) == len(b),
+    )
+
+
+def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
+    """Equality constraints, tendons, contact excludes/pairs and keyframes of the compiled
+    models: counts, equality data, tendon lengths at the zero pose, keyframe vectors."""
+    m1, m2 = ref.model, ours.model
+    problems = []
+    for attr in ("neq", "ntendon", "nexclude", "npair", "nkey"):
+        if getattr(m1, attr) != getattr(m2, attr):
+            problems.append(f"{attr} {getattr(m1, attr)}/{getattr(m2, attr)}")
+    if not problems:
+        if m1.neq:
+            # Matched by (type, object names): importers order equalities differently.
+            def eqs(m: mujoco.MjModel) -> dict:
+                out = {}
+                for i in range(m.neq):
+                    ot = int(m.eq_objtype[i])
+                    if ot == 0:  # MuJoCo leaves it unset for joint/tendon couplings
+                        ot = {2: mujoco.mjtObj.mjOBJ_JOINT, 3: mujoco.mjtObj.mjOBJ_TENDON}.get(
+                            int(m.eq_type[i]), mujoco.mjtObj.mjOBJ_BODY
+                        )
+                    key = (
+                        int(m.eq_type[i]),
+                        mujoco.mj_id2name(m, ot, int(m.eq_obj1id[i])),
+                        mujoco.mj_id2name(m, ot, int(m.eq_obj2id[i])),
+                    )
+                    out[key] = m.eq_data[i]
+                return out
+
+            e1, e2 = eqs(m1), eqs(m2)
+            if set(e1) != set(e2) or any(
+                np.abs(e1[k] - e2[k]).max() > tol * max(1.0, np.abs(e1[k]).max()) for k in e1
+            ):
+                problems.append("equality constraints differ")
+        if m1.ntendon:
+            d1, d2 = mujoco.MjData(m1), mujoco.MjData(m2)
+            mujoco.mj_fwdPosition(m1, d1)
+            mujoco.mj_fwdPosition(m2, d2)
+            if np.abs(d1.ten_length - d2.ten_length).max() > tol:
+                problems.append("tendon lengths differ")
+        if m1.nkey and m1.nq == m2.nq and np.abs(m1.key_qpos - m2.key_qpos).max() > tol:
+            problems.append("keyframe qpos differ")
+        sig = lambda m: sorted(  # noqa: E731 - a tiny key function
+            tuple(sorted((int(s) >> 16, int(s) & 0xFFFF))) for s in m.exclude_signature
+        )
+        names = lambda m, pairs: [(m.body(x).name, m.body(y).name) for x, y in pairs]  # noqa: E731
+        if sorted(names(m1, sig(m1))) != sorted(names(m2, sig(m2))):
+            problems.append("contact excludes differ")
+    summary = f"eq {m1.neq}, tendons {m1.ntendon}, excludes {m1.nexclude}, pairs {m1.npair}, keys {m1.nkey}"
+    return Row("equality/tendon/contact/keyframe", summary, not problems, "; ".join(problems))
 
 
 def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
@@ -372,7 +484,8 @@ def roundtrip(
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
         return report
-    for r in compare_views(ref, ours, configs=configs, mimic=mimic):
+    collision_only = source_kind(path) == "urdf"  # MuJoCo's URDF import drops visuals
+    for r in compare_views(ref, ours, configs=configs, mimic=mimic, collision_only=collision_only):
         r.check = "MJCF: " + r.check
         report.rows.append(r)
     if urdf:

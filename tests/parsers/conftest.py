@@ -1,0 +1,100 @@
+"""Fixtures of the parser tests: small MJCF models written to a temporary folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import trimesh
+
+MODEL = """<mujoco model="probe">
+  <compiler angle="degree"/>
+  <option timestep="0.004" gravity="0 0 -9.7"/>
+  <default>
+    <joint damping="0.3" armature="0.01"/>
+    <default class="leg"><joint range="-45 45" frictionloss="0.2"/>
+      <geom rgba="0.1 0.2 0.3 1" friction="0.8 0.01 0.001" condim="4" group="1"/></default>
+  </default>
+  <asset><mesh name="tet" file="tet.stl" scale="0.5 0.5 2"/>
+    <material name="shiny" rgba="0.9 0.8 0.7 1"/></asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="5 5 .1"/>
+    <light pos="0 0 3"/>
+    <body name="torso" pos="0 0 1" euler="0 0 30">
+      <freejoint name="root"/>
+      <geom type="capsule" fromto="0 -.1 0 0 .1 0" size=".05" mass="3"/>
+      <geom type="mesh" mesh="tet" pos=".1 0 0" euler="10 20 30" material="shiny"/>
+      <site name="imu" pos="0 0 .05" euler="0 90 0"/>
+      <body name="hip" pos="0 .1 -.1" childclass="leg">
+        <joint name="hip_x" axis="1 0 0"/>
+        <joint name="hip_y" axis="0 1 0" pos="0 0 .01"/>
+        <geom type="box" size=".02 .03 .1" pos="0 0 -.1"/>
+        <body name="shin" pos="0 0 -.2">
+          <joint name="knee" type="slide" axis="0 0 1" range="-.05 .05"/>
+          <geom type="cylinder" fromto="0 0 0 0 0 -.2" size=".02"/>
+          <site name="foot" pos="0 0 -.2"/>
+          <body name="ankle" pos="0 0 -.2"><joint name="ankle" type="ball" range="0 30"/>
+            <geom type="sphere" size=".03" mass=".2"/></body>
+        </body>
+      </body>
+      <body name="arm" pos="0 -.1 0" quat="0.9 0.1 0.2 0.3">
+        <joint name="shoulder" axis="0 1 0" stiffness="2" springref="10" ref="5"/>
+        <geom type="ellipsoid" size=".03 .04 .05"/>
+      </body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="coupling"><joint joint="hip_x" coef="1"/><joint joint="shoulder" coef="-.5"/></fixed></tendon>
+  <equality><joint joint1="hip_y" joint2="hip_x" polycoef="0.1 2 0 0 0"/></equality>
+  <contact><exclude body1="torso" body2="hip"/></contact>
+  <actuator>
+    <motor name="m_hip" joint="hip_x" gear="40" ctrlrange="-1 1"/>
+    <position name="p_knee" joint="knee" kp="300" kv="5" forcerange="-90 90"/>
+    <velocity name="v_sh" joint="shoulder" kv="12"/>
+  </actuator>
+  <sensor>
+    <gyro name="gyro" site="imu"/>
+    <framequat name="fq" objtype="site" objname="foot" reftype="body" refname="torso"/>
+    <jointpos name="jp" joint="knee" noise="0.01"/>
+    <touch name="touch" site="foot"/>
+  </sensor>
+  <keyframe><key name="home" qpos="0 0 1 1 0 0 0 .1 .2 .01 1 0 0 0 .3" ctrl=".5 .01 0"/></keyframe>
+</mujoco>
+"""
+
+
+def _tet_stl(path: Path) -> None:
+    """A binary STL tetrahedron (MuJoCo reads binary STL only)."""
+    tet = trimesh.Trimesh(
+        vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+        faces=[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    )
+    tet.export(str(path), file_type="stl")
+
+
+@pytest.fixture
+def probe(tmp_path: Path) -> Path:
+    _tet_stl(tmp_path / "tet.stl")
+    path = tmp_path / "probe.xml"
+    path.write_text(MODEL)
+    return path
+
+
+ARM = """<mujoco model="arm2">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="base"><geom type="cylinder" size=".05 .02" mass="1"/>
+      <body name="link1" pos="0 0 .05"><joint name="j1" axis="0 0 1" range="-2 2"/>
+        <geom type="capsule" fromto="0 0 0 .3 0 0" size=".02"/><site name="tip1" pos=".3 0 0"/>
+        <body name="link2" pos=".3 0 0"><joint name="j2" axis="0 1 0"/>
+          <geom type="box" size=".1 .02 .02" pos=".1 0 0"/></body></body></body>
+  </worldbody>
+  <actuator><position name="a1" joint="j1" kp="50"/><motor name="a2" joint="j2"/></actuator>
+</mujoco>
+"""
+
+
+@pytest.fixture
+def arm_mjcf(tmp_path: Path) -> Path:
+    path = tmp_path / "arm2.xml"
+    path.write_text(ARM)
+    return path

@@ -1,0 +1,52 @@
+"""``robotwright convert`` and ``robotwright roundtrip`` on small inputs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import pytest
+
+from robotwright.cli import main
+
+
+def test_convert_mjcf_to_hrdf_to_urdf_and_mjcf(probe: Path, tmp_path: Path, capsys) -> None:
+    folder = tmp_path / "out_hrdf"
+    assert main(["convert", str(probe), "-o", str(folder)]) == 0
+    out = capsys.readouterr().out
+    assert "warning:" in out and "worldbody" in out and f"wrote {folder}" in out
+    assert (folder / "body.csv").is_file() and any((folder / "meshes").iterdir())
+    xml = tmp_path / "again.xml"
+    assert main(["convert", str(folder), "-o", str(xml)]) == 0
+    again = mujoco.MjModel.from_xml_path(str(xml))
+    source = mujoco.MjModel.from_xml_path(str(probe))
+    assert again.nbody == source.nbody and again.nu == source.nu
+    assert abs(again.body_mass.sum() - source.body_mass.sum()) <= 1e-12
+    urdf = tmp_path / "robot.urdf"
+    assert main(["convert", str(folder), "-o", str(urdf)]) == 0
+    assert urdf.is_file()
+
+
+def test_convert_refuses_to_overwrite_and_unknown_types(probe: Path, tmp_path: Path) -> None:
+    out = tmp_path / "x.xml"
+    out.write_text("keep me")
+    with pytest.raises(FileExistsError):
+        main(["convert", str(probe), "-o", str(out)])
+    assert out.read_text() == "keep me"
+    assert main(["convert", str(probe), "-o", str(tmp_path / "x.obj")]) == 2
+
+
+def test_convert_strict_fails_without_output(probe: Path, tmp_path: Path, capsys) -> None:
+    out = tmp_path / "strict.xml"
+    assert main(["convert", str(probe), "-o", str(out), "--strict"]) == 2
+    assert "worldbody" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_roundtrip_command_prints_table(arm_mjcf: Path, probe: Path, capsys) -> None:
+    assert main(["roundtrip", str(arm_mjcf), "--configs", "5"]) == 0
+    out = capsys.readouterr().out
+    assert "MJCF: FK" in out and "URDF: total mass" in out and "result:    PASS" in out
+    # Two joints on one body need massless URDF links, which MuJoCo refuses: exit 1.
+    assert main(["roundtrip", str(probe), "--configs", "5"]) == 1
+    assert "result:    FAIL" in capsys.readouterr().out

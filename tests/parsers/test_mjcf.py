@@ -1,0 +1,112 @@
+"""MJCF -> HRDF on a hand-written model using classes, fromto, euler, several joints per
+body, every HRDF actuator type, sensors, tendons, equality, excludes and keyframes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from robotwright.errors import ConversionError
+from robotwright.parsers import mjcf_to_hrdf, mjcf_to_hrdf_with_warnings
+from robotwright.parsers.reference import view_from_model
+from robotwright.parsers.roundtrip import compare_views, our_mjcf_model
+
+
+def test_records_hold_resolved_values(probe: Path) -> None:
+    hrdf, warnings = mjcf_to_hrdf_with_warnings(probe)
+    assert [b.name for b in hrdf.bodies] == ["torso", "hip", "shin", "ankle", "arm"]
+    joints = {j.name: j for j in hrdf.joints}
+    assert [j.type for j in hrdf.joints] == ["free", "hinge", "hinge", "slide", "ball", "hinge"]
+    assert joints["hip_x"].range == pytest.approx((-np.pi / 4, np.pi / 4))  # degrees resolved
+    assert joints["hip_y"].pos == (0.0, 0.0, 0.01)
+    assert (joints["hip_x"].viscous_friction, joints["hip_x"].dynamic_friction) == (0.3, 0.2)
+    assert joints["shoulder"].ref == pytest.approx(np.radians(5))
+    acts = {a.name: a for a in hrdf.actuators}
+    assert (acts["m_hip"].type, acts["m_hip"].gear, acts["m_hip"].ctrl_range) == (
+        "motor",
+        40.0,
+        (-1.0, 1.0),
+    )
+    assert (acts["p_knee"].p_gain, acts["p_knee"].d_gain, acts["p_knee"].force_range) == (
+        300.0,
+        5.0,
+        (-90.0, 90.0),
+    )
+    assert (acts["v_sh"].type, acts["v_sh"].d_gain) == ("velocity", 12.0)
+    (mesh,) = hrdf.meshes
+    assert mesh.scale == (0.5, 0.5, 2.0) and mesh.rgba == pytest.approx((0.9, 0.8, 0.7, 1.0))
+    box = next(g for g in hrdf.simple_geoms if g.type == "box")
+    assert (box.condim, box.group, box.static_friction) == (4, 1, 0.8)
+    assert [s.type for s in hrdf.sensors] == ["gyro", "framequat", "jointpos", "touch"]
+    assert hrdf.meta.simulator_config.timestep == 0.004
+    text = " ".join(str(w) for w in warnings)
+    assert "worldbody dropped" in text and "light" in text
+    for section in ("<tendon>", "<equality>", "<exclude", "<keyframe>"):
+        assert section in hrdf.mjcf_extra
+
+
+def test_compiled_roundtrip_is_exact(probe: Path) -> None:
+    source = mujoco.MjModel.from_xml_path(str(probe))
+    hrdf = mjcf_to_hrdf(probe)
+    ours = our_mjcf_model(hrdf)
+    rows = compare_views(view_from_model(source), view_from_model(ours), configs=30)
+    assert all(r.ok for r in rows), "\n".join(f"{r.check} {r.value} {r.note}" for r in rows)
+    # Values not covered by the table.
+    assert np.array_equal(source.key_qpos, ours.key_qpos)
+    assert np.array_equal(source.key_ctrl, ours.key_ctrl)
+    assert np.array_equal(source.tendon_range, ours.tendon_range)
+    assert np.allclose(source.wrap_prm, ours.wrap_prm, rtol=0, atol=0)
+    assert np.array_equal(source.jnt_stiffness, ours.jnt_stiffness)
+    assert np.array_equal(source.qpos_spring, ours.qpos_spring)
+    assert np.array_equal(source.dof_armature, ours.dof_armature)
+    assert np.array_equal(source.sensor_noise, ours.sensor_noise)
+
+
+def test_strict_raises_listing_drops(probe: Path) -> None:
+    with pytest.raises(ConversionError) as err:
+        mjcf_to_hrdf(probe, strict=True)
+    assert "worldbody" in str(err.value) and "light" in str(err.value)
+
+
+def test_several_top_level_bodies_need_root_body(tmp_path: Path) -> None:
+    path = tmp_path / "two.xml"
+    path.write_text(
+        '<mujoco><worldbody><body name="a"><geom size=".1"/></body>'
+        '<body name="b"><freejoint/><geom size=".1"/></body></worldbody></mujoco>'
+    )
+    with pytest.raises(ConversionError, match=r"2 top-level bodies \['a', 'b'\].*root_body"):
+        mjcf_to_hrdf(path)
+    hrdf, warnings = mjcf_to_hrdf_with_warnings(path, root_body="b")
+    assert [b.name for b in hrdf.bodies] == ["b"] and hrdf.floating_base
+    assert any("'a'" in str(w) for w in warnings)
+
+
+def test_model_mujoco_rejects_names_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "bad.xml"
+    path.write_text(
+        '<mujoco><worldbody><body><joint type="hinge" range="1 0"/></body></worldbody></mujoco>'
+    )
+    with pytest.raises(ConversionError, match="bad.xml: MuJoCo cannot load it"):
+        mjcf_to_hrdf(path)
+
+
+def test_entity_expansion_refused(tmp_path: Path) -> None:
+    path = tmp_path / "bomb.xml"
+    path.write_text('<!DOCTYPE m [<!ENTITY a "x">]><mujoco model="&a;"/>')
+    with pytest.raises(ConversionError, match="unsafe XML"):
+        mjcf_to_hrdf(path)
+
+
+def test_saved_folder_holds_meshes_and_reloads(probe: Path, tmp_path: Path) -> None:
+    from robotwright.hrdf.model import HRDF
+
+    hrdf = mjcf_to_hrdf(probe)
+    out = hrdf.save(tmp_path / "probe_hrdf")
+    assert (out / hrdf.meshes[0].file).is_file()
+    again = HRDF.from_dir(out)
+    a = view_from_model(our_mjcf_model(hrdf))
+    b = view_from_model(our_mjcf_model(again))
+    assert all(r.ok for r in compare_views(a, b, configs=5))
