@@ -345,7 +345,7 @@ class _Reader:
         if sm.file:
             kw["file"] = self.path(sm.file, self.spec.meshdir)
         if len(sm.uservert):
-            kw["vertex"] = list(sm.uservert)
+            kw["vertex"] = _f32(sm.uservert)  # MuJoCo stores inline vertices as float32
         if len(sm.userface):
             kw["face"] = list(sm.userface)
         if len(sm.usernormal) or len(sm.usertexcoord) or sm.plugin.active or sm.content_type:
