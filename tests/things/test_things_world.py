@@ -121,6 +121,9 @@ def test_move_rotate_and_bulk_edits():
     np.testing.assert_allclose(arm.pos, [0.1, 0, 1])
     world.forward()
     np.testing.assert_allclose(arm.xmat @ [1, 0, 0], [0, 1, 0], atol=1e-12)
+    tip = world.find("tip")
+    tip.set_euler([0, 0, np.pi / 2])
+    np.testing.assert_allclose(tip.quat, [np.cos(np.pi / 4), 0, 0, np.sin(np.pi / 4)], atol=1e-12)
     assert arm.set_all("geom", rgba=[0, 0, 1, 1], condim=4) == 2
     assert all(g.condim == 4 for g in arm.all_geoms())
     assert np.all(world.model.geom_condim == 4)

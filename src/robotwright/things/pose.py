@@ -22,7 +22,11 @@ def axis_angle_quat(axis: Sequence[float], angle: float) -> np.ndarray:
 
 
 def euler_quat(euler: Sequence[float], seq: str = "xyz") -> np.ndarray:
-    """Quaternion of Euler angles in radians; ``seq`` as MJCF ``eulerseq`` (lower = intrinsic... as MuJoCo)."""
+    """Quaternion (w, x, y, z) of Euler angles in radians.
+
+    ``seq`` follows MJCF ``eulerseq``: lower-case axes rotate with the frame (intrinsic),
+    upper-case axes stay fixed (extrinsic).
+    """
     quat = np.zeros(4)
     mujoco.mju_euler2Quat(quat, np.asarray(euler, dtype=float), seq)
     return quat
