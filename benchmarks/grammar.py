@@ -48,6 +48,11 @@ def main() -> int:
     ap.add_argument("--designs", type=int, default=200)
     ap.add_argument("--max-links", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument(
+        "--compare-search",
+        action="store_true",
+        help="also compare best values of beam, MCTS and random search (seeds 0-2)",
+    )
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     g = default_grammar()
@@ -107,7 +112,41 @@ def main() -> int:
         print(
             f"search evaluations (reach + self-collision), {label:30s} {budget / dt:8.1f} designs/s"
         )
+    if args.compare_search:
+        compare_search(g, L)
     return 0
+
+
+def compare_search(g, max_links: int, budget: int = 300) -> None:
+    """Best value found by each method at the same budget (quality, not speed)."""
+    from robotwright.grammar.objectives import WorkspaceVolume
+    from robotwright.grammar.search import beam_search, mcts_search
+
+    print(f"best value at {budget} evaluations, <= {max_links} links, no self-collision")
+    for obj in (Reach(), WorkspaceVolume(samples=512)):
+        for seed in (0, 1, 2):
+            vals = {}
+            for name, fn in (
+                ("beam", beam_search),
+                ("mcts", mcts_search),
+                ("random", random_search),
+            ):
+                with ThreadPoolExecutor(1) as ex:
+                    res = fn(
+                        g,
+                        [obj],
+                        [NoSelfCollision()],
+                        budget=budget,
+                        max_links=max_links,
+                        seed=seed,
+                        executor=ex,
+                    )
+                vals[name] = res.best.score
+            ratio = {k: v / vals["random"] for k, v in vals.items()}
+            print(
+                f"  {obj.name:9s} seed {seed}: beam {vals['beam']:.4f} ({ratio['beam']:.2f}x random), "
+                f"mcts {vals['mcts']:.4f} ({ratio['mcts']:.2f}x), random {vals['random']:.4f}"
+            )
 
 
 if __name__ == "__main__":
