@@ -129,3 +129,22 @@ def test_python_built_robot_to_hrdf_uses_mujoco_inertia_and_reports_losses():
     two.attach(Body("a"), Body("b"))
     with pytest.raises(ConversionError, match="one top-level body"):
         things_to_hrdf(two)
+
+
+def test_mjcf_extra_is_kept_by_world_and_reported_by_body():
+    import dataclasses
+
+    robot = dataclasses.replace(
+        HRDF.from_dir(ROBOTS / "arm6"),
+        mjcf_extra='<mujoco><contact><exclude body1="base_link" body2="shoulder_link"/></contact>'
+        '<keyframe><key name="home" qpos="0 0.1 0.2 0 0 0"/></keyframe></mujoco>',
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConversionWarning)
+        world = hrdf_to_world(robot)
+        back = things_to_hrdf(world)
+    assert world.model.nexclude == 1 and world.model.key_qpos[0][2] == pytest.approx(0.2)
+    regenerated = _generated(back)
+    assert regenerated.nexclude == 1 and regenerated.nkey == 1
+    with pytest.raises(ConversionError, match="mjcf_extra"):
+        hrdf_to_body(robot, strict=True)
