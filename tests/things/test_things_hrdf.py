@@ -56,6 +56,7 @@ def test_bundled_robots_round_trip_through_things(name):
     assert again == strip
 
 
+@pytest.mark.hurodes
 def test_hurodes_g1_edit_attach_copied_limb_save_and_generate(g1_hrdf_dir, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fixture folder holds an extra export folder
