@@ -17,6 +17,7 @@ import difflib
 import fnmatch
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -24,6 +25,9 @@ import numpy as np
 from robotwright.errors import SensorError
 from robotwright.sensors.config import LidarCfg
 from robotwright.sensors.raycast import MujocoRayEngine, WarpRayEngine, make_ray_model
+
+if TYPE_CHECKING:  # the warp extra is optional
+    from mujoco_warp import Data as WarpData
 
 __all__ = ["LidarSensor", "LidarSensorData", "geom_paths"]
 
@@ -157,7 +161,10 @@ class LidarSensor:
     cfg: LidarCfg
 
     def __init__(
-        self, cfg: LidarCfg, model: mujoco.MjModel, data: mujoco.MjData | Sequence[mujoco.MjData]
+        self,
+        cfg: LidarCfg,
+        model: mujoco.MjModel,
+        data: mujoco.MjData | Sequence[mujoco.MjData] | WarpData,
     ) -> None:
         if not isinstance(cfg, LidarCfg):
             raise SensorError(f"cfg: expected a LidarCfg, got {type(cfg).__name__}")

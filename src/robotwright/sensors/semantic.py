@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -16,6 +17,9 @@ import numpy as np
 from robotwright.errors import SensorError
 from robotwright.sensors.config import SemanticLidarCfg
 from robotwright.sensors.lidar import LidarSensor, LidarSensorData
+
+if TYPE_CHECKING:  # the warp extra is optional
+    from mujoco_warp import Data as WarpData
 
 __all__ = ["SemanticLidarData", "SemanticLidarSensor"]
 
@@ -56,7 +60,7 @@ class SemanticLidarSensor(LidarSensor):
         self,
         cfg: SemanticLidarCfg,
         model: mujoco.MjModel,
-        data: mujoco.MjData | Sequence[mujoco.MjData],
+        data: mujoco.MjData | Sequence[mujoco.MjData] | WarpData,
     ) -> None:
         if not isinstance(cfg, SemanticLidarCfg):
             raise SensorError(f"cfg: expected a SemanticLidarCfg, got {type(cfg).__name__}")
