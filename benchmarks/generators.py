@@ -60,14 +60,17 @@ def composite():
 tasks = {"load+mjcf": load_mjcf, "urdf": urdf, "composite": composite}
 print("ready", flush=True)
 for line in sys.stdin:
-    task = line.strip()
-    with contextlib.redirect_stdout(sink):
-        c = time.process_time()
-        t = time.perf_counter()
-        tasks[task]()
-        dt = time.perf_counter() - t
-        dc = time.process_time() - c
-    print(repr(dt), repr(dc), flush=True)
+    task, count = line.split()
+    results = []
+    for _ in range(int(count)):
+        with contextlib.redirect_stdout(sink):
+            c = time.process_time()
+            t = time.perf_counter()
+            tasks[task]()
+            dt = time.perf_counter() - t
+            dc = time.process_time() - c
+        results.append(f"{dt!r},{dc!r}")
+    print(" ".join(results), flush=True)
 """
 
 
@@ -145,17 +148,21 @@ class HurodesWorker:
                 f"hurodes worker failed:\n{self.proc.stderr.read() if self.proc.stderr else ''}"
             )
 
-    def time(self, task: str) -> tuple[float, float]:
+    def time(self, task: str, count: int) -> list[tuple[float, float]]:
+        """Run ``task`` ``count`` times back to back; (wall, cpu) seconds of each run."""
         assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write(task + "\n")
+        self.proc.stdin.write(f"{task} {count}\n")
         self.proc.stdin.flush()
         line = self.proc.stdout.readline()
         if not line:
             raise SystemExit(
                 f"hurodes worker died:\n{self.proc.stderr.read() if self.proc.stderr else ''}"
             )
-        wall, cpu = line.split()
-        return float(wall), float(cpu)
+        out = []
+        for item in line.split():
+            wall, cpu = item.split(",")
+            out.append((float(wall), float(cpu)))
+        return out
 
     def close(self) -> None:
         if self.proc.stdin is not None:
@@ -167,7 +174,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", type=Path, default=DEFAULT_ROBOT, help="HRDF folder")
     parser.add_argument("--hurodes-python", default=None, help="python of a hurodes venv")
-    parser.add_argument("--repeat", type=int, default=30)
+    parser.add_argument("--repeat", type=int, default=30, help="runs of each task per tool")
+    parser.add_argument("--block", type=int, default=10, help="runs per alternation block")
     parser.add_argument(
         "--peak-velocity",
         type=float,
@@ -199,16 +207,23 @@ def main(argv: list[str] | None = None) -> int:
                 else None
             )
             try:
-                # Interleave the two tools task by task, so a busy machine slows both alike.
-                for _ in range(args.repeat):
+                # Alternate the two tools in blocks of --block runs of one task: both see
+                # the same machine load, and each block runs with warm caches (timing one
+                # run of each in turn would start every short run with caches emptied by
+                # the other process and penalise the faster tool).
+                done = 0
+                while done < args.repeat:
+                    n = min(args.block, args.repeat - done)
                     for task, fn in tasks.items():
-                        c = time.process_time()
-                        t = time.perf_counter()
-                        fn()
-                        dt = time.perf_counter() - t
-                        ours.setdefault(task, []).append((dt, time.process_time() - c))
+                        for _ in range(n):
+                            c = time.process_time()
+                            t = time.perf_counter()
+                            fn()
+                            dt = time.perf_counter() - t
+                            ours.setdefault(task, []).append((dt, time.process_time() - c))
                         if worker is not None and theirs is not None:
-                            theirs.setdefault(task, []).append(worker.time(task))
+                            theirs.setdefault(task, []).extend(worker.time(task, n))
+                    done += n
             finally:
                 if worker is not None:
                     worker.close()

@@ -174,16 +174,18 @@ class GeneratorBase(ABC):
         return text
 
     # -- mesh paths ---------------------------------------------------------------------
-    def _mesh_file(self, src: Path) -> Path:
+    def _mesh_file(self, src: str) -> str:
         """Absolute path the output should reference for source mesh ``src``."""
-        return self._mesh_copy.get(src, src)
+        if not self._mesh_copy:
+            return src
+        return str(self._mesh_copy.get(Path(src), src))
 
-    def _reference(self, path: Path, relative: bool) -> str:
+    def _reference(self, path: str | Path, relative: bool) -> str:
         """How the output names ``path``: relative to ``output_dir`` when asked and known,
         absolute otherwise (always with ``/`` separators)."""
         if relative and self.output_dir is not None:
-            return Path(os.path.relpath(path, self.output_dir)).as_posix()
-        return path.as_posix()
+            return os.path.relpath(path, self.output_dir).replace(os.sep, "/")
+        return str(path).replace(os.sep, "/")
 
 
 def _plan_mesh_copies(sources: list[tuple[str, Path]], out_dir: Path) -> dict[Path, Path]:

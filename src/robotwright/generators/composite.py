@@ -11,6 +11,7 @@ name used twice is a :class:`GeneratorError` before anything is written.
 
 from __future__ import annotations
 
+import os
 import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
@@ -295,17 +296,17 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
                     asset = self.get_elem("asset")
                     for el in section:
                         if el.tag == "mesh" and el.get("file"):
-                            path = Path(el.get("file", ""))
-                            if base is not None and not path.is_absolute():
-                                path = Path(base) / path
-                            el.set("file", path.as_posix())
+                            path = el.get("file", "")
+                            if base is not None and not os.path.isabs(path):
+                                path = os.path.join(base, path)
+                            el.set("file", path)
                             k = (
                                 path,
-                                *sorted(
+                                *[
                                     (a, v)
                                     for a, v in el.attrib.items()
                                     if a not in ("name", "file")
-                                ),
+                                ],
                             )
                             kept = mesh_keys.get(k)
                             if kept is not None:

@@ -31,7 +31,7 @@ class HRDFMixin:
             raise TypeError(f"{type(self).__name__}: HRDFMixin needs a GeneratorBase subclass")
         super().__init__(**kwargs)
         self.hrdf = None
-        self._mesh_abs: dict[tuple[str | None, str], Path] = {}
+        self._mesh_abs: dict[tuple[str | None, str], str] = {}
 
     def _load(self, hrdf: HRDF | None = None, *, validate: bool = True, **kwargs: Any) -> None:
         """Take ``hrdf`` after checking it (every problem listed in one :class:`HRDFError`).
@@ -64,22 +64,31 @@ class HRDFMixin:
         self.hrdf = None
         self._mesh_abs = {}
 
-    def mesh_abspath(self, mesh: MeshGeom) -> Path:
-        """Absolute path of a mesh geom's file (normalised, cached per load)."""
+    def mesh_abspath(self, mesh: MeshGeom) -> str:
+        """Absolute, normalised path of a mesh geom's file (as ``HRDF.mesh_path``; cached
+        per load, kept as a string because generation uses it for every mesh row)."""
         key = (mesh.file, mesh.name)
         path = self._mesh_abs.get(key)
         if path is None:
-            path = Path(os.path.abspath(self.loaded_hrdf.mesh_path(mesh)))
+            hrdf = self.loaded_hrdf
+            rel = (
+                mesh.file
+                if mesh.file is not None
+                else (f"meshes/{mesh.name}.{hrdf.meta.mesh_file_type}")
+            )
+            if hrdf.root_dir is not None and not os.path.isabs(rel):
+                rel = os.path.join(hrdf.root_dir, rel)
+            path = os.path.abspath(rel)
             self._mesh_abs[key] = path
         return path
 
     def mesh_sources(self) -> list[tuple[str, Path]]:
         """``(robot name, absolute path)`` of each distinct mesh file."""
         hrdf = self.loaded_hrdf
-        seen: dict[Path, None] = {}
+        seen: dict[str, None] = {}
         for m in hrdf.meshes:
             seen.setdefault(self.mesh_abspath(m), None)
-        return [(hrdf.name, p) for p in seen]
+        return [(hrdf.name, Path(p)) for p in seen]
 
     @property
     def loaded_hrdf(self) -> HRDF:

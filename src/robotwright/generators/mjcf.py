@@ -27,9 +27,9 @@ or raised as :class:`ConversionError` with ``strict=True``.
 
 from __future__ import annotations
 
+import os
 import warnings
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 from robotwright.errors import ConversionError, ConversionWarning, GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
@@ -165,14 +165,14 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
     def _add_mesh_assets(self, hrdf: HRDF, prefix: str | None) -> list[str]:
         """One ``<mesh>`` per distinct (file, scale); returns the asset name of each row."""
         asset = self.get_elem("asset")
-        by_key: dict[tuple[Path, tuple[float, float, float]], str] = {}
+        by_key: dict[tuple[str, tuple[float, float, float]], str] = {}
         used: set[str] = set()
         names: list[str] = []
-        checked: set[Path] = set()
+        checked: set[str] = set()
         for row, m in enumerate(hrdf.meshes):
             path = self.mesh_abspath(m)
             if path not in checked:
-                if not path.is_file():
+                if not os.path.isfile(path):
                     raise GeneratorError(
                         f"robot '{hrdf.name}': mesh.csv row {row} (mesh '{m.name}'): "
                         f"file '{path}' does not exist"
@@ -187,7 +187,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                     n += 1
                 used.add(name)
                 by_key[key] = name
-                attrs = {"name": prefixed(prefix, name), "file": str(path)}
+                attrs = {"name": prefixed(prefix, name), "file": path}
                 if m.scale != (1.0, 1.0, 1.0):
                     attrs["scale"] = fmt_vec(m.scale)
                 ET.SubElement(asset, "mesh", attrs)

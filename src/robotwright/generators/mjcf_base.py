@@ -9,7 +9,6 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from robotwright.errors import GeneratorError
@@ -282,13 +281,13 @@ class MJCFGeneratorBase(GeneratorBase):
             return
         files = [m.get("file", "") for m in meshes]
         if self._mesh_copy:
-            files = [str(self._mesh_file(Path(f))) for f in files]
+            files = [self._mesh_file(f) for f in files]
         common = os.path.commonpath({os.path.dirname(f) for f in files})
         head = common.rstrip("/") + "/"
         for elem, f in zip(meshes, files, strict=True):
             rel = f[len(head) :] if f.startswith(head) else os.path.relpath(f, common)
             elem.set("file", rel.replace(os.sep, "/"))
-        self.get_elem("compiler").set("meshdir", self._reference(Path(common), relative))
+        self.get_elem("compiler").set("meshdir", self._reference(common, relative))
 
     def _order_sections(self) -> None:
         """Drop empty top-level sections and put the rest in :data:`SECTION_ORDER`."""

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import replace
-from pathlib import Path
 
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
@@ -128,7 +127,7 @@ class _RobotWriter:
         self.mesh_path = owner.mesh_abspath
         self.for_mujoco, self.relative, self.losses = for_mujoco, relative, losses
         self.materials: dict[tuple[float, ...], str] = {}
-        self.mesh_refs: dict[Path, str] = {}
+        self.mesh_refs: dict[str, str] = {}
 
     def p(self, name: str) -> str:
         return prefixed(self.prefix, name)
