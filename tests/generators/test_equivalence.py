@@ -158,3 +158,16 @@ def test_multi_joint_bodies_anchors_and_slides_urdf_matches_mjcf(synth_urdf_safe
 
 def test_fixed_base_urdf_matches_mjcf(synth_fixed, tmp_path):
     _urdf_vs_mjcf(synth_fixed, tmp_path)
+
+
+def test_root_with_hinge_joints_urdf_matches_mjcf(synth_fixed, tmp_path):
+    import dataclasses
+
+    from robotwright.hrdf.model import Joint
+
+    root_joints = [
+        Joint("turn", "base", "hinge", (0.0, 0.0, 0.1), (0.0, 0.0, 1.0), (-2.0, 2.0)),
+        Joint("lift", "base", "slide", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.3)),
+    ]
+    h = dataclasses.replace(synth_fixed, joints=root_joints + synth_fixed.joints)
+    _urdf_vs_mjcf(h, tmp_path, n=30)
