@@ -241,3 +241,8 @@ def test_nested_composite_and_outer_prefix():
     mujoco.mj_forward(m, d)
     np.testing.assert_allclose(d.xpos[m.body("s_pair_b_base_link").id], [0.5, 2.0, 0.0], atol=1e-12)
     assert m.body("s_h_pelvis").id > 0
+
+
+def test_different_simulator_settings_warn(synth_urdf_safe):
+    with pytest.warns(ConversionWarning, match=r"robots \['s'\] have simulator settings"):
+        MJCFGeneratorComposite({"arm": _gen("arm6"), "s": _gen(synth_urdf_safe)}).export()

@@ -84,7 +84,8 @@ class _Robot:
         self.worldbody = root.find("worldbody")
         self.top = [] if self.worldbody is None else list(self.worldbody)
         self.joints = [] if self.worldbody is None else _joints(self.worldbody)
-        self.nu = len(root.find("actuator") or [])
+        actuators = root.find("actuator")
+        self.nu = 0 if actuators is None else len(actuators)
         self.keys: dict[str, dict[str, list[float]]] = {}
         self.key_time: dict[str, str] = {}
         keyframe = root.find("keyframe")
@@ -257,14 +258,7 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
                 gen._check_names = True
             robots.append(_Robot(key, child_prefix, gen.xml_root))
         if self._own_simulator_config is None:
-            self.simulator_config = next(
-                (
-                    g.simulator_config
-                    for g in self.generators.values()
-                    if isinstance(g, MJCFGeneratorBase) and g.simulator_config is not None
-                ),
-                None,
-            )
+            self.simulator_config = self._robots_simulator_config()
         self.add_compiler()
         self.add_option()
         self._merge(robots)
@@ -281,6 +275,27 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
         for g in self.generators.values():
             # The merged tree now owns the robots' elements; drop the robots' references.
             g.destroy()
+
+    def _robots_simulator_config(self) -> SimulatorConfig | None:
+        """The first robot's simulator settings; a warning names robots whose option
+        values (timestep, gravity, integrator) differ, since a scene has one of each."""
+        configs = [(k, g.simulator_config) for k, g in self.generators.items()]
+        chosen = next(((k, c) for k, c in configs if c is not None), None)
+        if chosen is None:
+            return None
+
+        def option(c: SimulatorConfig) -> tuple[object, ...]:
+            return (c.timestep, tuple(c.gravity or ()), c.integrator)
+
+        differ = [k for k, c in configs if c is not None and option(c) != option(chosen[1])]
+        if differ:
+            warnings.warn(
+                f"composite: robots {differ} have simulator settings different from "
+                f"'{chosen[0]}' ({option(chosen[1])}); the scene uses '{chosen[0]}''s",
+                ConversionWarning,
+                stacklevel=5,
+            )
+        return chosen[1]
 
     def _merge(self, robots: list[_Robot]) -> None:
         mesh_keys: dict[tuple[Any, ...], str] = {}
