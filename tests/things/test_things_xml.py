@@ -267,19 +267,32 @@ def test_unsafe_or_invalid_xml_is_rejected_with_a_clear_error(tmp_path):
         World.from_xml_path(tmp_path / "none.xml")
 
 
-_HFIELD = """<mujoco><asset><hfield name="terrain" nrow="2" ncol="2" size="1 1 0.1 0.1"/></asset>
-<worldbody><geom name="ground" type="hfield" hfield="terrain"/><body><geom size="0.1"/></body></worldbody></mujoco>"""
+_HFIELD = """<mujoco><asset><hfield name="terrain" nrow="3" ncol="2" size="1 1 0.1 0.1"
+ elevation="0 1 2 3 4 5"/><hfield name="unused" nrow="2" ncol="2" size="1 1 1 1"/></asset>
+<custom><numeric name="gain" data="3"/></custom>
+<worldbody><geom name="ground" type="hfield" hfield="terrain"/><body><geom size="0.1"/></body>
+</worldbody></mujoco>"""
 
 
-def test_unrepresentable_elements_warn_naming_them_or_raise_when_strict():
+def test_height_fields_round_trip_and_unrepresentable_parts_are_named():
+    from robotwright.things import HField
+
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         world = World.from_xml_string(_HFIELD)
     messages = [str(w.message) for w in caught if issubclass(w.category, ConversionWarning)]
-    assert any('<hfield name="terrain">' in m for m in messages)
-    assert any('<geom name="ground" type="hfield">' in m for m in messages)
-    assert world.model.ngeom == 1
-    with pytest.raises(ConversionError, match="terrain"):
+    assert any('<hfield name="unused">' in m and "no geom uses it" in m for m in messages)
+    assert any("custom" in m for m in messages)
+    ground = world.find("ground")
+    assert isinstance(ground, HField) and (ground.nrow, ground.ncol) == (3, 2)
+    original = mujoco.MjModel.from_xml_string(_HFIELD)
+    model = world.model
+    assert model.nhfield == 1 and model.ngeom == original.ngeom
+    np.testing.assert_allclose(model.hfield_size[0], original.hfield_size[0])
+    np.testing.assert_allclose(model.hfield_data, original.hfield_data[: model.hfield_data.size])
+    xml = world.to_xml_string()
+    assert World.from_xml_string(xml).to_xml_string() == xml
+    with pytest.raises(ConversionError, match="unused"):
         World.from_xml_string(_HFIELD, strict=True)
 
 

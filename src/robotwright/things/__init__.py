@@ -22,7 +22,17 @@ from robotwright.things.attrs import ThingAttributeError
 from robotwright.things.base import BaseThing, ThingType
 from robotwright.things.body import Body
 from robotwright.things.cameras import Camera
-from robotwright.things.geoms import Box, Capsule, Cylinder, Ellipsoid, Geom, Mesh, Plane, Sphere
+from robotwright.things.geoms import (
+    Box,
+    Capsule,
+    Cylinder,
+    Ellipsoid,
+    Geom,
+    HField,
+    Mesh,
+    Plane,
+    Sphere,
+)
 from robotwright.things.hrdf_bridge import hrdf_to_body, hrdf_to_world, things_to_hrdf
 from robotwright.things.joints import Ball, Free, Hinge, Joint, Slide
 from robotwright.things.lights import Light
@@ -94,6 +104,7 @@ __all__ = [
     "General",
     "Geom",
     "Gyro",
+    "HField",
     "Hinge",
     "Joint",
     "JointActuatorFrc",

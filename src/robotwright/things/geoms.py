@@ -205,7 +205,10 @@ class Mesh(Geom):
     """
 
     type = "mesh"
+    #: The geom owns a ``<mesh>`` asset made of these attributes (MJCF names in _ASSET_XML).
+    _ASSET_TAG = "mesh"
     _ASSET_ATTR = tuple(_MESH_ASSET_ATTR)
+    _ASSET_XML = {"meshinertia": "inertia"}
     _NEW_MUJOCO_ATTR = _MESH_ASSET_ATTR
     _NEW_BLUEPRINTS_ATTR = _MESH_ASSET_ATTR
     _NEW_DEFAULT_VALS = {
@@ -221,4 +224,38 @@ class Mesh(Geom):
     }
 
 
-GEOM_CLASSES: tuple[type[Geom], ...] = (Sphere, Capsule, Cylinder, Box, Ellipsoid, Plane, Mesh)
+_HFIELD_ASSET_ATTR: dict[str, Any] = {
+    "hfield": Text(),
+    "file": Text(),
+    "nrow": Integer(minimum=0),
+    "ncol": Integer(minimum=0),
+    "hfield_size": Vector(4, nonneg=True),
+    "elevation": Vector(None, optional=True),
+}
+
+
+class HField(Geom):
+    """Height field geom. ``hfield_size = [x half, y half, z top, z bottom]`` (m); heights
+    from an image/binary ``file``, from ``elevation`` (``nrow * ncol`` values, row-major,
+    scaled to [0, 1] by MuJoCo), or all zero when only ``nrow``/``ncol`` are given (to be
+    filled at run time in ``model.hfield_data``). ``hfield`` is the asset name."""
+
+    type = "hfield"
+    _ASSET_TAG = "hfield"
+    _ASSET_ATTR = tuple(_HFIELD_ASSET_ATTR)
+    _ASSET_XML = {"hfield_size": "size"}
+    _NEW_MUJOCO_ATTR = _HFIELD_ASSET_ATTR
+    _NEW_BLUEPRINTS_ATTR = _HFIELD_ASSET_ATTR
+    _NEW_DEFAULT_VALS = {
+        "hfield": None,
+        "file": None,
+        "nrow": 0,
+        "ncol": 0,
+        "hfield_size": np.zeros(4),
+        "elevation": None,
+    }
+
+
+GEOM_CLASSES: tuple[type[Geom], ...] = (
+    Sphere, Capsule, Cylinder, Box, Ellipsoid, Plane, Mesh, HField,
+)  # fmt: skip

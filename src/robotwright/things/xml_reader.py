@@ -88,6 +88,7 @@ class _Reader:
         self.by_name: dict[tuple[str, str], BaseThing] = {}
         self.materials: dict[str, Material] = {}
         self.textures: dict[str, Texture] = {}
+        self.used_hfields: set[str] = set()
 
     # ------------------------------------------------------------------ helpers
     def lose(self, element: str, message: str) -> None:
@@ -179,7 +180,7 @@ class _Reader:
             thing = Material(self.name(mat), **kw)
             self.materials[mat.name] = thing
             world.assets.append(thing)
-        for kind in ("hfields", "skins", "flexes"):
+        for kind in ("skins", "flexes"):
             for item in getattr(spec, kind):
                 self.lose(
                     f'<{kind[:-1] if kind != "flexes" else "flex"} name="{item.name}">',
@@ -324,6 +325,8 @@ class _Reader:
             kw["material"] = self.material(sg.material)
         if gtype == "mesh":
             kw.update(self.mesh_asset(sg.meshname, where))
+        elif gtype == "hfield":
+            kw.update(self.hfield_asset(sg.hfieldname, where))
         geom = cls(self.name(sg), **kw)
         self.register("geom", sg.name, geom)
         return geom
@@ -353,6 +356,29 @@ class _Reader:
                 f'<mesh name="{meshname}">',
                 "mesh normals, texture coordinates, content type and plugins are not kept",
             )
+        return kw
+
+    def hfield_asset(self, name: str, where: str) -> dict[str, Any]:
+        sh = self.spec.hfield(name)
+        if sh is None:
+            raise ThingXMLError(
+                f"{self.source}: {where} refers to hfield {name!r}, which is not defined"
+            )
+        self.used_hfields.add(name)
+        kw: dict[str, Any] = {
+            "hfield": name,
+            "nrow": sh.nrow,
+            "ncol": sh.ncol,
+            "hfield_size": sh.size,
+        }
+        if sh.file:
+            kw["file"] = self.path(sh.file, self.spec.meshdir)
+        if len(sh.userdata):
+            # MuJoCo's parser stores MJCF elevation rows bottom-up; flip back to MJCF order.
+            rows = np.asarray(_f32(sh.userdata)).reshape(sh.nrow, sh.ncol)[::-1]
+            kw["elevation"] = rows.ravel().tolist()
+        if sh.content_type:
+            self.lose(f'<hfield name="{name}">', "content_type is not kept")
         return kw
 
     def site(self, ss: Any) -> Site:
@@ -612,6 +638,9 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
     reader.by_name[("body", "world")] = world
     reader.read_assets(world)
     reader.read_body_children(spec.worldbody, world)
+    for hfield in spec.hfields:
+        if hfield.name not in reader.used_hfields:
+            reader.lose(f'<hfield name="{hfield.name}">', "no geom uses it; not kept")
 
     try:
         carried_root = ET.fromstring(spec.to_xml())

@@ -33,8 +33,9 @@ class _Writer:
         self.out: list[str] = []
         self.actuators: list[BaseThing] = []
         self.sensors: list[BaseThing] = []
-        self.mesh_assets: dict[tuple, str] = {}
-        self.mesh_of_geom: dict[int, str] = {}
+        self.mesh_of_geom: dict[int, str] = {}  # geom ID -> name of the asset it owns
+        self._owned_base: dict[str, str] = {}
+        self._owned_assets: list[tuple[str, BaseThing]] = []
         self.asset_names: dict[int, str] = {}
         self.assets: list[BaseThing] = []
         # model ids in compile order: namespace -> list of Thing IDs
@@ -81,30 +82,29 @@ class _Writer:
 
     # ------------------------------------------------------------------ assets
     def collect_assets(self) -> None:
-        from robotwright.things.geoms import Mesh
-
         requested: list[BaseThing] = list(getattr(self.root, "assets", []))
         seen = {a.ID for a in requested}
-        mesh_keys: list[tuple[tuple, str]] = []
-        mesh_things: list[BaseThing] = []
+        # Geoms that own their asset (Mesh, HField): equal asset attributes share one asset.
+        owned: list[tuple[BaseThing, str, str]] = []
         for thing in self.root.walk():
-            if isinstance(thing, Mesh):
-                mesh_things.append(thing)
+            asset_tag = getattr(thing, "_ASSET_TAG", None)
+            if asset_tag is not None:
+                name_attr = asset_tag  # the geom attribute naming the asset ("mesh", ...)
                 key = tuple(
-                    (k, _hashable(getattr(thing, k))) for k in Mesh._ASSET_ATTR if k != "mesh"
+                    (k, _hashable(getattr(thing, k))) for k in thing._ASSET_ATTR if k != name_attr
                 )
-                base = thing.mesh or (
-                    os.path.splitext(os.path.basename(thing.file))[0]
-                    if thing.file
-                    else thing._name or "mesh"
+                file = thing.__dict__.get("file")
+                base = getattr(thing, name_attr) or (
+                    os.path.splitext(os.path.basename(file))[0]
+                    if file
+                    else thing._name or asset_tag
                 )
-                mesh_keys.append((key, base))
-                self.mesh_of_geom[thing.ID] = repr((key, base))
-            for key in ("material",):
-                value = thing.__dict__.get(key)
-                if isinstance(value, BaseThing) and value.ID not in seen:
-                    seen.add(value.ID)
-                    requested.append(value)
+                owned.append((thing, asset_tag, repr((asset_tag, key, base))))
+                self._owned_base[repr((asset_tag, key, base))] = base
+            value = thing.__dict__.get("material")
+            if isinstance(value, BaseThing) and value.ID not in seen:
+                seen.add(value.ID)
+                requested.append(value)
         for asset in list(requested):
             tex = asset.__dict__.get("texture")
             if isinstance(tex, BaseThing) and tex.ID not in seen:
@@ -116,47 +116,40 @@ class _Writer:
                 taken, asset._TAG, asset.__dict__.get("_name") or asset._TAG
             )
         self.assets = requested
-        unique_meshes: dict[str, str] = {}
-        for key, base in mesh_keys:
-            ident = repr((key, base))
-            if ident not in unique_meshes:
-                unique_meshes[ident] = _unique(taken, "mesh", base)
-                self.mesh_assets[key] = unique_meshes[ident]
-        self.mesh_of_geom = {gid: unique_meshes[ident] for gid, ident in self.mesh_of_geom.items()}
-        self._mesh_geoms: dict[str, BaseThing] = {}
-        for geom in mesh_things:
-            self._mesh_geoms.setdefault(self.mesh_of_geom[geom.ID], geom)
+        unique: dict[str, str] = {}
+        for geom, asset_tag, ident in owned:
+            if ident not in unique:
+                unique[ident] = _unique(taken, asset_tag, self._owned_base[ident])
+                self._owned_assets.append((unique[ident], geom))
+            self.mesh_of_geom[geom.ID] = unique[ident]
 
     def write_assets(self) -> None:
-        from robotwright.things.geoms import Mesh
-
-        if not self.assets and not self._mesh_geoms:
+        if not self.assets and not self._owned_assets:
             return
         self.out.append("  <asset>")
         for asset in self.assets:
             self.out.append(f"    <{asset._TAG} {self.attrs(asset)}/>")
-        for name, geom in self._mesh_geoms.items():
+        for name, geom in self._owned_assets:
             parts = [f'name="{_q(name)}"']
-            for key in Mesh._ASSET_ATTR:
-                if key == "mesh":
+            cls = type(geom)
+            for key in cls._ASSET_ATTR:
+                if key == cls._ASSET_TAG:
                     continue
                 value = getattr(geom, key)
                 if value is None or (
-                    key in Mesh._DEFAULT_VALS
-                    and Mesh._MUJOCO_ATTR[key].equal(value, Mesh._DEFAULT_VALS[key])
+                    key in cls._DEFAULT_VALS
+                    and cls._MUJOCO_ATTR[key].equal(value, cls._DEFAULT_VALS[key])
                 ):
                     continue
                 text = (
-                    self.path_for(value) if key == "file" else Mesh._MUJOCO_ATTR[key].format(value)
+                    self.path_for(value) if key == "file" else cls._MUJOCO_ATTR[key].format(value)
                 )
-                parts.append(f'{"inertia" if key == "meshinertia" else key}="{_q(text)}"')
-            self.out.append(f"    <mesh {' '.join(parts)}/>")
+                parts.append(f'{cls._ASSET_XML.get(key, key)}="{_q(text)}"')
+            self.out.append(f"    <{cls._ASSET_TAG} {' '.join(parts)}/>")
         self.out.append("  </asset>")
 
     # ------------------------------------------------------------------ tree
     def write_children(self, node: BaseThing, indent: str, body_idx: int = 0) -> None:
-        from robotwright.things.geoms import Mesh
-
         out = self.out
         order = self.order
         for child in node._children:
@@ -180,9 +173,10 @@ class _Writer:
                 continue
             # MuJoCo numbers geoms, joints, sites, ... body by body (body id order).
             self.by_body.setdefault(ns, []).append((body_idx, child.ID))
-            if isinstance(child, Mesh):
-                attrs = self.attrs(child, skip=set(Mesh._ASSET_ATTR))
-                attrs += f' mesh="{_q(self.mesh_of_geom[child.ID])}"'
+            asset_tag = getattr(child, "_ASSET_TAG", None)
+            if asset_tag is not None:
+                attrs = self.attrs(child, skip=set(child._ASSET_ATTR))
+                attrs += f' {asset_tag}="{_q(self.mesh_of_geom[child.ID])}"'
             else:
                 attrs = self.attrs(child)
             out.append(f"{indent}<{child._TAG} {attrs}/>")
