@@ -120,3 +120,24 @@ def test_library_referenced_by_grammar_file(tmp_path):
     g["library"] = "library.yaml"
     gp, _ = write(tmp_path, g, lib)
     assert load_grammar(gp).library.source.endswith("library.yaml")
+
+
+def test_unknown_fields_and_bad_connector_ranges(tmp_path):
+    g, lib = default_data()
+    g["rules"]["r2"]["rsh"] = "typo"
+    lib["components"]["revolute"]["dofs"][0]["range"] = ["-lim", "lim"]
+    lib["components"]["link"]["colour"] = [1, 0, 0, 1]
+    msgs = [str(p) for p in _problems(tmp_path, g, lib)]
+    assert any("rule 'r2'" in m and "column 'rsh'" in m and "unknown field" in m for m in msgs)
+    assert any("component 'revolute'" in m and "unknown parameter '-lim'" in m for m in msgs)
+    assert any("component 'link'" in m and "column 'colour'" in m for m in msgs)
+
+
+def test_symbol_never_produced_is_a_warning_not_an_error(tmp_path):
+    from robotwright.grammar.loader import GrammarWarning
+
+    g, lib = default_data()
+    g["symbols"]["W"] = {"kind": "terminal", "description": "unused"}
+    with pytest.warns(GrammarWarning, match="symbol 'W'"):
+        grammar = load_variant(tmp_path, g, lib)
+    assert "W" in grammar.symbols
