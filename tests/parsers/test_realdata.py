@@ -27,19 +27,18 @@ TESTDATA = Path(__file__).resolve().parents[2] / ".testdata/mjlab/mjlab/asset_zo
 # 2 cores; tolerances are the same as for 50.
 CORPUS_CONFIGS = 10
 
-HEAVY = "an STL has over 200k faces, which MuJoCo refuses (no decimation applied by default)"
-MASSLESS = "massless or zero-inertia moving link: HRDF requires mass > 0 and inertia > 0"
+MASSLESS = (
+    "massless or zero-inertia moving link: HRDF requires mass > 0 and inertia > 0 "
+    "(passes with bound_mass/bound_inertia, see test_repaired_robots_match_yourdfpy)"
+)
 EXPECTED_FAILURES: dict[str, str] = {
     "alex_description/urdf/alex_nub_hands.urdf": "visual mesh 'nub' has too small a volume: MuJoCo refuses to compile it",
     "alex_description/urdf/alex_psyonic_hands.urdf": "mimic joints name a joint ('index_q1') that does not exist; the mimic is dropped, yourdfpy still couples them",
-    "b1_description/urdf/b1-z1.urdf": HEAVY,
-    "b1_description/urdf/b1.urdf": HEAVY,
-    "go1_description/urdf/go1.urdf": HEAVY,
     "human_description/robots/human.urdf": MASSLESS,
     "icub_description/robots/icub.urdf": MASSLESS,
     "icub_description/robots/icub_reduced.urdf": MASSLESS,
     "romeo_description/urdf/romeo.urdf": MASSLESS,
-    "romeo_description/urdf/romeo_small.urdf": "non-physical inertia (A + B < C) that HRDF refuses (balance_inertia=True repairs it)",
+    "romeo_description/urdf/romeo_small.urdf": "non-physical inertia (A + B < C) that HRDF refuses (passes with balance_inertia, see test_repaired_robots_match_yourdfpy)",
     "romeo_description/urdf/romeo_laas_small.urdf": "meshes point to file:///usr/Romeo/..., absent",
     "ur_description/urdf/ur3.urdf": "the file holds an empty <robot>",
 }
@@ -71,6 +70,34 @@ def test_expected_failures_exist() -> None:
         pytest.skip(f"example-robot-data absent: {ERD}")
     missing = [k for k in EXPECTED_FAILURES if not (ERD / k).is_file()]
     assert not missing
+
+
+REPAIRED = [
+    "human_description/robots/human.urdf",
+    "icub_description/robots/icub.urdf",
+    "icub_description/robots/icub_reduced.urdf",
+    "romeo_description/urdf/romeo.urdf",
+    "romeo_description/urdf/romeo_small.urdf",
+]
+
+
+@pytest.mark.parametrize("rel", REPAIRED)
+def test_repaired_robots_match_yourdfpy(rel: str) -> None:
+    """The robots HRDF refuses as they are import with MuJoCo's repairs, given as options
+    (each repair is a warning), and match yourdfpy with the same repairs applied."""
+    if not (ERD / rel).is_file():
+        pytest.skip(f"example-robot-data absent: {ERD / rel}")
+    report = roundtrip(
+        ERD / rel,
+        configs=CORPUS_CONFIGS,
+        reference="yourdfpy",
+        fixed_joints="keep",
+        bound_mass=1e-4,
+        bound_inertia=1e-8,
+        balance_inertia=True,
+    )
+    assert report.ok, report.table()
+    assert any("raised to bound" in w or "balanced" in w for w in report.warnings)
 
 
 @pytest.mark.parametrize("robot", ["unitree_g1/xmls/g1.xml", "unitree_go1/xmls/go1.xml"])

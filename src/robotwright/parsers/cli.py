@@ -12,7 +12,18 @@ def _options(args: argparse.Namespace) -> dict:
         opts["fixed_joints"] = args.fixed_joints
     if getattr(args, "root_body", None):
         opts["root_body"] = args.root_body
+    for name in ("bound_mass", "bound_inertia"):
+        if getattr(args, name, None) is not None:
+            opts[name] = getattr(args, name)
+    if getattr(args, "balance_inertia", False):
+        opts["balance_inertia"] = True
     return opts
+
+
+def _repair_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--balance-inertia", action="store_true", help="URDF: MuJoCo's balanceinertia")
+    p.add_argument("--bound-mass", type=float, help="URDF: raise masses below this (kg)")
+    p.add_argument("--bound-inertia", type=float, help="URDF: raise moments below this (kg m^2)")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -28,6 +39,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--root-body", help="MJCF sources: the top-level body that is the robot")
     p.add_argument("--strict", action="store_true", help="fail instead of dropping anything")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output")
+    _repair_args(p)
     p.set_defaults(func=_convert)
 
     p = sub.add_parser(
@@ -42,6 +54,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fixed-joints", choices=("keep", "merge", "site"), help="URDF sources")
     p.add_argument("--root-body", help="MJCF sources: the top-level body that is the robot")
     p.add_argument("--show-warnings", action="store_true", help="list the parse warnings")
+    p.add_argument(
+        "--reference",
+        choices=("auto", "mujoco", "yourdfpy"),
+        default="auto",
+        help="URDF: what to compare with (auto: MuJoCo's import, yourdfpy if MuJoCo refuses)",
+    )
+    _repair_args(p)
     p.set_defaults(func=_roundtrip)
 
 
@@ -62,7 +81,9 @@ def _roundtrip(args: argparse.Namespace) -> int:
     from robotwright.parsers.roundtrip import roundtrip
 
     logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
-    report = roundtrip(args.source, configs=args.configs, **_options(args))
+    report = roundtrip(
+        args.source, configs=args.configs, reference=args.reference, **_options(args)
+    )
     print(report.table())
     if args.show_warnings:
         for w in report.warnings:

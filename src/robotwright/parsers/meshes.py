@@ -1,11 +1,16 @@
-"""Mesh files of a parsed robot: staging, format conversion and face counts.
+"""Mesh files of a parsed robot: staging, lossless format conversion and face counts.
 
 A parsed robot's meshes are gathered in one staging folder (``<work_dir>/meshes/``)
 under unique names, so that two source files with the same base name never collide and
-``HRDF.save`` copies them into the HRDF folder. Formats MuJoCo reads (STL, OBJ, MSH) are
-linked (or copied where links are not possible); other formats (DAE, PLY, ...) are
-converted to binary STL with trimesh, which keeps the geometry in the file's own units
-and drops the file's materials and textures (reported by the caller).
+``HRDF.save`` copies them into the HRDF folder.
+
+- Binary STL up to :data:`HEAVY_FACES` faces, OBJ and MSH (formats MuJoCo decodes) are
+  hard-linked, or copied where links are not possible.
+- Other formats (DAE, PLY, ...), ASCII STL (MuJoCo reads binary STL only) and STLs over
+  :data:`HEAVY_FACES` faces (MuJoCo's STL decoder refuses them) are converted with
+  trimesh, triangles unchanged (``process=False``: no merging, no cleaning), to binary
+  STL, or to OBJ above :data:`HEAVY_FACES` faces. Scene transforms of the file are
+  applied; materials and textures of the file are dropped (callers report it).
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ import numpy as np
 
 #: Extensions MuJoCo decodes itself.
 MUJOCO_MESH_EXTENSIONS = frozenset({".stl", ".obj", ".msh"})
-#: Meshes above this many faces are reported (MuJoCo refuses STLs over 200k faces).
+#: MuJoCo's STL decoder refuses files with more faces than this.
 HEAVY_FACES = 200_000
 
 
@@ -40,22 +45,23 @@ class StagedMesh:
     Attributes:
         source: the original file.
         rel: path relative to the staging folder (``meshes/<name>.<ext>``).
-        converted: True when the file was converted (not a link/copy of the source).
-        faces: face count when known (converted files and STL headers), else None.
+        converted: why the file was rewritten (``"format"``, ``"ascii-stl"``,
+            ``"heavy-stl"``, ``"mirrored"``), or ``None`` for a link/copy of the source.
+        faces: face count when known (converted files and binary STL headers), else None.
     """
 
     source: Path
     rel: str
-    converted: bool
+    converted: str | None
     faces: int | None = None
 
 
 @dataclass
 class MeshStore:
-    """Stages mesh files into ``root/meshes``; one entry per distinct source file."""
+    """Stages mesh files into ``root/meshes``; one entry per distinct source (and mirror)."""
 
     root: Path = field(default_factory=lambda: Path(tempfile.mkdtemp(prefix="robotwright-mesh-")))
-    staged: dict[Path, StagedMesh] = field(default_factory=dict)
+    staged: dict[str, StagedMesh] = field(default_factory=dict)
     _used: set[str] = field(default_factory=set)
 
     def __post_init__(self) -> None:
@@ -69,39 +75,32 @@ class MeshStore:
         self._used.add(name.lower())
         return name
 
-    def add_mirrored(self, source: Path, signs: tuple[float, float, float]) -> StagedMesh:
-        """Stage ``source`` mirrored by the per-axis ``signs`` (each +1 or -1): vertices
-        are multiplied by the signs and, for an odd number of flips, the face winding is
-        reversed so that normals still point outwards."""
-        import trimesh
-
-        key = Path(f"{source.resolve()}#mirror{signs}")
-        if key in self.staged:
-            return self.staged[key]
-        try:
-            # process=False: keep triangles exactly as in the file (no merging/cleaning)
-            mesh = trimesh.load(str(source), force="mesh", process=False)
-        except Exception as exc:  # trimesh raises many types; name the file
-            raise MeshConversionError(f"cannot read mesh {source}: {exc}") from exc
-        mesh.apply_transform(np.diag([*signs, 1.0]))
-        name = self._unique(_safe_stem(source) + "_mirrored", ".stl")
+    def _write(self, mesh, stem: str) -> tuple[str, int]:
+        faces = int(len(mesh.faces))
+        ext = ".obj" if faces > HEAVY_FACES else ".stl"
+        name = self._unique(stem, ext)
         dest = self.root / "meshes" / name
         tmp = dest.with_name(dest.name + ".tmp")
-        mesh.export(str(tmp), file_type="stl")
+        mesh.export(str(tmp), file_type=ext[1:])
         os.replace(tmp, dest)
-        entry = StagedMesh(source, f"meshes/{name}", True, int(len(mesh.faces)))
-        self.staged[key] = entry
-        return entry
+        return f"meshes/{name}", faces
 
     def add(self, source: Path) -> StagedMesh:
         """Stage ``source`` (an existing file) and return its entry."""
         source = source.resolve()
-        if source in self.staged:
-            return self.staged[source]
+        key = str(source)
+        if key in self.staged:
+            return self.staged[key]
         ext = source.suffix.lower()
-        # MuJoCo reads binary STL only: an ASCII STL is converted like other formats.
-        ascii_stl = ext == ".stl" and stl_face_count(source) is None
-        if ext in MUJOCO_MESH_EXTENSIONS and not ascii_stl:
+        faces = stl_face_count(source)
+        reason = None
+        if ext not in MUJOCO_MESH_EXTENSIONS:
+            reason = "format"
+        elif ext == ".stl" and faces is None:
+            reason = "ascii-stl"
+        elif ext == ".stl" and faces > HEAVY_FACES:
+            reason = "heavy-stl"
+        if reason is None:
             name = self._unique(_safe_stem(source), ext)
             dest = self.root / "meshes" / name
             # A hard link costs nothing and, unlike a symlink, resolves inside the
@@ -110,14 +109,40 @@ class MeshStore:
                 os.link(source, dest)
             except OSError:
                 shutil.copyfile(source, dest)
-            entry = StagedMesh(source, f"meshes/{name}", False, stl_face_count(source))
+            entry = StagedMesh(source, f"meshes/{name}", None, faces)
         else:
-            name = self._unique(_safe_stem(source), ".stl")
-            dest = self.root / "meshes" / name
-            faces = convert_to_stl(source, dest)
-            entry = StagedMesh(source, f"meshes/{name}", True, faces)
-        self.staged[source] = entry
+            rel, faces = self._write(load_triangles(source), _safe_stem(source))
+            entry = StagedMesh(source, rel, reason, faces)
+        self.staged[key] = entry
         return entry
+
+    def add_mirrored(self, source: Path, signs: tuple[float, float, float]) -> StagedMesh:
+        """Stage ``source`` mirrored by the per-axis ``signs`` (each +1 or -1): vertices
+        are multiplied by the signs; trimesh reverses the face winding of a reflection so
+        that normals still point outwards."""
+        key = f"{source.resolve()}#mirror{signs}"
+        if key in self.staged:
+            return self.staged[key]
+        mesh = load_triangles(source)
+        mesh.apply_transform(np.diag([*signs, 1.0]))
+        rel, faces = self._write(mesh, _safe_stem(source) + "_mirrored")
+        entry = StagedMesh(source, rel, "mirrored", faces)
+        self.staged[key] = entry
+        return entry
+
+
+def conversion_note(staged: StagedMesh) -> str | None:
+    """The warning text for a converted mesh (None for a plain link/copy)."""
+    target = staged.rel.rsplit(".", 1)[-1].upper()
+    return {
+        "format": f"converted to {target} ({staged.rel}); triangles kept, the file's "
+        "materials/textures dropped",
+        "ascii-stl": f"ASCII STL rewritten as binary STL ({staged.rel}; MuJoCo reads binary "
+        "STL only); triangles unchanged",
+        "heavy-stl": f"{staged.faces} faces, over MuJoCo's STL limit of {HEAVY_FACES}: "
+        f"rewritten as OBJ ({staged.rel}); triangles unchanged",
+        "mirrored": None,
+    }.get(staged.converted or "")
 
 
 def stl_face_count(path: Path) -> int | None:
@@ -137,9 +162,9 @@ def stl_face_count(path: Path) -> int | None:
     return count if size == 84 + 50 * count else None
 
 
-def convert_to_stl(source: Path, dest: Path) -> int:
-    """Convert ``source`` (any format trimesh reads, scene transforms applied) to binary
-    STL at ``dest`` (written to a temporary file, then renamed). Returns the face count."""
+def load_triangles(source: Path):
+    """The triangles of a mesh file as one ``trimesh.Trimesh`` (scene transforms applied,
+    nothing merged or cleaned)."""
     import trimesh
 
     try:
@@ -148,7 +173,4 @@ def convert_to_stl(source: Path, dest: Path) -> int:
         raise MeshConversionError(f"cannot read mesh {source}: {exc}") from exc
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise MeshConversionError(f"mesh {source} holds no triangles")
-    tmp = dest.with_name(dest.name + ".tmp")
-    loaded.export(str(tmp), file_type="stl")
-    os.replace(tmp, dest)
-    return int(len(loaded.faces))
+    return loaded

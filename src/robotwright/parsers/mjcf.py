@@ -36,7 +36,7 @@ from robotwright.hrdf.model import (
     Site,
 )
 from robotwright.parsers import inertia as inr
-from robotwright.parsers.meshes import HEAVY_FACES, MeshConversionError, MeshStore
+from robotwright.parsers.meshes import MeshConversionError, MeshStore, conversion_note
 from robotwright.parsers.reference import body_name, joint_name
 from robotwright.parsers.report import ParseResult, Reporter
 from robotwright.parsers.xmlsafe import parse_xml
@@ -373,10 +373,9 @@ def parse_mjcf(
                     staged = store.add(src)
                 except (MeshConversionError, OSError) as exc:
                     raise ConversionError([Problem(str(path), str(exc), element=where)]) from exc
-                if staged.faces is not None and staged.faces > HEAVY_FACES:
-                    rep.warn(
-                        f"mesh '{m_spec.file}' has {staged.faces} faces (> {HEAVY_FACES})", where
-                    )
+                note = conversion_note(staged)
+                if note:
+                    rep.warn(f"mesh '{m_spec.file}': {note}", where)
                 mesh_files[mid] = (model.mesh(mid).name or Path(m_spec.file).stem, staged.rel)
             mname, rel = mesh_files[mid]
             # Undo MuJoCo's mesh re-centring: compiled = authored * mesh frame.

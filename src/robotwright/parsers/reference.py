@@ -239,8 +239,34 @@ def urdf_mujoco_view(path: Path, package_map=None, **compiler) -> RobotView:
     return view_from_model(mujoco.MjModel.from_xml_string(text), "mujoco")
 
 
-def urdf_yourdfpy_view(path: Path) -> RobotView:
-    """An independent reference: ``yourdfpy`` kinematics and the URDF's inertials."""
+def _repair(
+    mass: float, tensor: np.ndarray, balance_inertia: bool, bound_mass, bound_inertia
+) -> tuple[float, np.ndarray]:
+    """MuJoCo's compiler repairs (balanceinertia, boundmass, boundinertia) applied to one
+    body's mass and tensor: moments are frame-invariant, so any frame works."""
+    if not (balance_inertia or bound_mass is not None or bound_inertia is not None):
+        return mass, tensor
+    values, vectors = np.linalg.eigh(tensor)
+    if balance_inertia and mass > 0 and values.min() > 0:
+        a, b, c = values
+        if a + b < c or a + c < b or b + c < a:
+            values = np.full(3, values.mean())
+    if bound_mass is not None:
+        mass = max(mass, float(bound_mass))
+    if bound_inertia is not None:
+        values = np.maximum(values, float(bound_inertia))
+    return mass, vectors @ np.diag(values) @ vectors.T
+
+
+def urdf_yourdfpy_view(
+    path: Path,
+    *,
+    balance_inertia: bool = False,
+    bound_mass: float | None = None,
+    bound_inertia: float | None = None,
+) -> RobotView:
+    """An independent reference: ``yourdfpy`` kinematics and the URDF's inertials (with
+    the same repairs as the parser options, when given)."""
     import yourdfpy
 
     robot = yourdfpy.URDF.load(
@@ -268,6 +294,9 @@ def urdf_yourdfpy_view(path: Path) -> RobotView:
         rot = world[:3, :3]
         mass[n] = float(link.inertial.mass or 0.0)
         inertia[n] = (world[:3, 3].copy(), rot @ np.asarray(link.inertial.inertia) @ rot.T)
+    for n in links:
+        m, t = _repair(mass[n], inertia[n][1], balance_inertia, bound_mass, bound_inertia)
+        mass[n], inertia[n] = m, (inertia[n][0], t)
     joints = []
     for jn, j in robot.joint_map.items():
         if j.type in ("fixed",):

@@ -443,8 +443,11 @@ def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
         return mujoco.MjModel.from_xml_string(text)
 
 
-def reference_view(path: Path, **options: Any) -> RobotView:
-    """The source as MuJoCo compiles it; for a URDF MuJoCo refuses, yourdfpy's view."""
+def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:
+    """The source as MuJoCo compiles it; for a URDF MuJoCo refuses (or with
+    ``reference="yourdfpy"``), yourdfpy's view."""
+    if reference not in ("auto", "mujoco", "yourdfpy"):
+        raise ValueError(f"reference={reference!r}: expected 'auto', 'mujoco' or 'yourdfpy'")
     if source_kind(path) == "mjcf":
         return view_from_model(
             mujoco.MjModel.from_xml_path(str(path)), root=options.get("root_body")
@@ -452,18 +455,30 @@ def reference_view(path: Path, **options: Any) -> RobotView:
     compiler = {
         k: options[k] for k in ("balance_inertia", "bound_mass", "bound_inertia") if k in options
     }
+    if reference == "yourdfpy":
+        return urdf_yourdfpy_view(path, **compiler)
     try:
         return urdf_mujoco_view(path, options.get("package_map"), **compiler)
     except ValueError as exc:
-        view = urdf_yourdfpy_view(path)
+        if reference == "mujoco":
+            raise
+        view = urdf_yourdfpy_view(path, **compiler)
         view.kind = f"yourdfpy (MuJoCo refuses the source: {str(exc).splitlines()[0][:120]})"
         return view
 
 
 def roundtrip(
-    source: str | os.PathLike, *, configs: int = 50, urdf: bool = True, **options: Any
+    source: str | os.PathLike,
+    *,
+    configs: int = 50,
+    urdf: bool = True,
+    reference: str = "auto",
+    **options: Any,
 ) -> RoundTripReport:
-    """The fidelity table of one MJCF or URDF file (see the module docstring)."""
+    """The fidelity table of one MJCF or URDF file (see the module docstring).
+
+    ``reference``: ``"auto"`` (MuJoCo's import; yourdfpy for a URDF MuJoCo refuses),
+    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``options`` go to the parser."""
     path = Path(source)
     report = RoundTripReport(str(path), "")
     try:
@@ -473,7 +488,7 @@ def roundtrip(
         return report
     report.warnings = [str(w) for w in result.warnings]
     try:
-        ref = reference_view(path, **options)
+        ref = reference_view(path, reference, **options)
     except Exception as exc:
         report.error = f"no reference: {type(exc).__name__}: {exc}"
         return report

@@ -34,7 +34,7 @@ from robotwright.hrdf.model import (
 )
 from robotwright.parsers import inertia as inr
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
-from robotwright.parsers.meshes import HEAVY_FACES, MeshConversionError, MeshStore
+from robotwright.parsers.meshes import MeshConversionError, MeshStore, conversion_note
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import ParseResult, Reporter
 from robotwright.parsers.xmlsafe import describe, parse_xml
@@ -193,7 +193,7 @@ class _URDFReader:
         self.unresolved: list[Problem] = []
         self.mesh_names: dict[tuple[str, tuple[float, float, float]], str] = {}
         self.mesh_name_used: set[str] = set()
-        self.heavy: dict[str, int] = {}
+        self.noted: set[str] = set()
 
     # -- geometry -------------------------------------------------------------------------
     def _material(self, elem: ET.Element | None, where: str) -> tuple | None:
@@ -283,12 +283,11 @@ class _URDFReader:
                 else:
                     self.unresolved.append(Problem(self.rep.file, str(exc), element=where))
                 return None
-            if staged.converted and not staged.rel.endswith("_mirrored.stl"):
-                self.rep.warn(
-                    f"mesh '{uri}' converted to STL (its materials/textures are dropped)", where
-                )
-            if staged.faces is not None and staged.faces > HEAVY_FACES:
-                self.heavy[uri] = staged.faces
+            if staged.rel not in self.noted:
+                self.noted.add(staged.rel)
+                note = conversion_note(staged)
+                if note:
+                    self.rep.warn(f"mesh '{uri}': {note}", where)
             fields.update(
                 mesh=True, name=self._mesh_name(staged.rel, scale), file=staged.rel, scale=scale
             )
@@ -432,8 +431,6 @@ def parse_urdf(
         raise ConversionError(
             reader.unresolved, summary=f"{len(reader.unresolved)} mesh(es) of {path} not resolved"
         )
-    for uri, faces in sorted(reader.heavy.items()):
-        rep.warn(f"mesh '{uri}' has {faces} faces (> {HEAVY_FACES}): MuJoCo refuses such STLs")
 
     # A massless, geometry-free root link (usually "world") only anchors the robot: its
     # single child becomes the root, placed at the joint origin.
@@ -443,7 +440,13 @@ def parse_urdf(
     free_name: str | None = None
     dropped_root: tuple[str, str] | None = None
     r = data[root_name]
-    if (not r.has_inertial or r.mass == 0.0) and not r.geoms and len(children[root_name]) == 1:
+    # (With bound_mass the root is not massless: it stays, as in MuJoCo's importer.)
+    if (
+        (not r.has_inertial or r.mass == 0.0)
+        and opt.bound_mass is None
+        and not r.geoms
+        and len(children[root_name]) == 1
+    ):
         j = children[root_name][0]
         if j.get("type") in ("fixed", "floating"):
             child = j.find("child").get("link")
