@@ -70,6 +70,10 @@ HURODES_META_KEYS: tuple[str, ...] = (
 EXTENSION_META_KEYS: tuple[str, ...] = ("format_version", "floating_base", "base_joint_name")
 EXTRA_MJCF_FILE = "extra.xml"
 JOINT_MAPPING_FILE = "joint_mapping.yaml"
+_KNOWN_FILES = frozenset(
+    {f"{stem}.csv" for stem in TABLES}
+    | {"meta.yaml", "meshes", EXTRA_MJCF_FILE, JOINT_MAPPING_FILE}
+)
 
 
 # libyaml's loader is ~20x faster than the pure-Python one; both are "safe" loaders.
@@ -433,10 +437,13 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
 
     root = Path(path)
     problems: list[Problem] = []
-    if not root.is_dir():
+    try:
+        # One listing answers every "is this file there" question below.
+        present = {e.name for e in os.scandir(root)}
+    except (FileNotFoundError, NotADirectoryError):
         return None, [Problem(str(root), "not a folder: expected an HRDF folder")]
     meta_path = root / "meta.yaml"
-    if not meta_path.is_file():
+    if "meta.yaml" not in present or not meta_path.is_file():
         return None, [Problem(str(meta_path), "meta.yaml is missing")]
     meta, parent_ids, ext = _parse_meta(_load_yaml(meta_path, problems), problems)
     hurodes_format = meta.format_version is None
@@ -452,7 +459,7 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
     tables: dict[str, _Table | None] = {}
     for stem, schema in TABLES.items():
         csv_path = root / f"{stem}.csv"
-        if not csv_path.exists():
+        if csv_path.name not in present:
             if stem == "body":
                 problems.append(Problem("body.csv", "required file is missing"))
             tables[stem] = None
@@ -467,15 +474,9 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
             )
         tables[stem] = _read_table(csv_path, schema, problems, hurodes_format=hurodes_format)
 
-    for child in sorted(root.iterdir()):
-        known = {f"{s}.csv" for s in TABLES} | {
-            "meta.yaml",
-            "meshes",
-            EXTRA_MJCF_FILE,
-            JOINT_MAPPING_FILE,
-        }
-        if child.name not in known and not child.name.startswith("."):
-            problems.append(Problem(child.name, "unknown file, ignored", severity="warning"))
+    for child_name in sorted(present - _KNOWN_FILES):
+        if not child_name.startswith("."):
+            problems.append(Problem(child_name, "unknown file, ignored", severity="warning"))
 
     if tables.get("body") is None:
         return None, problems
@@ -546,16 +547,17 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
 
     joint_mapping = None
     jm_path = root / JOINT_MAPPING_FILE
-    if jm_path.exists():
+    if JOINT_MAPPING_FILE in present:
         joint_mapping = _load_yaml(jm_path, problems)
     meta.joint_mapping = joint_mapping
     mjcf_extra = None
     extra_path = root / EXTRA_MJCF_FILE
-    if extra_path.exists():
+    if EXTRA_MJCF_FILE in present:
         mjcf_extra = extra_path.read_text(encoding="utf-8")
 
+    resolved = root.resolve()
     hrdf = HRDF(
-        name=root.resolve().name,
+        name=resolved.name,
         bodies=[b for b in bodies if b is not None]
         if all(b is not None for b in bodies)
         else bodies,  # type: ignore[misc]
@@ -567,7 +569,7 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
         sensors=[s for s in records["sensor"] if s is not None],
         meta=meta,
         mjcf_extra=mjcf_extra,
-        root_dir=root.resolve(),
+        root_dir=resolved,
     )
     if any(b is None for b in hrdf.bodies):
         return None, problems

@@ -34,7 +34,7 @@ AXIS_NORM_MIN = 1e-9
 
 
 def _quat_problem(q: Sequence[float]) -> str | None:
-    norm = math.sqrt(sum(v * v for v in q))
+    norm = math.hypot(*q)
     if abs(norm - 1.0) > QUAT_NORM_TOL:
         return f"quaternion {tuple(q)} has norm {norm:.6g}: expected 1 (tolerance {QUAT_NORM_TOL})"
     return None
@@ -299,7 +299,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             msg = _quat_problem(g.quat)
             if msg:
                 out.append(Problem(table, msg, row=i, column="quat"))
-            if any(not 0.0 <= v <= 1.0 for v in g.rgba):
+            if not (min(g.rgba) >= 0.0 and max(g.rgba) <= 1.0):
                 out.append(
                     Problem(
                         table, f"rgba {g.rgba}: expected values in [0, 1]", row=i, column="rgba"
