@@ -233,7 +233,9 @@ def _convert_table_fast(
                             return None
                     else:
                         part = list(map(float, cells))
-                        if not all(map(isfinite, part)):
+                        # inf/nan propagate through a sum: one C-level check per column
+                        # (a finite sum that overflows only sends us to the slow path).
+                        if not isfinite(sum(part)):
                             return None
                     parts.append(part)
                 if col.size == 0:
@@ -265,7 +267,11 @@ def _convert_table_fast(
             values.append(vals)
     except ValueError:
         return None
-    return [dict(absent, **dict(zip(fields_, row))) for row in zip(*values)]
+    n = len(data)
+    for name, default in absent.items():
+        fields_.append(name)
+        values.append([default] * n)
+    return [dict(zip(fields_, row)) for row in zip(*values)]
 
 
 def _record(cls: type, values: dict[str, Any]) -> Any:
