@@ -8,13 +8,16 @@ its own robot pose).
 
 Contenders, timed per frame on the same poses and directions:
   raw mj_multiRay       one mj_multiRay call per environment, one thread, no labels
-  robotwright mujoco/1t SemanticLidarSensor.update() (labels on), engine "mujoco", 1 thread
+  robotwright mujoco/1t SemanticLidarSensor.update() (labels on), engine "mujoco", 1 thread,
+                        with the raw call's fixed directions, and with the Mid-360
+                        pattern regenerated every frame
   robotwright mujoco/Nt the same on every core
   robotwright warp      engine "warp" (mujoco-warp BVH; CPU device here, CUDA when present)
   mujoco-lidar cpu/warp MjLidarWrapper backends, when the package is installed (no labels)
 
 Contenders run interleaved (one frame each, in turn) so load from other processes hits
-them alike; prints medians of --repeats frames, the ratio to raw mj_multiRay and the
+them alike, for at least --repeats rounds and --min-seconds of raw frames; prints median
+frame times, the ratio to raw mj_multiRay and the
 fraction of rays that hit something within 40 m (a check that all do the same work).
 Run: python benchmarks/lidar.py [--repeats 7] [--envs 1 16] [--scenes plane hfield]
 """
@@ -25,13 +28,16 @@ import argparse
 import math
 import os
 import statistics
+import tempfile
 import time
+from pathlib import Path
 
 import mujoco
 import numpy as np
 import trimesh
 
 from robotwright.sensors import (
+    FilePatternCfg,
     LivoxPatternCfg,
     SemanticLidarCfg,
     SemanticLidarSensor,
@@ -106,7 +112,9 @@ def make_envs(model: mujoco.MjModel, n: int) -> list[mujoco.MjData]:
     return datas
 
 
-def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float, float]]:
+def bench_scene(
+    kind: str, num_envs: int, repeats: int, min_seconds: float
+) -> list[tuple[str, float, float]]:
     """(label, median seconds per frame, fraction of rays that hit) for every contender."""
     model = build_scene(kind)
     datas = make_envs(model, num_envs)
@@ -139,12 +147,23 @@ def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float
         return float(((raw_ids >= 0) & (raw_dist <= 40.0)).mean())
 
     contenders = [("raw mj_multiRay (1 thread, no labels)", raw)]
-    common = dict(prim_path="lidar", pattern_cfg=pattern, max_distance=40.0, return_mesh_ids=True)
+    common = dict(prim_path="lidar", max_distance=40.0, return_mesh_ids=True)
+    # The same 20k directions every frame, as the raw call uses (read from a file of
+    # angles), and the Mid-360 pattern regenerated every frame (non-repetitive).
+    angles = np.stack(
+        [np.arctan2(dirs_s[:, 1], dirs_s[:, 0]), np.arcsin(np.clip(dirs_s[:, 2], -1, 1))], 1
+    )
+    fixed_file = Path(tempfile.mkdtemp()) / "mid360_frame0.npy"
+    np.save(fixed_file, angles)
+    fixed = FilePatternCfg(path=fixed_file)
     ncpu = os.cpu_count() or 1
-    engines = [("mujoco, 1 thread", dict(engine="mujoco", num_threads=1))]
-    engines.append((f"mujoco, {ncpu} threads", dict(engine="mujoco", num_threads=ncpu)))
+    engines = [
+        ("mujoco, 1 thread, fixed rays", dict(engine="mujoco", num_threads=1, pattern_cfg=fixed)),
+        ("mujoco, 1 thread", dict(engine="mujoco", num_threads=1, pattern_cfg=pattern)),
+        (f"mujoco, {ncpu} threads", dict(engine="mujoco", num_threads=ncpu, pattern_cfg=pattern)),
+    ]
     if warp_available():
-        engines.append(("warp", dict(engine="warp")))
+        engines.append(("warp", dict(engine="warp", pattern_cfg=pattern)))
     for label, extra in engines:
         sensor = SemanticLidarSensor(SemanticLidarCfg(**common, **extra), model, datas)
         if extra["engine"] == "warp":
@@ -190,13 +209,18 @@ def bench_scene(kind: str, num_envs: int, repeats: int) -> list[tuple[str, float
     for label, fn in contenders:  # warm-up: JIT compile, caches
         fn()
         hits[label] = fn()
+    # Short frames get more rounds (at least min_seconds of raw frames, at most 300).
+    t0 = time.perf_counter()
+    raw()
+    rounds = max(repeats, min(300, math.ceil(min_seconds / (time.perf_counter() - t0))))
     # Interleave the contenders so that load from other processes hits them alike.
     times: dict[str, list[float]] = {label: [] for label, _ in contenders}
-    for _ in range(repeats):
+    for _ in range(rounds):
         for label, fn in contenders:
             t0 = time.perf_counter()
             fn()
             times[label].append(time.perf_counter() - t0)
+    print(f"  ({rounds} interleaved rounds)")
     return [(label, statistics.median(times[label]), hits[label]) for label, _ in contenders]
 
 
@@ -204,7 +228,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--repeats", type=int, default=7, help="minimum rounds per case")
+    ap.add_argument("--min-seconds", type=float, default=1.0, help="minimum raw time per case")
     ap.add_argument("--envs", type=int, nargs="+", default=[1, 16])
     ap.add_argument("--scenes", nargs="+", default=["plane", "hfield"], choices=["plane", "hfield"])
     args = ap.parse_args()
@@ -212,13 +237,13 @@ def main() -> None:
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     for kind in args.scenes:
         for n in args.envs:
-            print(f"\nscene={kind} envs={n}  (median of {args.repeats} frames)")
-            results = bench_scene(kind, n, args.repeats)
+            print(f"\nscene={kind} envs={n}  (median frame time)")
+            results = bench_scene(kind, n, args.repeats, args.min_seconds)
             base = results[0][1]
             for label, t, hit in results:
                 mrays = n * NUM_RAYS / t / 1e6
                 print(
-                    f"  {label:40s} {t * 1e3:9.2f} ms/frame {mrays:7.2f} Mrays/s"
+                    f"  {label:48s} {t * 1e3:9.2f} ms/frame {mrays:7.2f} Mrays/s"
                     f"  x{base / t:6.2f} vs raw  hits {hit:6.1%}"
                 )
     print(f"\nload average after: {os.getloadavg()[0]:.2f}")
