@@ -111,21 +111,23 @@ def test_mjlab_mjcf_roundtrip(robot: str) -> None:
 
 
 DM = PURELIB / "dm_control" / "suite"
+MULTI = "URDF: several joints on one body need massless links, which MuJoCo refuses"
+SITE_NAMES = "URDF: site names equal body names (our URDF writes sites as links)"
 DM_EXPECTED = {
-    "fish.xml": "a tendon-driven actuator: HRDF actuators drive joints only",
-    "point_mass.xml": "tendon-driven actuators: HRDF actuators drive joints only",
-    "swimmer.xml": "a sensor reads a site of a body outside the robot (dropped)",
-    "ball_in_cup.xml": "a tendon ties the cup to the ball, which is not part of the robot",
-    "dog.xml": "keyframes hold the ball's qpos too (the ball is not part of the robot)",
-    "finger.xml": "sensors read the spinner/target outside the robot (dropped)",
-    "manipulator.xml": "a tendon-driven gripper actuator: HRDF actuators drive joints only",
-    "stacker.xml": "a tendon-driven gripper actuator: HRDF actuators drive joints only",
-    "quadruped.xml": "tendon-driven actuators; URDF: site names equal body names",
-    "cheetah.xml": "URDF: several joints on one body need massless links, which MuJoCo refuses",
-    "hopper.xml": "URDF: several joints on one body need massless links, which MuJoCo refuses",
-    "walker.xml": "URDF: several joints on one body need massless links, which MuJoCo refuses",
-    "humanoid.xml": "URDF: site names equal body names (URDF writes sites as links)",
-    "humanoid_CMU.xml": "URDF: site 'root' equals a body name (URDF writes sites as links)",
+    "ball_in_cup.xml": "a tendon ties the cup to the ball, which is not part of the robot "
+    "(dropped); " + SITE_NAMES,
+    "cheetah.xml": MULTI,
+    "dog.xml": SITE_NAMES,
+    "finger.xml": "sensors read the spinner/target outside the robot (dropped); URDF: the "
+    "joint ref (qpos0 offset) is not applied by our URDF writer",
+    "fish.xml": SITE_NAMES,
+    "hopper.xml": MULTI,
+    "humanoid.xml": SITE_NAMES,
+    "humanoid_CMU.xml": SITE_NAMES,
+    "point_mass.xml": MULTI,
+    "quadruped.xml": SITE_NAMES,
+    "swimmer.xml": "a sensor reads a site outside the robot (dropped); " + SITE_NAMES,
+    "walker.xml": MULTI,
 }
 DM_ROOT = {
     "ball_in_cup.xml": "cup",
@@ -137,7 +139,14 @@ DM_ROOT = {
 }
 
 
-def _dm() -> list:
+DM_MJCF_EXPECTED = {
+    "ball_in_cup.xml": "a tendon ties the cup to the ball, which is not part of the robot",
+    "finger.xml": "sensors read the spinner/target outside the robot (dropped)",
+    "swimmer.xml": "a sensor reads a site outside the robot (dropped)",
+}
+
+
+def _dm(expected: dict[str, str]) -> list:
     if not DM.is_dir():
         return [pytest.param(None, marks=pytest.mark.skip(reason=f"dm_control absent: {DM}"))]
     out = []
@@ -145,16 +154,23 @@ def _dm() -> list:
         if p.name == "lqr.xml":  # generated at run time, the file holds no body
             continue
         marks = (
-            [pytest.mark.xfail(reason=DM_EXPECTED[p.name], strict=True)]
-            if p.name in DM_EXPECTED
-            else []
+            [pytest.mark.xfail(reason=expected[p.name], strict=True)] if p.name in expected else []
         )
         out.append(pytest.param(p.name, marks=marks, id=p.name))
     return out
 
 
-@pytest.mark.parametrize("name", _dm())
-def test_dm_control_suite_roundtrip(name: str) -> None:
+@pytest.mark.parametrize("name", _dm(DM_MJCF_EXPECTED))
+def test_dm_control_suite_mjcf_roundtrip(name: str) -> None:
+    """Source -> HRDF -> our MJCF, every row of the table exact."""
+    opts = {"root_body": DM_ROOT[name]} if name in DM_ROOT else {}
+    report = roundtrip(DM / name, configs=20, urdf=False, **opts)
+    assert report.ok, report.table()
+
+
+@pytest.mark.parametrize("name", _dm(DM_EXPECTED))
+def test_dm_control_suite_full_roundtrip(name: str) -> None:
+    """Both paths: our MJCF exact and our URDF (mass, FK to 1e-6)."""
     opts = {"root_body": DM_ROOT[name]} if name in DM_ROOT else {}
     report = roundtrip(DM / name, configs=20, **opts)
     assert report.ok, report.table()

@@ -86,44 +86,60 @@ def _fmt(values) -> str:
     return " ".join(repr(float(v)) for v in np.atleast_1d(values))
 
 
-def _actuator(model: mujoco.MjModel, i: int, rep: Reporter) -> Actuator | None:
-    name = model.actuator(i).name or None
-    where = f'<actuator name="{name}">' if name else f"actuator #{i}"
+_TRN_ATTR = {
+    int(mujoco.mjtTrn.mjTRN_JOINT): ("joint", mujoco.mjtObj.mjOBJ_JOINT),
+    int(mujoco.mjtTrn.mjTRN_JOINTINPARENT): ("jointinparent", mujoco.mjtObj.mjOBJ_JOINT),
+    int(mujoco.mjtTrn.mjTRN_TENDON): ("tendon", mujoco.mjtObj.mjOBJ_TENDON),
+    int(mujoco.mjtTrn.mjTRN_SITE): ("site", mujoco.mjtObj.mjOBJ_SITE),
+    int(mujoco.mjtTrn.mjTRN_BODY): ("body", mujoco.mjtObj.mjOBJ_BODY),
+}
+_DYN = {0: "none", 1: "integrator", 2: "filter", 3: "filterexact", 4: "muscle", 5: "user"}
+_GAIN = {0: "fixed", 1: "affine", 2: "muscle", 3: "user"}
+_BIAS = {0: "none", 1: "affine", 2: "muscle", 3: "user"}
+
+
+def _actuator_record(model: mujoco.MjModel, i: int) -> Actuator | None:
+    """The actuator as an HRDF record when the table holds it exactly, else None."""
     if model.actuator_trntype[i] != mujoco.mjtTrn.mjTRN_JOINT:
-        rep.warn("actuator with a non-joint transmission dropped (HRDF drives joints only)", where)
         return None
-    joint = joint_name(model, int(model.actuator_trnid[i, 0]))
     gain, bias = model.actuator_gainprm[i], model.actuator_biasprm[i]
     gt, bt = int(model.actuator_gaintype[i]), int(model.actuator_biastype[i])
-    if model.actuator_dyntype[i] != mujoco.mjtDyn.mjDYN_NONE:
-        rep.warn("actuator activation dynamics dropped (HRDF actuators have none)", where)
-    if gt != 0 or np.any(gain[3:] != 0) or np.any(bias[3:] != 0):
-        rep.warn("general actuator gain/bias beyond kp/kv dropped", where)
+    if (
+        model.actuator_dyntype[i] != mujoco.mjtDyn.mjDYN_NONE
+        or gt != 0
+        or np.any(gain[3:] != 0)
+        or np.any(bias[3:] != 0)
+        or np.any(model.actuator_gear[i, 1:] != 0)
+        or model.actuator_actlimited[i]
+        or model.actuator_group[i] != 0
+    ):
+        return None
     kind, kp, kv = None, None, None
-    if bt == 0 and gain[0] == 1.0 and not np.any(bias[:3]):
+    if bt == 0 and gain[0] == 1.0 and not np.any(gain[1:3]) and not np.any(bias[:3]):
         kind = "motor"
-    elif bt == 1 and bias[0] == 0 and gain[0] == -bias[1] and gain[0] != 0:
+    elif (
+        bt == 1 and bias[0] == 0 and gain[0] == -bias[1] and gain[0] != 0 and not np.any(gain[1:3])
+    ):
         kind, kp = "position", float(gain[0])
         kv = float(-bias[2]) if bias[2] != 0 else None
-    elif bt == 1 and bias[0] == 0 and bias[1] == 0 and gain[0] == -bias[2] and gain[0] != 0:
+    elif (
+        bt == 1
+        and bias[0] == 0
+        and bias[1] == 0
+        and gain[0] == -bias[2]
+        and gain[0] != 0
+        and not np.any(gain[1:3])
+    ):
         kind, kv = "velocity", float(gain[0])
     if kind is None:
-        rep.warn(
-            f"actuator gain {gain[:3].tolist()} / bias {bias[:3].tolist()} is not a motor, "
-            "position or velocity servo: dropped",
-            where,
-        )
         return None
-    gear = model.actuator_gear[i]
-    if np.any(gear[1:] != 0):
-        rep.warn("actuator gear beyond its first component dropped", where)
     return Actuator(
-        joint=joint,
-        name=name,
+        joint=joint_name(model, int(model.actuator_trnid[i, 0])),
+        name=model.actuator(i).name or None,
         type=kind,
         p_gain=kp,
         d_gain=kv,
-        gear=float(gear[0]),
+        gear=float(model.actuator_gear[i, 0]),
         ctrl_range=(float(model.actuator_ctrlrange[i, 0]), float(model.actuator_ctrlrange[i, 1]))
         if model.actuator_ctrllimited[i]
         else None,
@@ -134,6 +150,84 @@ def _actuator(model: mujoco.MjModel, i: int, rep: Reporter) -> Actuator | None:
         if model.actuator_forcelimited[i]
         else None,
     )
+
+
+def _actuator_target(model: mujoco.MjModel, i: int) -> tuple[str, str] | None:
+    """(attribute, object name) of the actuator's transmission, or None (slider-crank)."""
+    trn = _TRN_ATTR.get(int(model.actuator_trntype[i]))
+    if trn is None:
+        return None
+    attr, obj = trn
+    oid = int(model.actuator_trnid[i, 0])
+    if obj == mujoco.mjtObj.mjOBJ_JOINT:
+        return attr, joint_name(model, oid)
+    if obj == mujoco.mjtObj.mjOBJ_BODY:
+        return attr, body_name(model, oid)
+    return attr, mujoco.mj_id2name(model, obj, oid) or ""
+
+
+def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
+    """The compiled actuator as a ``<general>`` element, every parameter explicit."""
+    attrs: dict[str, str] = {}
+    if model.actuator(i).name:
+        attrs["name"] = model.actuator(i).name
+    attr, target = _actuator_target(model, i)
+    attrs[attr] = target
+    if model.actuator_trntype[i] == mujoco.mjtTrn.mjTRN_SITE and model.actuator_trnid[i, 1] >= 0:
+        attrs["refsite"] = model.site(int(model.actuator_trnid[i, 1])).name
+    if model.actuator_group[i]:
+        attrs["group"] = str(int(model.actuator_group[i]))
+    attrs["gear"] = _fmt(model.actuator_gear[i])
+    for flag, rng in (("ctrl", "ctrlrange"), ("force", "forcerange"), ("act", "actrange")):
+        limited = bool(getattr(model, f"actuator_{flag}limited")[i])
+        attrs[f"{flag}limited"] = "true" if limited else "false"
+        if limited:
+            attrs[rng] = _fmt(getattr(model, f"actuator_{rng}")[i])
+    attrs["dyntype"] = _DYN[int(model.actuator_dyntype[i])]
+    attrs["gaintype"] = _GAIN[int(model.actuator_gaintype[i])]
+    attrs["biastype"] = _BIAS[int(model.actuator_biastype[i])]
+    attrs["dynprm"] = _fmt(model.actuator_dynprm[i])
+    attrs["gainprm"] = _fmt(model.actuator_gainprm[i])
+    attrs["biasprm"] = _fmt(model.actuator_biasprm[i])
+    if model.actuator_actearly[i]:
+        attrs["actearly"] = "true"
+    if np.any(model.actuator_lengthrange[i] != 0):
+        attrs["lengthrange"] = _fmt(model.actuator_lengthrange[i])
+    return ET.Element("general", attrs)
+
+
+def _actuators(
+    model: mujoco.MjModel, names: dict[str, set[str]], rep: Reporter
+) -> tuple[list[Actuator], list[ET.Element], list[int]]:
+    """Table actuators, and the rest as exact ``<general>`` elements for ``mjcf_extra``.
+
+    From the first actuator the table cannot hold exactly (tendon or site transmission,
+    activation dynamics, general gains, ...), every later actuator goes to ``mjcf_extra``
+    too, so that actuator order (and ``ctrl`` layout) is kept."""
+    table: list[Actuator] = []
+    carried: list[ET.Element] = []
+    kept: list[int] = []
+    for i in range(model.nu):
+        name = model.actuator(i).name
+        where = f'<actuator name="{name}">' if name else f"actuator #{i}"
+        target = _actuator_target(model, i)
+        kind = {"jointinparent": "joint"}.get(target[0], target[0]) if target else None
+        if target is None or target[1] not in names.get(kind, set()):
+            rep.warn(f"actuator dropped: its transmission {target} is not part of the robot", where)
+            continue
+        kept.append(i)
+        record = None if carried else _actuator_record(model, i)
+        if record is not None:
+            table.append(record)
+            continue
+        if not carried:
+            rep.warn(
+                "actuator not expressible as an HRDF motor/position/velocity record: it and "
+                "every later actuator are carried exactly as <general> in mjcf_extra",
+                where,
+            )
+        carried.append(_general_elem(model, i))
+    return table, carried, kept
 
 
 def _excludes(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[ET.Element]:
@@ -152,8 +246,32 @@ def _excludes(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[ET.E
     return [section] if len(section) else []
 
 
+_REF_KIND = {
+    "joint": "joint", "joint1": "joint", "joint2": "joint",
+    "site": "site", "site1": "site", "site2": "site", "sidesite": "site",
+    "geom": "geom", "geom1": "geom", "geom2": "geom",
+    "body": "body", "body1": "body", "body2": "body",
+    "tendon": "tendon", "tendon1": "tendon", "tendon2": "tendon",
+}  # fmt: skip
+
+
+def _outside_refs(elem: ET.Element, names: dict[str, set[str]]) -> list[str]:
+    """Names an element (or its children) refers to that are not part of the robot."""
+    out = []
+    for el in elem.iter():
+        for attr, value in el.attrib.items():
+            kind = _REF_KIND.get(attr)
+            if kind is not None and value not in names[kind]:
+                out.append(f"{kind} '{value}'")
+    return out
+
+
 def _carried_sections(
-    spec: mujoco.MjSpec, model: mujoco.MjModel, kept: set[int], rep: Reporter
+    spec: mujoco.MjSpec,
+    model: mujoco.MjModel,
+    kept: set[int],
+    names: dict[str, set[str]],
+    rep: Reporter,
 ) -> list[ET.Element]:
     """Tendon, equality and contact sections.
 
@@ -162,10 +280,25 @@ def _carried_sections(
     references removed (reported: values inherited from a class are not carried)."""
     if not any(len(getattr(spec, a)) for a in ("tendons", "equalities", "pairs")):
         return _excludes(model, kept, rep)
+    # Tendon sections come first in EXTRA_SECTIONS, so equality/actuator references to a
+    # dropped tendon are caught after it is removed from ``names``.
     root = ET.fromstring(spec.to_xml())  # MuJoCo's own output: trusted text
     out = []
     for tag in EXTRA_SECTIONS:
         for section in root.findall(tag):
+            for child in list(section):
+                outside = _outside_refs(child, names)
+                if outside:
+                    rep.warn(
+                        f"<{child.tag}> in <{tag}> dropped: it refers to {outside} outside "
+                        "the robot",
+                        f'<{child.tag} name="{child.get("name", "")}">',
+                    )
+                    section.remove(child)
+                    if tag == "tendon" and child.get("name"):
+                        names["tendon"].discard(child.get("name"))
+            if not len(section):
+                continue
             for el in section.iter():
                 if "class" in el.attrib:
                     rep.warn(
@@ -176,6 +309,45 @@ def _carried_sections(
                     del el.attrib["class"]
             out.append(section)
     return out
+
+
+def _keyframes(
+    model: mujoco.MjModel, keep: list[int], actuators: list[int], rep: Reporter
+) -> ET.Element:
+    """``<keyframe>`` rebuilt from the compiled model, restricted to the robot: the qpos
+    and qvel of its joints and the ctrl/act of its actuators, in model order."""
+    kept = set(keep)
+    qpos_idx: list[int] = []
+    dof_idx: list[int] = []
+    for j in range(model.njnt):
+        if int(model.jnt_bodyid[j]) in kept:
+            nq = {0: 7, 1: 4}.get(int(model.jnt_type[j]), 1)
+            nv = {0: 6, 1: 3}.get(int(model.jnt_type[j]), 1)
+            qpos_idx += range(int(model.jnt_qposadr[j]), int(model.jnt_qposadr[j]) + nq)
+            dof_idx += range(int(model.jnt_dofadr[j]), int(model.jnt_dofadr[j]) + nv)
+    act_idx: list[int] = []
+    for i in actuators:
+        adr, num = int(model.actuator_actadr[i]), int(model.actuator_actnum[i])
+        if adr >= 0:
+            act_idx += range(adr, adr + num)
+    if len(qpos_idx) != model.nq or len(actuators) != model.nu:
+        rep.warn("keyframes restricted to the robot's joints and actuators (the rest dropped)")
+    section = ET.Element("keyframe")
+    for k in range(model.nkey):
+        attrs = {}
+        if model.key(k).name:
+            attrs["name"] = model.key(k).name
+        attrs["time"] = repr(float(model.key_time[k]))
+        attrs["qpos"] = _fmt(model.key_qpos[k][qpos_idx])
+        attrs["qvel"] = _fmt(model.key_qvel[k][dof_idx])
+        if act_idx:
+            attrs["act"] = _fmt(model.key_act[k][act_idx])
+        if actuators:
+            attrs["ctrl"] = _fmt(model.key_ctrl[k][actuators])
+        if model.nmocap:
+            rep.warn("keyframe mocap poses dropped", f"keyframe {k}")
+        ET.SubElement(section, "key", attrs)
+    return section
 
 
 def parse_mjcf(
@@ -310,8 +482,6 @@ def parse_mjcf(
             )
         )
 
-    actuators = [a for i in range(model.nu) if (a := _actuator(model, i, rep)) is not None]
-
     store = MeshStore(opt.work_dir) if opt.work_dir else MeshStore()
     meshdir = spec.compiler.meshdir or ""
     base_dir = path.resolve().parent
@@ -434,6 +604,15 @@ def parse_mjcf(
             )
         )
 
+    names = {
+        "joint": {j.name for j in joints if j.name},
+        "tendon": {model.tendon(t).name for t in range(model.ntendon) if model.tendon(t).name},
+        "site": {x.name for x in sites},
+        "body": {body_name(model, b) for b in keep} | {"world"},
+        "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
+    }
+    extra_parts = _carried_sections(spec, model, kept, names, rep)
+    actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
     sensors: list[Sensor] = []
     extra_sensors: list[ET.Element] = []
     kept_names = {
@@ -441,8 +620,9 @@ def parse_mjcf(
         "xbody": {body_name(model, b) for b in keep},
         "site": {x.name for x in sites},
         "joint": {x.name for x in joints},
-        "actuator": {x.name for x in actuators},
+        "actuator": {x.name for x in actuators} | {e.get("name") for e in carried_actuators},
         "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
+        "tendon": names["tendon"],
     }
     for s in range(model.nsensor):
         sname = model.sensor(s).name or f"sensor_{s}"
@@ -502,30 +682,16 @@ def parse_mjcf(
     if model.nhfield or model.ntex:
         rep.warn(f"{model.nhfield} height field(s) and {model.ntex} texture(s) dropped")
 
-    extra_parts = _carried_sections(spec, model, kept, rep)
+    if carried_actuators:
+        section = ET.Element("actuator")
+        section.extend(carried_actuators)
+        extra_parts.append(section)
     if extra_sensors:
         section = ET.Element("sensor")
         section.extend(extra_sensors)
         extra_parts.append(section)
     if model.nkey:
-        section = ET.Element("keyframe")
-        for k in range(model.nkey):
-            attrs = {}
-            if model.key(k).name:
-                attrs["name"] = model.key(k).name
-            attrs["time"] = repr(float(model.key_time[k]))
-            attrs["qpos"] = _fmt(model.key_qpos[k])
-            attrs["qvel"] = _fmt(model.key_qvel[k])
-            if model.na:
-                attrs["act"] = _fmt(model.key_act[k])
-            if model.nu:
-                attrs["ctrl"] = _fmt(model.key_ctrl[k])
-            if model.nmocap:
-                rep.warn("keyframe mocap poses dropped", f"keyframe {k}")
-            ET.SubElement(section, "key", attrs)
-        extra_parts.append(section)
-        if len(keep) != model.nbody - 1 or len(actuators) != model.nu:
-            rep.warn("keyframes kept, but qpos/ctrl sizes no longer match the dropped parts")
+        extra_parts.append(_keyframes(model, keep, kept_actuators, rep))
     extra = None
     if extra_parts:
         root = ET.Element("mujoco")

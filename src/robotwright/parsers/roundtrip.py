@@ -272,13 +272,16 @@ def _geom_records(model: mujoco.MjModel, bodies: set[str], collision_only: bool)
             continue
         t = int(model.geom_type[g])
         verts = int(model.mesh_vertnum[model.geom_dataid[g]]) if t == 7 else 0
+        # Only the size values the type uses (MuJoCo keeps unused ones as written).
+        used = {2: 1, 3: 2, 5: 2, 7: 0}.get(t, 3)
         out.append(
             (
                 t,
                 verts,
-                model.geom_size[g].copy(),
+                model.geom_size[g][:used].copy(),
                 data.geom_xpos[g].copy(),
                 data.geom_xmat[g].reshape(3, 3).copy(),
+                model.geom(g).name,
             )
         )
     return out
@@ -293,17 +296,27 @@ def compare_geoms(ref: RobotView, ours: RobotView, tol: float, collision_only: b
     b = _geom_records(ours.model, our_bodies, collision_only)
     worst, unmatched = 0.0, 0
     free = list(range(len(b)))
-    for t, verts, size, pos, rot in a:
-        best, best_k = None, None
-        for k in free:
-            t2, v2, size2, pos2, rot2 = b[k]
-            if t2 != t or v2 != verts:
-                continue
-            err = max(float(np.abs(size - size2).max()), float(np.abs(pos - pos2).max()))
-            if t not in (2,):  # a sphere has no orientation to compare
-                err = max(err, quat_angle(rot, rot2))
-            if best is None or err < best:
-                best, best_k = err, k
+    by_name = {rec[5]: k for k, rec in enumerate(b) if rec[5]}
+
+    def error(x: tuple, y: tuple) -> float | None:
+        if x[0] != y[0] or x[1] != y[1]:
+            return None
+        err = max(float(np.abs(x[2] - y[2]).max(initial=0.0)), float(np.abs(x[3] - y[3]).max()))
+        if x[0] != 2:  # a sphere has no orientation to compare
+            err = max(err, quat_angle(x[4], y[4]))
+        return err
+
+    for rec in a:
+        # Same name first; unnamed geoms go to the closest free geom of the same shape.
+        k = by_name.get(rec[5]) if rec[5] else None
+        if k is not None and k in free and error(rec, b[k]) is not None:
+            best, best_k = error(rec, b[k]), k
+        else:
+            best, best_k = None, None
+            for k in free:
+                err = error(rec, b[k])
+                if err is not None and (best is None or err < best):
+                    best, best_k = err, k
         if best_k is None:
             unmatched += 1
             continue
