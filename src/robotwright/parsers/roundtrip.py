@@ -491,8 +491,17 @@ def roundtrip(
     """The fidelity table of one MJCF or URDF file (see the module docstring).
 
     ``reference``: ``"auto"`` (MuJoCo's import; yourdfpy for a URDF MuJoCo refuses),
-    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``options`` go to the parser."""
-    path = Path(source)
+    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``options`` go to the parser. Staged
+    meshes live in a temporary folder removed at the end (unless ``work_dir`` is given)."""
+    if "work_dir" in options:
+        return _roundtrip(Path(source), configs, urdf, reference, options)
+    with tempfile.TemporaryDirectory(prefix="robotwright-rt-") as tmp:
+        return _roundtrip(Path(source), configs, urdf, reference, {**options, "work_dir": tmp})
+
+
+def _roundtrip(
+    path: Path, configs: int, urdf: bool, reference: str, options: dict[str, Any]
+) -> RoundTripReport:
     report = RoundTripReport(str(path), "")
     try:
         result = parse_source(path, **options)
@@ -501,7 +510,9 @@ def roundtrip(
         return report
     report.warnings = [str(w) for w in result.warnings]
     try:
-        ref = reference_view(path, reference, **options)
+        ref = reference_view(
+            path, reference, **{k: v for k, v in options.items() if k != "work_dir"}
+        )
     except Exception as exc:
         report.error = f"no reference: {type(exc).__name__}: {exc}"
         return report
