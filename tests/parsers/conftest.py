@@ -63,9 +63,10 @@ MODEL = """<mujoco model="probe">
 
 
 def _tet_stl(path: Path) -> None:
-    """A binary STL tetrahedron (MuJoCo reads binary STL only)."""
+    """A binary STL tetrahedron (MuJoCo reads binary STL only) with well separated
+    principal moments, so that its principal axes are well conditioned."""
     tet = trimesh.Trimesh(
-        vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+        vertices=[[0, 0, 0], [1, 0, 0], [0, 2.5, 0], [0, 0, 6]],
         faces=[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
     )
     tet.export(str(path), file_type="stl")
@@ -98,3 +99,9 @@ def arm_mjcf(tmp_path: Path) -> Path:
     path = tmp_path / "arm2.xml"
     path.write_text(ARM)
     return path
+
+
+@pytest.fixture
+def write_tet():
+    """Writes a binary STL tetrahedron to the path given."""
+    return _tet_stl

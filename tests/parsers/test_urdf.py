@@ -76,6 +76,7 @@ def arm(tmp_path: Path) -> Path:
 
 def test_keep_policy_matches_mujoco_import_except_massless_tcp(arm: Path) -> None:
     hrdf, warnings = urdf_to_hrdf_with_warnings(arm, fixed_joints="site")
+    assert any("ASCII STL rewritten as binary STL" in str(w) for w in warnings)
     assert [b.name for b in hrdf.bodies] == ["base", "upper", "slider", "finger", "tool"]
     assert [s.name for s in hrdf.sites] == ["tcp"]
     assert {j.name: j.type for j in hrdf.joints} == {
@@ -218,3 +219,78 @@ def test_actuators_motor_option_keeps_effort(arm: Path) -> None:
     hrdf = urdf_to_hrdf(arm, fixed_joints="site", actuators="motor")
     rail = next(a for a in hrdf.actuators if a.joint == "rail")
     assert (rail.peak_torque, rail.ctrl_range, rail.peak_velocity) == (10.0, (-10.0, 10.0), 1.0)
+
+
+def test_negative_scale_mirrored_copy_matches_mujoco(arm: Path, write_tet) -> None:
+    """MuJoCo mirrors a mesh with a negative scale itself; our mirrored copy (positive
+    scale) must give the same compiled collision geom (MuJoCo re-centres each mesh on its
+    own volume centroid, so the geom pose checks the mirrored triangles)."""
+    write_tet(arm.parent.parent / "meshes" / "tetb.stl")  # MuJoCo reads binary STL only
+    text = ARM.replace(
+        '<collision><geometry><box size="0.2 0.2 0.1"/>',
+        '<collision><geometry><mesh filename="package://armpkg/meshes/tetb.stl" scale="1 -2 1"/>',
+    )
+    path = arm.with_name("mirror.urdf")
+    path.write_text(text)
+    hrdf, warnings = urdf_to_hrdf_with_warnings(path, fixed_joints="site")
+    mirrored = [m for m in hrdf.meshes if m.group == 3]
+    assert mirrored[0].scale == (1.0, 2.0, 1.0) and "mirrored" in mirrored[0].file
+    assert any("negative scale" in str(w) for w in warnings)
+    ref = urdf_mujoco_view(path)
+    ours = view_from_model(our_mjcf_model(hrdf))
+    row = next(
+        r for r in compare_views(ref, ours, configs=3, collision_only=True) if "geoms" in r.check
+    )
+    assert row.ok, row
+
+
+def test_saved_hrdf_folder_reloads_to_the_same_model(arm: Path, tmp_path: Path) -> None:
+    from robotwright.hrdf.model import HRDF
+
+    hrdf = urdf_to_hrdf(arm, fixed_joints="merge", work_dir=tmp_path / "stage")
+    folder = hrdf.save(tmp_path / "arm_hrdf")
+    assert all((folder / m.file).is_file() for m in hrdf.meshes)
+    again = HRDF.from_dir(folder)
+    assert again.mjcf_extra == hrdf.mjcf_extra
+    rows = compare_views(
+        view_from_model(our_mjcf_model(hrdf)), view_from_model(our_mjcf_model(again)), configs=5
+    )
+    assert all(r.ok for r in rows), rows
+
+
+def test_floating_joint_from_world_becomes_free_root(tmp_path: Path) -> None:
+    path = tmp_path / "r" / "urdf" / "float.urdf"
+    path.parent.mkdir(parents=True)
+    path.write_text(
+        '<robot name="f"><link name="world"/><link name="base"><inertial><mass value="1"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+        '<joint name="float" type="floating"><parent link="world"/><child link="base"/>'
+        '<origin xyz="0 0 1"/></joint></robot>'
+    )
+    hrdf = urdf_to_hrdf(path)
+    assert hrdf.floating_base and hrdf.joints[0].name == "float"
+    assert hrdf.bodies[0].pos == (0.0, 0.0, 1.0)
+
+
+def test_planar_joint_is_a_clear_error(tmp_path: Path) -> None:
+    path = tmp_path / "planar.urdf"
+    path.write_text(
+        '<robot name="p"><link name="a"/><link name="b"/><joint name="pl" type="planar">'
+        '<parent link="a"/><child link="b"/></joint></robot>'
+    )
+    with pytest.raises(ConversionError, match=r'planar.urdf.*joint name="pl".*planar'):
+        urdf_to_hrdf(path)
+
+
+def test_file_uri_and_ament_prefix_path(arm: Path, tmp_path: Path, monkeypatch) -> None:
+    uri = (arm.parent.parent / "meshes" / "tet.stl").as_uri()
+    path = arm.with_name("file_uri.urdf")
+    path.write_text(ARM.replace("package://armpkg/meshes/tet.stl", uri))
+    assert len(urdf_to_hrdf(path, fixed_joints="site").meshes) == 1
+    prefix = tmp_path / "install"
+    (prefix / "share" / "otherpkg" / "meshes").mkdir(parents=True)
+    (prefix / "share" / "otherpkg" / "meshes" / "tet.stl").write_text(BOX_STL)
+    path2 = arm.with_name("ament.urdf")
+    path2.write_text(ARM.replace("package://armpkg/", "package:///otherpkg/"))
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(prefix))
+    assert len(urdf_to_hrdf(path2, fixed_joints="site").meshes) == 1
