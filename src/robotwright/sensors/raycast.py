@@ -57,8 +57,9 @@ def make_ray_model(model: mujoco.MjModel, hittable: np.ndarray) -> mujoco.MjMode
 
 
 def _split(n: int, parts: int) -> list[tuple[int, int]]:
-    bounds = np.linspace(0, n, parts + 1).round().astype(int)
-    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+    """``parts`` contiguous near-equal ranges covering ``range(n)`` (empty ones dropped)."""
+    bounds = [n * k // parts for k in range(parts + 1)]
+    return [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
 
 
 class MujocoRayEngine:

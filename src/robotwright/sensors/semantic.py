@@ -114,15 +114,16 @@ class SemanticLidarSensor(LidarSensor):
     def _initialize_warp_meshes(self) -> None:
         """Classify every hittable geom once (seed name; the "meshes" here are MuJoCo geoms).
 
-        Builds ``mesh_id_to_semantic_class`` and a lookup table indexed by ``geom id + 1``
-        so that a miss (-1) maps to class 0.
+        Builds ``mesh_id_to_semantic_class`` and a lookup table indexed by geom id whose
+        last entry (index -1, a miss) is class 0.
         """
         self.geom_semantic_class = np.zeros(self.model.ngeom, dtype=np.int32)
         for g in np.flatnonzero(self.hittable_geom_mask):
             cls_id = self._classify_mesh_path(self._geom_paths[g])
             self.geom_semantic_class[g] = cls_id
             self.mesh_id_to_semantic_class[int(g)] = cls_id
-        self._label_lut = np.concatenate([[0], self.geom_semantic_class]).astype(np.int32)
+        # Indexed by geom id; the extra last entry answers id -1 (a miss) with class 0.
+        self._label_lut = np.concatenate([self.geom_semantic_class, [0]]).astype(np.int32)
 
     def _update_buffers_impl(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
         """Cast (parent), then turn hit geom ids into labels, as in the seed."""
@@ -134,7 +135,10 @@ class SemanticLidarSensor(LidarSensor):
         rows = self._rows(env_ids)
         ids = self._raw_geom_ids[rows]
         if self._data.semantic_labels is not None:
-            self._data.semantic_labels[rows] = self._label_lut[ids + 1]
+            if env_ids is None:
+                np.take(self._label_lut, ids, out=self._data.semantic_labels)
+            else:
+                self._data.semantic_labels[rows] = self._label_lut[ids]
         if self._data.mesh_ids is not None:
             self._data.mesh_ids[rows] = ids
 
