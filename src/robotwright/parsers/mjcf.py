@@ -74,6 +74,56 @@ class MJCFOptions:
     work_dir: Path | None = None
 
 
+_DEFAULT_MODEL = mujoco.MjModel.from_xml_string(
+    '<mujoco><asset><material name="m"/></asset>'
+    '<worldbody><body><joint/><geom size="1"/></body></worldbody></mujoco>'
+)
+#: Material fields beyond the colour (a material with defaults there is just a colour).
+_MATERIAL_UNHELD = (
+    "mat_texid", "mat_texuniform", "mat_texrepeat", "mat_emission", "mat_specular",
+    "mat_shininess", "mat_reflectance", "mat_metallic", "mat_roughness",
+)  # fmt: skip
+#: Joint fields HRDF has no column for: (MJCF attribute, model array, per-dof?).
+_JOINT_UNHELD = (
+    ("solreflimit", "jnt_solref", False),
+    ("solimplimit", "jnt_solimp", False),
+    ("margin", "jnt_margin", False),
+    ("group", "jnt_group", False),
+    ("actuatorgravcomp", "jnt_actgravcomp", False),
+    ("stiffnesspoly", "jnt_stiffnesspoly", False),
+    ("springyield", "jnt_springyield", False),
+    ("solreffriction", "dof_solref", True),
+    ("solimpfriction", "dof_solimp", True),
+    ("dampingpoly", "dof_dampingpoly", True),
+)
+#: Geom fields HRDF has no column for.
+_GEOM_UNHELD = (
+    "geom_solref", "geom_solimp", "geom_solmix", "geom_margin", "geom_gap",
+    "geom_priority", "geom_fluid",
+)  # fmt: skip
+#: Option fields carried by SimulatorConfig; the others are reported when not default.
+_OPTION_HELD = {"timestep", "gravity", "integrator"}
+
+
+def _differs(model: mujoco.MjModel, attr: str, i: int, j: int = 0) -> bool:
+    if not hasattr(model, attr):  # fields of other MuJoCo versions
+        return False
+    return bool(np.any(getattr(model, attr)[i] != getattr(_DEFAULT_MODEL, attr)[j]))
+
+
+def _unheld_option_fields(model: mujoco.MjModel) -> list[str]:
+    out = []
+    for name in dir(model.opt):
+        if name.startswith("_") or name in _OPTION_HELD:
+            continue
+        a, b = getattr(model.opt, name), getattr(_DEFAULT_MODEL.opt, name)
+        if callable(a):
+            continue
+        if np.any(np.asarray(a) != np.asarray(b)):
+            out.append(name)
+    return out
+
+
 def _t3(v) -> tuple[float, float, float]:
     return (float(v[0]), float(v[1]), float(v[2]))
 
@@ -430,6 +480,7 @@ def parse_mjcf(
         )
 
     joints: list[Joint] = []
+    unheld_joint: dict[str, list[str]] = {}
     for j in range(model.njnt):
         b = int(model.jnt_bodyid[j])
         if b not in kept:
@@ -452,6 +503,9 @@ def parse_mjcf(
             rep.warn(f"unnamed joint named '{name}'", where)
         dof = int(model.jnt_dofadr[j])
         qadr = int(model.jnt_qposadr[j])
+        for attr, field_name, per_dof in _JOINT_UNHELD:
+            if _differs(model, field_name, dof if per_dof else j):
+                unheld_joint.setdefault(attr, []).append(name or joint_name(model, j))
         if model.jnt_actfrclimited[j]:
             rep.warn(
                 f"actuatorfrcrange {model.jnt_actfrcrange[j].tolist()} dropped (HRDF joints "
@@ -489,6 +543,8 @@ def parse_mjcf(
     meshes: list[MeshGeom] = []
     simple: list[SimpleGeom] = []
     world_geoms = 0
+    materials: set[str] = set()
+    unheld_geom: dict[str, list[str]] = {}
     for g in range(model.ngeom):
         b = int(model.geom_bodyid[g])
         if b == 0:
@@ -504,20 +560,15 @@ def parse_mjcf(
             continue
         rgba = model.geom_rgba[g]
         mat = int(model.geom_matid[g])
+        # MuJoCo draws the material colour unless the geom's own rgba is not the default.
         if mat >= 0:
-            rgba = model.mat_rgba[mat]
-            if model.mat_texid[mat].max() >= 0:
-                rep.warn(
-                    f"material '{model.material(mat).name}' texture dropped (colour kept)", where
-                )
-        if (
-            np.any(model.geom_solref[g] != [0.02, 1.0])
-            or np.any(model.geom_solimp[g] != [0.9, 0.95, 0.001, 0.5, 2.0])
-            or model.geom_margin[g]
-            or model.geom_gap[g]
-            or model.geom_priority[g]
-        ):
-            rep.warn("geom solref/solimp/margin/gap/priority dropped (HRDF has no field)", where)
+            if any(_differs(model, attr, mat) for attr in _MATERIAL_UNHELD):
+                materials.add(model.material(mat).name or f"material #{mat}")
+            if not _differs(model, "geom_rgba", g):
+                rgba = model.mat_rgba[mat]
+        for attr in _GEOM_UNHELD:
+            if _differs(model, attr, g):
+                unheld_geom.setdefault(attr[len("geom_") :], []).append(gname or f"geom #{g}")
         common = {
             "body": body_name(model, b),
             "rgba": _t4(np.clip(rgba, 0.0, 1.0)),
@@ -579,6 +630,14 @@ def parse_mjcf(
         from dataclasses import replace
 
         simple[k] = replace(sg, name=nm)
+    if materials:
+        rep.warn(
+            f"materials {sorted(materials)} replaced by their colour (their textures, "
+            "specular, shininess, reflectance, emission dropped)"
+        )
+    for attr, gnames in unheld_geom.items():
+        shown = gnames[:8] + ([f"... {len(gnames) - 8} more"] if len(gnames) > 8 else [])
+        rep.warn(f"geom attribute '{attr}' dropped (no HRDF column) on geoms {shown}")
     if world_geoms:
         rep.warn(f"{world_geoms} geom(s) of the worldbody dropped (scene, not robot)")
 
@@ -613,6 +672,13 @@ def parse_mjcf(
     }
     extra_parts = _carried_sections(spec, model, kept, names, rep)
     actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
+    for attr, jnames in unheld_joint.items():
+        rep.warn(f"joint attribute '{attr}' dropped (no HRDF column) on joints {jnames}")
+    option_fields = _unheld_option_fields(model)
+    if option_fields:
+        rep.warn(
+            f"<option> fields {option_fields} dropped (HRDF keeps timestep, gravity, integrator)"
+        )
     sensors: list[Sensor] = []
     extra_sensors: list[ET.Element] = []
     kept_names = {
@@ -679,8 +745,9 @@ def parse_mjcf(
     for what, count in (("camera", model.ncam), ("light", model.nlight)):
         if count:
             rep.warn(f"{count} {what}(s) dropped (HRDF has no {what}s)")
-    if model.nhfield or model.ntex:
-        rep.warn(f"{model.nhfield} height field(s) and {model.ntex} texture(s) dropped")
+    for what, count in (("height field", model.nhfield), ("texture", model.ntex)):
+        if count:
+            rep.warn(f"{count} {what}(s) dropped (HRDF geoms carry a colour only)")
 
     if carried_actuators:
         section = ET.Element("actuator")

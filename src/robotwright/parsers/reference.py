@@ -23,17 +23,28 @@ from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.xmlsafe import parse_xml
 
 _MJ_JOINT = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
+#: Actuator transmission type -> MuJoCo object type of its target.
+_TRN_OBJ = {
+    0: mujoco.mjtObj.mjOBJ_JOINT,
+    1: mujoco.mjtObj.mjOBJ_JOINT,
+    3: mujoco.mjtObj.mjOBJ_TENDON,
+    4: mujoco.mjtObj.mjOBJ_SITE,
+    5: mujoco.mjtObj.mjOBJ_BODY,
+}
 
 
 @dataclass
 class JointInfo:
-    """A 1-DoF or multi-DoF joint: type, axis in its body frame, range or None."""
+    """A 1-DoF or multi-DoF joint: type, axis in its body frame, range or None, and (for
+    MuJoCo views) its dynamics: armature, damping, frictionloss, stiffness, springref and
+    qpos0 of its first degree of freedom."""
 
     name: str
     type: str
     body: str
     axis: np.ndarray
     range: tuple[float, float] | None
+    dynamics: np.ndarray | None = None
 
 
 @dataclass
@@ -133,6 +144,16 @@ def _view_from_model(model: mujoco.MjModel, kind: str = "mujoco") -> RobotView:
                 body_name(model, int(model.jnt_bodyid[i])),
                 model.jnt_axis[i].copy(),
                 tuple(model.jnt_range[i]) if model.jnt_limited[i] else None,
+                np.array(
+                    [
+                        model.dof_armature[model.jnt_dofadr[i]],
+                        model.dof_damping[model.jnt_dofadr[i]],
+                        model.dof_frictionloss[model.jnt_dofadr[i]],
+                        model.jnt_stiffness[i],
+                        model.qpos_spring[model.jnt_qposadr[i]],
+                        model.qpos0[model.jnt_qposadr[i]],
+                    ]
+                ),
             )
         )
     sites = [model.site(i).name or f"site_{i}" for i in range(model.nsite)]
@@ -161,9 +182,21 @@ def _view_from_model(model: mujoco.MjModel, kind: str = "mujoco") -> RobotView:
                 "name": model.actuator(i).name,
                 "type": _actuator_type(model, i),
                 "joint": joint_name(model, jid) if model.actuator_trntype[i] == 0 else None,
-                "gear": float(model.actuator_gear[i, 0]),
-                "gainprm": model.actuator_gainprm[i, :3].copy(),
-                "biasprm": model.actuator_biasprm[i, :3].copy(),
+                "kinds": (
+                    int(model.actuator_trntype[i]),
+                    int(model.actuator_dyntype[i]),
+                    int(model.actuator_gaintype[i]),
+                    int(model.actuator_biastype[i]),
+                    int(model.actuator_group[i]),
+                    _obj_name(model, _TRN_OBJ.get(int(model.actuator_trntype[i]), 0), jid),
+                ),
+                "gear": model.actuator_gear[i].copy(),
+                "gainprm": model.actuator_gainprm[i].copy(),
+                "biasprm": model.actuator_biasprm[i].copy(),
+                "dynprm": model.actuator_dynprm[i].copy(),
+                "actrange": model.actuator_actrange[i].copy()
+                if model.actuator_actlimited[i]
+                else None,
                 "ctrlrange": model.actuator_ctrlrange[i].copy()
                 if model.actuator_ctrllimited[i]
                 else None,

@@ -208,6 +208,25 @@ def compare_views(
             Row("joint types equal", "yes" if not bad_type else f"no: {bad_type[:5]}", not bad_type)
         )
         rows.append(Row("joint axes max err", f"{worst_axis:.1e}", worst_axis <= tol))
+        worst_dyn, no_dyn = 0.0, []
+        for j in ref.joints:
+            o = ours_j.get(j.name)
+            if o is None or j.dynamics is None:
+                continue
+            if o.dynamics is None:
+                no_dyn.append(j.name)
+                continue
+            scale = np.maximum(np.abs(j.dynamics), 1.0)
+            worst_dyn = max(worst_dyn, float((np.abs(j.dynamics - o.dynamics) / scale).max()))
+        if ref.kind == "mujoco":
+            rows.append(
+                Row(
+                    "joint dynamics max err (armature, damping, frictionloss, stiffness, "
+                    "springref, qpos0)",
+                    f"{worst_dyn:.1e}",
+                    worst_dyn <= tol and not no_dyn,
+                )
+            )
         rows.append(
             Row(
                 "joint ranges max err",
@@ -384,14 +403,21 @@ def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
 def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
     if len(ref.actuators) != len(ours.actuators):
         return Row(
-            "actuators (order, type, gains, ranges)",
+            "actuators (order, type, transmission, dyn/gain/bias, ranges)",
             f"{len(ref.actuators)}/{len(ours.actuators)}",
             False,
         )
     bad = []
     for a, b in zip(ref.actuators, ours.actuators, strict=True):
-        same = a["name"] == b["name"] and a["type"] == b["type"] and a["joint"] == b["joint"]
-        for key in ("gear", "gainprm", "biasprm", "ctrlrange", "forcerange"):
+        same = (
+            a["name"] == b["name"]
+            and a["type"] == b["type"]
+            and a["joint"] == b["joint"]
+            and a["kinds"] == b["kinds"]
+        )
+        for key in (
+            "gear", "gainprm", "biasprm", "dynprm", "ctrlrange", "forcerange", "actrange",
+        ):  # fmt: skip
             x, y = a[key], b[key]
             if (x is None) != (y is None):
                 same = False
@@ -402,7 +428,7 @@ def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
         if not same:
             bad.append(a["name"] or a["joint"])
     return Row(
-        "actuators (order, type, gains, ranges)",
+        "actuators (order, type, transmission, dyn/gain/bias, ranges)",
         f"{len(ref.actuators)}/{len(ours.actuators)}",
         not bad,
         f"differ: {bad[:5]}" if bad else "",
