@@ -6,6 +6,7 @@ import json
 
 import mujoco
 import numpy as np
+import pytest
 from lidar_scenes import CLUTTER_XML
 
 from robotwright.cli import main
@@ -95,3 +96,23 @@ def test_scan_to_files_summary(tmp_path):
     assert summary["num_rays"] == 28800 and summary["png"] is None
     assert sum(summary["class_counts"].values()) == summary["num_hits"] > 0
     assert not (tmp_path / "a.png").exists()
+
+
+@pytest.mark.warp
+def test_cli_warp_engine_matches_mujoco(tmp_path):
+    pytest.importorskip("mujoco_warp", reason="robotwright[warp] not installed")
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    out = {}
+    for engine in ("mujoco", "warp"):
+        npz = tmp_path / f"{engine}.npz"
+        assert (
+            main(["lidar", str(scene), "--sensor", "lidar", "--engine", engine, "-o", str(npz)])
+            == 0
+        )
+        with np.load(npz) as z:
+            out[engine] = (z["mesh_ids"], z["distances"])
+    same = out["mujoco"][0] == out["warp"][0]
+    assert same.mean() >= 0.999
+    hit = same & (out["mujoco"][0] >= 0)
+    np.testing.assert_allclose(out["warp"][1][hit], out["mujoco"][1][hit], atol=1e-5)

@@ -334,3 +334,21 @@ def test_ellipsoid_and_cylinder_distances(engine):
     np.testing.assert_allclose(
         top.get_distances()[0, 0], 1.5, atol=1e-6 if engine == "mujoco" else 1e-5
     )  # cap
+
+
+def test_sensor_frame_points_use_the_pose_at_scan_time():
+    xml = """<mujoco><worldbody><geom name="floor" type="plane" size="10 10 0.1"/>
+      <body name="bot" pos="0 0 1"><freejoint/><geom type="sphere" size="0.05"/></body>
+      </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = forward(model)[0]
+    s = LidarSensor(LidarCfg(prim_path="bot", pattern_cfg=RaysPattern([(1, 0, -1)])), model, data)
+    s.update()
+    before = s.get_pointcloud(frame="sensor")
+    np.testing.assert_allclose(before[0, 0], [1.0, 0.0, -1.0], atol=1e-9)
+    data.qpos[:3] = [5.0, 5.0, 3.0]  # move after the scan: the scan's points do not change
+    mujoco.mj_forward(model, data)
+    np.testing.assert_array_equal(s.get_pointcloud(frame="sensor"), before)
+    np.testing.assert_allclose(s.get_pointcloud()[0, 0], [1.0, 0.0, 0.0], atol=1e-9)
+    with pytest.raises(SensorError, match="frame: expected 'world' or 'sensor'"):
+        s.get_pointcloud(frame="body")
