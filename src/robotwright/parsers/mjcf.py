@@ -537,6 +537,7 @@ def parse_mjcf(
         )
 
     store = MeshStore(opt.work_dir) if opt.work_dir else MeshStore()
+    # Relative to the main file's folder (MuJoCo folds <compiler assetdir> into meshdir).
     meshdir = spec.compiler.meshdir or ""
     base_dir = path.resolve().parent
     mesh_files: dict[int, tuple[str, str]] = {}
@@ -589,6 +590,23 @@ def parse_mjcf(
                 if not m_spec.file:
                     rep.warn("mesh without a file (inline vertices) dropped", where)
                     continue
+                unheld = [
+                    attr
+                    for attr, default in (
+                        ("inertia", mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY),
+                        ("maxhullvert", -1),
+                        ("smoothnormal", False),
+                    )
+                    if getattr(m_spec, attr) != default
+                ]
+                if np.any(m_spec.refpos != 0) or np.any(m_spec.refquat != [1, 0, 0, 0]):
+                    unheld.append("refpos/refquat")
+                if unheld:
+                    rep.warn(
+                        f"mesh asset '{model.mesh(mid).name}': {unheld} dropped (no HRDF "
+                        "column); MuJoCo may centre the mesh differently",
+                        where,
+                    )
                 src = (base_dir / meshdir / m_spec.file).resolve()
                 try:
                     staged = store.add(src)
