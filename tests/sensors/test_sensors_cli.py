@@ -29,6 +29,8 @@ def test_cli_writes_npz_and_png(tmp_path, capsys):
             str(npz),
             "--png",
             str(png),
+            "--view-radius",
+            "5",
         ]
     )
     assert rc == 0

@@ -43,6 +43,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="sensor position in the carrier's frame [m]",
     )
     p.add_argument(
+        "--view-radius",
+        type=float,
+        help="picture only: draw points within this horizontal distance of the sensor [m]",
+    )
+    p.add_argument(
         "--mapping",
         type=Path,
         help="JSON file: {class name: [keywords]} (default: the seed's mapping)",
@@ -91,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         offset_pos=tuple(args.offset),
         exclude_robot=not args.include_robot,
         engine=args.engine,
+        view_radius=args.view_radius,
     )
     counts = ", ".join(f"{k}={v}" for k, v in summary["class_counts"].items())
     print(f"{summary['num_rays']} rays, {summary['num_hits']} hits ({counts})")

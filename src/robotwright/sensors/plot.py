@@ -32,6 +32,7 @@ def plot_scan(
     path: str | Path,
     sensor_pos: np.ndarray | None = None,
     title: str | None = None,
+    view_radius: float | None = None,
 ) -> Path:
     """Draw hit points (world frame [m]) coloured by class id into a PNG file.
 
@@ -42,6 +43,9 @@ def plot_scan(
         path: the PNG to write (written to a temporary file first, then renamed).
         sensor_pos: sensor position, drawn as a black cross.
         title: figure title.
+        view_radius: show only points within this horizontal distance [m] of the sensor
+            (of the origin without ``sensor_pos``); ``None`` shows every point. Legend
+            counts always cover every point.
     """
     import matplotlib
 
@@ -52,6 +56,11 @@ def plot_scan(
     labels = np.asarray(labels).reshape(-1)
     keep = np.isfinite(points).all(axis=1)
     points, labels = points[keep], labels[keep]
+    counts = [int((labels == i).sum()) for i in range(len(class_names))]
+    if view_radius is not None:
+        centre = np.zeros(3) if sensor_pos is None else np.asarray(sensor_pos, dtype=np.float64)
+        near = np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]) <= view_radius
+        points, labels = points[near], labels[near]
     fig, axes = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1, 1]})
     views = (("top view", 0, 1, "x [m]", "y [m]"), ("side view", 0, 2, "x [m]", "z [m]"))
     for ax, (name, i, j, xl, yl) in zip(axes, views, strict=True):
@@ -73,7 +82,7 @@ def plot_scan(
     # Legend markers drawn at a readable size (the scatter dots themselves are tiny).
     handles = []
     for cls_id, cls_name in enumerate(class_names):
-        n = int((labels == cls_id).sum())
+        n = counts[cls_id]
         color = _COLORS[cls_id % len(_COLORS)]
         handles.append(
             Line2D(

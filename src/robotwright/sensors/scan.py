@@ -48,6 +48,7 @@ def scan_to_files(
     exclude_robot: bool = True,
     engine: str = "mujoco",
     title: str | None = None,
+    view_radius: float | None = None,
 ) -> dict[str, Any]:
     """Scan one environment with a :class:`SemanticLidarSensor` and save the result.
 
@@ -55,7 +56,8 @@ def scan_to_files(
     ``distances`` (N,) [m] (inf = miss), ``points`` (N, 3) world frame [m] (NaN = miss),
     ``labels`` (N,) class ids, ``mesh_ids`` (N,) hit geom ids (-1 = miss),
     ``directions`` (N, 3), ``sensor_pos`` (3,), ``sensor_quat`` (4, w x y z),
-    ``class_names`` and ``geom_paths`` (strings).
+    ``class_names`` and ``geom_paths`` (strings). ``view_radius`` [m] crops the picture
+    (not the data) around the sensor; ``None`` draws every point.
 
     Returns:
         A summary: ``num_rays``, ``num_hits``, ``class_counts`` (name -> points),
@@ -106,6 +108,7 @@ def scan_to_files(
             sensor_pos=lidar.data.pos_w[0],
             title=title
             or f"{pattern_name} scan from '{sensor}': {int(lidar.get_hit_mask().sum())} hits",
+            view_radius=view_radius,
         )
     return {
         "sensor": sensor,
