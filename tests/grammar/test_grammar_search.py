@@ -151,3 +151,18 @@ def test_mcts_respects_budget_is_reproducible_and_beats_random_on_workspace():
         e.feasible for e in a.evaluations
     )
     assert mean_mcts > mean_random  # the tree concentrates on good designs
+
+
+@pytest.mark.parametrize("search", [beam_search, mcts_search, random_search])
+def test_search_reports_progress_up_to_the_budget(search):
+    g = default_grammar()
+    seen: list[tuple[int, float | None]] = []
+
+    def progress(n, best):
+        seen.append((n, None if best is None else best.score))
+
+    with ThreadPoolExecutor(2) as ex:
+        res = search(g, [Reach()], budget=25, max_links=3, seed=2, executor=ex, progress=progress)
+    counts = [n for n, _ in seen]
+    assert counts == sorted(counts) and counts[-1] == res.n_evaluated == 25
+    assert seen[-1][1] == res.best.score

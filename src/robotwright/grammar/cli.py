@@ -153,6 +153,25 @@ def _sample(args: argparse.Namespace) -> int:
     return 0
 
 
+def _search_progress(budget: int, name: str, t0: float):
+    """A callback printing ``evaluated/budget, best`` to stderr at most twice a second."""
+    last = [0.0]
+
+    def show(n: int, best) -> None:
+        now = time.perf_counter()
+        if now - last[0] < 0.5 and n < budget:
+            return
+        last[0] = now
+        score = "-" if best is None else f"{best.values[name]:.4f}"
+        print(
+            f"  {n}/{budget} designs evaluated, best {name} {score} ({now - t0:.1f} s)",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    return show
+
+
 def _search(args: argparse.Namespace) -> int:
     from robotwright.grammar.export import export_design
     from robotwright.grammar.objectives import OBJECTIVES, make_constraint
@@ -165,8 +184,14 @@ def _search(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     objective = OBJECTIVES[args.objective]()
-    kw = dict(budget=args.budget, max_links=args.max_links, seed=args.seed, workers=args.workers)
     t0 = time.perf_counter()
+    kw = dict(
+        budget=args.budget,
+        max_links=args.max_links,
+        seed=args.seed,
+        workers=args.workers,
+        progress=_search_progress(args.budget, objective.name, t0),
+    )
     if args.method == "beam":
         res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
     elif args.method == "mcts":

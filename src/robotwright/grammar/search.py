@@ -43,7 +43,9 @@ class _Evaluator:
         budget: int,
         executor: Executor | None,
         workers: int | None,
+        progress: Callable[[int, Evaluation | None], None] | None = None,
     ) -> None:
+        self.progress = progress
         self.fn = bind(
             evaluate, grammar, objectives=tuple(objectives), constraints=tuple(constraints)
         )
@@ -82,6 +84,8 @@ class _Evaluator:
         for d, ev in zip(todo, self.executor.map(self.fn, todo, chunksize=chunk)):
             self.cache[d.hash()] = ev
             self.order.append(ev)
+        if self.progress is not None and todo:
+            self.progress(len(self.order), _best(self.order))
         return [self.cache.get(d.hash()) for d in designs]
 
 
@@ -100,11 +104,12 @@ def random_search(
     seed: int = 0,
     executor: Executor | None = None,
     workers: int | None = None,
+    progress: Callable[[int, Evaluation | None], None] | None = None,
 ) -> SearchResult:
     """Evaluate ``budget`` distinct designs drawn uniformly (baseline for beam search)."""
     rng = random.Random(seed)
     counter = Counter(grammar)
-    with _Evaluator(grammar, objectives, constraints, budget, executor, workers) as ev:
+    with _Evaluator(grammar, objectives, constraints, budget, executor, workers, progress) as ev:
         tries = 0
         while ev.left > 0 and tries < 20 * budget:
             batch = [sample(grammar, max_links, rng, counter) for _ in range(ev.left)]
@@ -139,7 +144,7 @@ def beam_search(
     rng = random.Random(seed)
     counter = Counter(grammar)
     beam = [Partial.start(grammar)]
-    with _Evaluator(grammar, objectives, constraints, budget, executor, workers) as ev:
+    with _Evaluator(grammar, objectives, constraints, budget, executor, workers, progress) as ev:
         while beam and ev.left > 0:
             children: list[Partial] = []
             for p in beam:
@@ -175,8 +180,6 @@ def beam_search(
                     scored.append((max(r.score for r in rs), i, c))
             scored.sort(key=lambda t: (-t[0], t[1]))
             beam = [c for _, _, c in scored[:beam_width]]
-            if progress is not None:
-                progress(len(ev.order), _best(ev.order))
         return SearchResult(_best(ev.order), ev.order)
 
 
@@ -214,6 +217,7 @@ def mcts_search(
     seed: int = 0,
     executor: Executor | None = None,
     workers: int | None = None,
+    progress: Callable[[int, Evaluation | None], None] | None = None,
 ) -> SearchResult:
     """Monte Carlo tree search (UCT) over the decisions of canonical derivations.
 
@@ -241,7 +245,7 @@ def mcts_search(
     def value(n: _Node) -> float:
         return 0.5 * (n.total / n.visits) + 0.5 * n.best if n.visits else 0.0
 
-    with _Evaluator(grammar, objectives, constraints, budget, executor, workers) as ev:
+    with _Evaluator(grammar, objectives, constraints, budget, executor, workers, progress) as ev:
         k = batch or max(1, 2 * (ev.workers or os.cpu_count() or 1))
         stalls = 0
         while ev.left > 0 and stalls < 50 and (root.untried or root.children):
