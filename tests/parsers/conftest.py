@@ -43,8 +43,16 @@ MODEL = """<mujoco model="probe">
       </body>
     </body>
   </worldbody>
-  <tendon><fixed name="coupling"><joint joint="hip_x" coef="1"/><joint joint="shoulder" coef="-.5"/></fixed></tendon>
-  <equality><joint joint1="hip_y" joint2="hip_x" polycoef="0.1 2 0 0 0"/></equality>
+  <tendon><fixed name="coupling" stiffness="3.14159265358979" springlength="0.1">
+      <joint joint="hip_x" coef="1"/><joint joint="shoulder" coef="-0.123456789012345"/></fixed>
+    <spatial name="cable" width="0.004" rgba="0.1 0.9 0.2 1" range="0 2" damping="0.7">
+      <site site="imu"/><site site="foot"/><pulley divisor="2"/><site site="foot"/><site site="imu"/>
+    </spatial>
+  </tendon>
+  <equality><joint joint1="hip_y" joint2="hip_x" polycoef="0.123456789012345 2.71828182845905 0 0 0"/>
+    <weld body1="arm" body2="torso" solref="0.01 1.3"/>
+    <weld body1="ankle" body2="shin" relpose="0 0 -.2 1 0 0 0" torquescale="0.5"/>
+    <connect body1="shin" body2="hip" anchor="0 0 -.1" active="false"/></equality>
   <contact><exclude body1="torso" body2="hip"/></contact>
   <actuator>
     <motor name="m_hip" joint="hip_x" gear="40" ctrlrange="-1 1"/>

@@ -36,6 +36,7 @@ from robotwright.hrdf.model import (
     Site,
 )
 from robotwright.parsers import inertia as inr
+from robotwright.parsers import mjcf_extra
 from robotwright.parsers.meshes import MeshConversionError, MeshStore, conversion_note
 from robotwright.parsers.reference import body_name, joint_name
 from robotwright.parsers.report import ParseResult, Reporter
@@ -55,8 +56,6 @@ _OBJ = {
     mujoco.mjtObj.mjOBJ_TENDON: "tendon",
 }
 _INTEGRATORS = {0: "Euler", 1: "RK4", 2: "implicit", 3: "implicitfast"}
-#: Sections of the source carried verbatim (as MuJoCo writes them) into ``mjcf_extra``.
-EXTRA_SECTIONS = ("tendon", "equality", "contact")
 
 
 @dataclass(frozen=True)
@@ -278,87 +277,6 @@ def _actuators(
             )
         carried.append(_general_elem(model, i))
     return table, carried, kept
-
-
-def _excludes(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[ET.Element]:
-    """``<contact><exclude>`` rebuilt from the compiled model (signature = b1 << 16 | b2)."""
-    section = ET.Element("contact")
-    for e in range(model.nexclude):
-        sig = int(model.exclude_signature[e])
-        b1, b2 = sig >> 16, sig & 0xFFFF
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_EXCLUDE, e)
-        if b1 not in kept and b1 != 0 or b2 not in kept and b2 != 0:
-            rep.warn("contact exclude with a body outside the robot dropped", f"exclude #{e}")
-            continue
-        attrs = {"name": name} if name else {}
-        attrs |= {"body1": body_name(model, b1), "body2": body_name(model, b2)}
-        ET.SubElement(section, "exclude", attrs)
-    return [section] if len(section) else []
-
-
-_REF_KIND = {
-    "joint": "joint", "joint1": "joint", "joint2": "joint",
-    "site": "site", "site1": "site", "site2": "site", "sidesite": "site",
-    "geom": "geom", "geom1": "geom", "geom2": "geom",
-    "body": "body", "body1": "body", "body2": "body",
-    "tendon": "tendon", "tendon1": "tendon", "tendon2": "tendon",
-}  # fmt: skip
-
-
-def _outside_refs(elem: ET.Element, names: dict[str, set[str]]) -> list[str]:
-    """Names an element (or its children) refers to that are not part of the robot."""
-    out = []
-    for el in elem.iter():
-        for attr, value in el.attrib.items():
-            kind = _REF_KIND.get(attr)
-            if kind is not None and value not in names[kind]:
-                out.append(f"{kind} '{value}'")
-    return out
-
-
-def _carried_sections(
-    spec: mujoco.MjSpec,
-    model: mujoco.MjModel,
-    kept: set[int],
-    names: dict[str, set[str]],
-    rep: Reporter,
-) -> list[ET.Element]:
-    """Tendon, equality and contact sections.
-
-    Contact excludes alone are rebuilt from the compiled model (exact and fast); otherwise
-    the sections are taken as MuJoCo writes them (``spec.to_xml``), with ``class``
-    references removed (reported: values inherited from a class are not carried)."""
-    if not any(len(getattr(spec, a)) for a in ("tendons", "equalities", "pairs")):
-        return _excludes(model, kept, rep)
-    # Tendon sections come first in EXTRA_SECTIONS, so equality/actuator references to a
-    # dropped tendon are caught after it is removed from ``names``.
-    root = ET.fromstring(spec.to_xml())  # MuJoCo's own output: trusted text
-    out = []
-    for tag in EXTRA_SECTIONS:
-        for section in root.findall(tag):
-            for child in list(section):
-                outside = _outside_refs(child, names)
-                if outside:
-                    rep.warn(
-                        f"<{child.tag}> in <{tag}> dropped: it refers to {outside} outside "
-                        "the robot",
-                        f'<{child.tag} name="{child.get("name", "")}">',
-                    )
-                    section.remove(child)
-                    if tag == "tendon" and child.get("name"):
-                        names["tendon"].discard(child.get("name"))
-            if not len(section):
-                continue
-            for el in section.iter():
-                if "class" in el.attrib:
-                    rep.warn(
-                        f"<{el.tag}> in <{tag}>: default class '{el.attrib['class']}' not "
-                        "carried; attributes MuJoCo wrote are kept",
-                        f'<{el.tag} name="{el.get("name", "")}">',
-                    )
-                    del el.attrib["class"]
-            out.append(section)
-    return out
 
 
 def _keyframes(
@@ -688,7 +606,15 @@ def parse_mjcf(
         "body": {body_name(model, b) for b in keep} | {"world"},
         "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
     }
-    extra_parts = _carried_sections(spec, model, kept, names, rep)
+    extra_parts: list[ET.Element] = []
+    tendon_section, names["tendon"] = mjcf_extra.tendons(model, names, rep.warn)
+    for section in (
+        tendon_section,
+        mjcf_extra.equalities(model, names, rep.warn),
+        mjcf_extra.contacts(model, names, rep.warn),
+    ):
+        if section is not None:
+            extra_parts.append(section)
     actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
     for attr, jnames in unheld_joint.items():
         rep.warn(f"joint attribute '{attr}' dropped (no HRDF column) on joints {jnames}")
@@ -763,6 +689,16 @@ def parse_mjcf(
     for what, count in (("camera", model.ncam), ("light", model.nlight)):
         if count:
             rep.warn(f"{count} {what}(s) dropped (HRDF has no {what}s)")
+    for what, count in (
+        ("flex", model.nflex),
+        ("skin", model.nskin),
+        ("plugin instance", model.nplugin),
+        ("custom numeric", model.nnumeric),
+        ("custom text", model.ntext),
+        ("custom tuple", model.ntuple),
+    ):
+        if count:
+            rep.warn(f"{count} {what} element(s) dropped (no HRDF equivalent)")
     for what, count in (("height field", model.nhfield), ("texture", model.ntex)):
         if count:
             rep.warn(f"{count} {what}(s) dropped (HRDF geoms carry a colour only)")

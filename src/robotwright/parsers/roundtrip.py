@@ -388,8 +388,44 @@ def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
             mujoco.mj_fwdPosition(m2, d2)
             if np.abs(d1.ten_length - d2.ten_length).max() > tol:
                 problems.append("tendon lengths differ")
-        if m1.nkey and m1.nq == m2.nq and np.abs(m1.key_qpos - m2.key_qpos).max() > tol:
-            problems.append("keyframe qpos differ")
+        if m1.ntendon:
+            for field_name in sorted(dir(m1)):
+                if not (field_name.startswith(("tendon_", "wrap_"))) or field_name.endswith(
+                    ("adr", "num", "id", "treeid", "treenum", "objid")
+                ):
+                    continue
+                x, y = getattr(m1, field_name), getattr(m2, field_name)
+                if not (isinstance(x, np.ndarray) and x.size):
+                    continue
+                x, y = x.astype(float), np.asarray(y, dtype=float)
+                if field_name in ("tendon_rgba", "tendon_width") and x.shape == y.shape:
+                    # Drawing fields: MJCF has no such attribute on a fixed tendon.
+                    spatial = m1.wrap_type[m1.tendon_adr] != mujoco.mjtWrap.mjWRAP_JOINT
+                    x, y = x[spatial], y[spatial]
+                    if not x.size:
+                        continue
+                scale = max(1.0, float(np.abs(x).max()))
+                if x.shape != y.shape or np.abs(x - y).max() > tol * scale:
+                    problems.append(f"{field_name} differs")
+        if m1.npair:
+            for field_name in ("pair_dim", "pair_friction", "pair_solref", "pair_solimp",
+                               "pair_solreffriction", "pair_margin", "pair_gap"):  # fmt: skip
+                x, y = getattr(m1, field_name), getattr(m2, field_name)
+                if x.shape != y.shape or np.abs(x - y).max() > tol:
+                    problems.append(f"{field_name} differs")
+        if m1.nkey:
+            # Per joint name: a robot taken out of a larger world has fewer qpos entries.
+            def key_slices(m: mujoco.MjModel) -> dict[str, np.ndarray]:
+                out = {}
+                for j in range(m.njnt):
+                    a = int(m.jnt_qposadr[j])
+                    n = {0: 7, 1: 4}.get(int(m.jnt_type[j]), 1)
+                    out[m.joint(j).name or f"joint_{j}"] = m.key_qpos[:, a : a + n]
+                return out
+
+            k1, k2 = key_slices(m1), key_slices(m2)
+            if any(name not in k1 or np.abs(k1[name] - k2[name]).max() > tol for name in k2):
+                problems.append("keyframe qpos differ")
         sig = lambda m: sorted(  # noqa: E731 - a tiny key function
             tuple(sorted((int(s) >> 16, int(s) & 0xFFFF))) for s in m.exclude_signature
         )
