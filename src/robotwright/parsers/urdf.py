@@ -326,32 +326,25 @@ def _make_geom(body: str, kind: str, pose: _Pose, fields: dict) -> MeshGeom | Si
     return SimpleGeom(name="", type=fields["type"], size=fields["size"], **common)
 
 
-def parse_urdf(
-    path: str | os.PathLike, options: URDFOptions | None = None, *, strict: bool = False
-) -> ParseResult:
-    """Parse a URDF file into an HRDF (see :class:`URDFOptions`).
+@dataclass
+class _Tree:
+    """The link tree of a URDF: elements by name, joints, and depth-first link order."""
+
+    links: dict[str, ET.Element]
+    joints: list[ET.Element]
+    parent_of: dict[str, ET.Element]
+    children: dict[str, list[ET.Element]]
+    order: list[str]
+    roots: list[str]
+
+
+def _read_tree(root: ET.Element, path: Path) -> _Tree:
+    """Links and joints checked (names, references, one parent each, one root, no cycle).
 
     Raises:
-        ConversionError: malformed or unsafe XML, an invalid tree, unresolved meshes
-            (all listed in one error), or, with ``strict=True``, any warning.
+        ConversionError: listing every problem found.
     """
-    path = Path(path)
-    opt = options or URDFOptions()
-    rep = Reporter(str(path))
-    root = parse_xml(path)
-    if root.tag != "robot":
-        raise ConversionError([Problem(str(path), f"root element <{root.tag}>: expected <robot>")])
-    reader = _URDFReader(path, opt, rep)
     errors: list[Problem] = []
-
-    for mat in root.findall("material"):
-        rgba = reader._material(mat, describe(mat))
-        if rgba is not None and mat.get("name"):
-            reader.materials[mat.get("name")] = rgba
-    dropped = Counter(child.tag for child in root if child.tag not in _KNOWN_TOP)
-    for tag, count in sorted(dropped.items()):
-        rep.warn(f"{count} top-level <{tag}> element(s) dropped (not robot structure)")
-
     links: dict[str, ET.Element] = {}
     for link in root.findall("link"):
         name = link.get("name")
@@ -426,6 +419,188 @@ def parse_urdf(
     if len(order) != len(links):
         raise ConversionError([Problem(str(path), "the joints do not form a tree (cycle)")])
 
+    return _Tree(links, joints, parent_of, children, order, roots)
+
+
+def _num(elem: ET.Element | None, attr: str, default: float, where: str, rep: Reporter) -> float:
+    """A numeric attribute (``default`` when the element or attribute is absent)."""
+    if elem is None or elem.get(attr) is None:
+        return default
+    try:
+        return float(elem.get(attr))
+    except ValueError as exc:
+        raise ConversionError(
+            [
+                Problem(
+                    rep.file,
+                    f"<{elem.tag} {attr}={elem.get(attr)!r}>: expected a number",
+                    element=where,
+                )
+            ]
+        ) from exc
+
+
+def _joint_record(
+    j: ET.Element, body: str, opt: URDFOptions, rep: Reporter
+) -> tuple[Joint, Actuator | None, tuple[str, str, float, float] | None, bool]:
+    """A moving URDF joint as an HRDF joint, its motor (``actuators="motor"``), its mimic
+    ``(follower, leader, multiplier, offset)`` and whether effort/velocity were dropped."""
+    where = describe(j)
+    jtype = j.get("type")
+    axis_el = j.find("axis")
+    axis = _floats(
+        axis_el.get("xyz") if axis_el is not None else None, 3, (1, 0, 0), f"{where} <axis>", rep
+    )
+    if np.linalg.norm(axis) < 1e-12:
+        raise ConversionError([Problem(rep.file, "axis is zero", element=where)])
+    limit = j.find("limit")
+    rng = None
+    if jtype in ("revolute", "prismatic"):
+        if limit is None or limit.get("lower") is None and limit.get("upper") is None:
+            rep.warn(f"{jtype} joint without <limit lower upper>: kept unlimited", where)
+        else:
+            rng = (_num(limit, "lower", 0.0, where, rep), _num(limit, "upper", 0.0, where, rep))
+            if rng[0] == rng[1]:
+                rep.warn(
+                    f"lower = upper = {rng[0]}: limit ignored, joint kept unlimited "
+                    "(as MuJoCo's URDF importer does)",
+                    where,
+                )
+                rng = None
+    dyn = j.find("dynamics")
+    joint = Joint(
+        name=j.get("name"),
+        body=body,
+        type="slide" if jtype == "prismatic" else "hinge",
+        axis=_t(axis),
+        range=rng,
+        dynamic_friction=_num(dyn, "friction", 0.0, where, rep),
+        viscous_friction=_num(dyn, "damping", 0.0, where, rep),
+    )
+    effort = _num(limit, "effort", 0.0, where, rep)
+    velocity = _num(limit, "velocity", 0.0, where, rep)
+    actuator = None
+    if opt.actuators == "motor" and effort > 0:
+        actuator = Actuator(
+            joint=joint.name,
+            name=joint.name,
+            type="motor",
+            peak_torque=effort,
+            peak_velocity=velocity if velocity > 0 else None,
+            ctrl_range=(-effort, effort),
+        )
+    for tag in ("safety_controller", "calibration"):
+        if j.find(tag) is not None:
+            rep.warn(f"<{tag}> dropped (no HRDF equivalent)", where)
+    mimic_el = j.find("mimic")
+    mimic = None
+    if mimic_el is not None:
+        mimic = (
+            joint.name,
+            mimic_el.get("joint"),
+            _num(mimic_el, "multiplier", 1.0, where, rep),
+            _num(mimic_el, "offset", 0.0, where, rep),
+        )
+    return joint, actuator, mimic, actuator is None and (effort > 0 or velocity > 0)
+
+
+def _mimic_extra(
+    mimics: list[tuple[str, str, float, float]], moving: set[str], rep: Reporter
+) -> str | None:
+    """``<equality>`` joint couplings ``q_follower = offset + multiplier * q_leader``."""
+    lines = []
+    for follower, leader, mult, off in mimics:
+        if leader not in moving or follower not in moving:
+            rep.warn(
+                f"mimic of joint '{leader}' dropped: no moving joint of that name",
+                f'<joint name="{follower}">',
+            )
+            continue
+        lines.append(
+            f'    <joint joint1="{follower}" joint2="{leader}" polycoef="{off!r} {mult!r} 0 0 0"/>'
+        )
+    if not lines:
+        return None
+    return "<mujoco>\n  <equality>\n" + "\n".join(lines) + "\n  </equality>\n</mujoco>\n"
+
+
+def _body_record(
+    name: str, b: dict, index: dict[str, int], opt: URDFOptions, rep: Reporter
+) -> Body:
+    """One body: its parts (link inertials, merged ones included) combined and
+    diagonalised, with the repairs the options ask for (each reported)."""
+    if len(b["parts"]) == 1:
+        mass, com, tensor = b["parts"][0]
+    elif b["parts"]:
+        mass, com, tensor = inr.combine(b["parts"])
+    else:
+        mass, com, tensor = 0.0, np.zeros(3), np.zeros((3, 3))
+    diag, iquat = inr.diagonalize(tensor)
+    where = f'<link name="{name}">'
+    if mass > 0 and not inr.is_physical(diag):
+        if opt.balance_inertia and min(diag) > 0:
+            fixed = inr.balance(diag)
+            rep.warn(f"principal moments {diag} violate A + B >= C: balanced to {fixed}", where)
+            diag = fixed
+        else:
+            rep.warn(
+                f"non-physical inertia: principal moments {diag} (negative or A + B < C)", where
+            )
+    if opt.bound_mass is not None and mass < opt.bound_mass:
+        rep.warn(f"mass {mass} raised to bound_mass {opt.bound_mass}", where)
+        mass = opt.bound_mass
+    if opt.bound_inertia is not None and min(diag) < opt.bound_inertia:
+        new = tuple(max(v, opt.bound_inertia) for v in diag)
+        rep.warn(f"principal moments {diag} raised to bound_inertia: {new}", where)
+        diag = new
+    if mass <= 0 or min(diag) <= 0:
+        rep.warn(
+            f"massless or zero-inertia body (mass {mass}, moments {diag}): HRDF checks "
+            "need mass > 0 and moments > 0; fixed_joints='merge' folds fixed links into "
+            "their parent, bound_mass/bound_inertia raise them",
+            where,
+        )
+    pose = b["pose"]
+    return Body(
+        name=name,
+        parent=-1 if b["parent"] is None else index[b["parent"]],
+        pos=_t(pose.pos),
+        quat=pose.quat,
+        mass=float(mass),
+        inertial_pos=_t(com),
+        inertial_quat=iquat,
+        diag_inertia=diag,
+    )
+
+
+def parse_urdf(
+    path: str | os.PathLike, options: URDFOptions | None = None, *, strict: bool = False
+) -> ParseResult:
+    """Parse a URDF file into an HRDF (see :class:`URDFOptions`).
+
+    Raises:
+        ConversionError: malformed or unsafe XML, an invalid tree, unresolved meshes
+            (all listed in one error), or, with ``strict=True``, any warning.
+    """
+    path = Path(path)
+    opt = options or URDFOptions()
+    rep = Reporter(str(path))
+    root = parse_xml(path)
+    if root.tag != "robot":
+        raise ConversionError([Problem(str(path), f"root element <{root.tag}>: expected <robot>")])
+    reader = _URDFReader(path, opt, rep)
+
+    for mat in root.findall("material"):
+        rgba = reader._material(mat, describe(mat))
+        if rgba is not None and mat.get("name"):
+            reader.materials[mat.get("name")] = rgba
+    dropped = Counter(child.tag for child in root if child.tag not in _KNOWN_TOP)
+    for tag, count in sorted(dropped.items()):
+        rep.warn(f"{count} top-level <{tag}> element(s) dropped (not robot structure)")
+
+    tree = _read_tree(root, path)
+    links, joints, parent_of, children = tree.links, tree.joints, tree.parent_of, tree.children
+    order, roots = tree.order, tree.roots
     data = {n: reader.link_data(links[n]) for n in order}
     if reader.unresolved:
         raise ConversionError(
@@ -464,8 +639,7 @@ def parse_urdf(
             parent_of.pop(child)
             joints.remove(j)
 
-    mimic_eq: list[str] = []
-    mimic_pairs: list[tuple[str, str]] = []
+    mimics: list[tuple[str, str, float, float]] = []
     sites: list[Site] = []
     if dropped_root is not None and dropped_root[0] != "world":
         # Keep the dropped root's frame as a site on the new root (MuJoCo's convention
@@ -533,7 +707,6 @@ def parse_urdf(
             "pose": pose,
             "parts": [(d.mass, d.com, d.tensor)] if d.mass > 0 else [],
             "geoms": list(d.geoms),
-            "declared": d.has_inertial,
         }
         body_order.append(name)
         if j is None:
@@ -542,71 +715,14 @@ def parse_urdf(
             continue
         if jtype == "fixed":
             continue
-        where = describe(j)
-        axis = _floats(
-            (j.find("axis").get("xyz") if j.find("axis") is not None else None),
-            3,
-            (1, 0, 0),
-            f"{where} <axis>",
-            rep,
-        )
-        if np.linalg.norm(axis) < 1e-12:
-            raise ConversionError([Problem(str(path), "axis is zero", element=where)])
-        limit = j.find("limit")
-        rng = None
-        if jtype in ("revolute", "prismatic"):
-            if limit is None or limit.get("lower") is None and limit.get("upper") is None:
-                rep.warn(f"{jtype} joint without <limit lower upper>: kept unlimited", where)
-            else:
-                rng = (float(limit.get("lower", "0")), float(limit.get("upper", "0")))
-                if rng[0] == rng[1]:
-                    rep.warn(
-                        f"lower = upper = {rng[0]}: limit ignored, joint kept unlimited "
-                        "(as MuJoCo's URDF importer does)",
-                        where,
-                    )
-                    rng = None
-        dyn = j.find("dynamics")
-        damping = float(dyn.get("damping", "0")) if dyn is not None else 0.0
-        friction = float(dyn.get("friction", "0")) if dyn is not None else 0.0
-        hrdf_joints.append(
-            Joint(
-                name=j.get("name"),
-                body=name,
-                type="slide" if jtype == "prismatic" else "hinge",
-                axis=_t(axis),
-                range=rng,
-                dynamic_friction=friction,
-                viscous_friction=damping,
-            )
-        )
-        effort = float(limit.get("effort", "0")) if limit is not None else 0.0
-        velocity = float(limit.get("velocity", "0")) if limit is not None else 0.0
-        if opt.actuators == "motor" and effort > 0:
-            actuators.append(
-                Actuator(
-                    joint=j.get("name"),
-                    name=j.get("name"),
-                    type="motor",
-                    peak_torque=effort,
-                    peak_velocity=velocity if velocity > 0 else None,
-                    ctrl_range=(-effort, effort),
-                )
-            )
-        elif effort > 0 or velocity > 0:
-            dropped_limits.append(j.get("name"))
-        for tag in ("safety_controller", "calibration"):
-            if j.find(tag) is not None:
-                rep.warn(f"<{tag}> dropped (no HRDF equivalent)", where)
-        mimic = j.find("mimic")
+        joint, actuator, mimic, limits_dropped = _joint_record(j, name, opt, rep)
+        hrdf_joints.append(joint)
+        if actuator is not None:
+            actuators.append(actuator)
+        if limits_dropped:
+            dropped_limits.append(joint.name)
         if mimic is not None:
-            mult = float(mimic.get("multiplier", "1"))
-            off = float(mimic.get("offset", "0"))
-            mimic_pairs.append((j.get("name"), mimic.get("joint")))
-            mimic_eq.append(
-                f'    <joint joint1="{j.get("name")}" joint2="{mimic.get("joint")}" '
-                f'polycoef="{off!r} {mult!r} 0 0 0"/>'
-            )
+            mimics.append(mimic)
     if dropped_limits:
         rep.warn(
             f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept (HRDF joints "
@@ -620,49 +736,7 @@ def parse_urdf(
     geoms_simple: list[SimpleGeom] = []
     for name in body_order:
         b = bodies[name]
-        mass, com, tensor = (
-            inr.combine(b["parts"]) if b["parts"] else (0.0, np.zeros(3), np.zeros((3, 3)))
-        )
-        if len(b["parts"]) == 1:
-            mass, com, tensor = b["parts"][0]
-        diag, iquat = inr.diagonalize(tensor)
-        where = f'<link name="{name}">'
-        if mass > 0 and not inr.is_physical(diag):
-            if opt.balance_inertia and min(diag) > 0:
-                fixed = inr.balance(diag)
-                rep.warn(f"principal moments {diag} violate A + B >= C: balanced to {fixed}", where)
-                diag = fixed
-            else:
-                rep.warn(
-                    f"non-physical inertia: principal moments {diag} (negative or A + B < C)", where
-                )
-        if opt.bound_mass is not None and mass < opt.bound_mass:
-            rep.warn(f"mass {mass} raised to bound_mass {opt.bound_mass}", where)
-            mass = opt.bound_mass
-        if opt.bound_inertia is not None and min(diag) < opt.bound_inertia:
-            new = tuple(max(v, opt.bound_inertia) for v in diag)
-            rep.warn(f"principal moments {diag} raised to bound_inertia: {new}", where)
-            diag = new
-        if mass <= 0 or min(diag) <= 0:
-            rep.warn(
-                f"massless or zero-inertia body (mass {mass}, moments {diag}): HRDF checks "
-                "need mass > 0 and moments > 0; fixed_joints='merge' folds fixed links into "
-                "their parent, bound_mass/bound_inertia raise them",
-                where,
-            )
-        pose = b["pose"]
-        hrdf_bodies.append(
-            Body(
-                name=name,
-                parent=-1 if b["parent"] is None else index[b["parent"]],
-                pos=_t(pose.pos),
-                quat=pose.quat,
-                mass=float(mass),
-                inertial_pos=_t(com),
-                inertial_quat=iquat,
-                diag_inertia=diag,
-            )
-        )
+        hrdf_bodies.append(_body_record(name, b, index, opt, rep))
         for kind, gpose, fields in b["geoms"]:
             g = _make_geom(name, kind, gpose, fields)
             (geoms_mesh if isinstance(g, MeshGeom) else geoms_simple).append(g)
@@ -679,20 +753,7 @@ def parse_urdf(
                 new_name = f"{g.geom_name}_{seen_names[g.geom_name] - 1}"
                 rep.warn(f"geom name '{g.geom_name}' repeated: renamed '{new_name}'")
                 table[i] = _replace_name(g, new_name, "geom_name")
-    moving = {j.name for j in hrdf_joints}
-    kept = []
-    for line, (follower, leader) in zip(mimic_eq, mimic_pairs, strict=True):
-        if leader in moving:
-            kept.append(line)
-        else:
-            rep.warn(
-                f"mimic of joint '{leader}' dropped: no moving joint of that name",
-                f'<joint name="{follower}">',
-            )
-    mimic_eq = kept
-    extra = None
-    if mimic_eq:
-        extra = "<mujoco>\n  <equality>\n" + "\n".join(mimic_eq) + "\n  </equality>\n</mujoco>\n"
+    extra = _mimic_extra(mimics, {j.name for j in hrdf_joints}, rep)
     hrdf = HRDF(
         name=root.get("name") or path.stem,
         bodies=hrdf_bodies,
