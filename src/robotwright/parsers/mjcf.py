@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import mujoco
@@ -318,26 +318,10 @@ def _keyframes(
     return section
 
 
-def parse_mjcf(
-    path: str | os.PathLike, options: MJCFOptions | None = None, *, strict: bool = False
-) -> ParseResult:
-    """Parse an MJCF file into an HRDF (see the module docstring and :class:`MJCFOptions`).
-
-    Raises:
-        ConversionError: unsafe XML, a model MuJoCo cannot compile (MuJoCo's message),
-            a world with several robots and no ``root_body``, or, with ``strict=True``,
-            any warning.
-    """
-    path = Path(path)
-    opt = options or MJCFOptions()
-    rep = Reporter(str(path))
-    parse_xml(path)  # refuse entity tricks before MuJoCo's own (expanding) XML reader
-    try:
-        spec = mujoco.MjSpec.from_file(str(path))
-        model = spec.compile()
-    except ValueError as exc:
-        raise ConversionError([Problem(str(path), f"MuJoCo cannot load it: {exc}")]) from exc
-
+def _select_robot(
+    model: mujoco.MjModel, path: Path, opt: MJCFOptions, rep: Reporter
+) -> tuple[int, list[int]]:
+    """The robot's root body id and its subtree's body ids (model order)."""
     top = [i for i in range(1, model.nbody) if model.body_parentid[i] == 0]
     if opt.root_body is not None:
         ids = [i for i in top if model.body(i).name == opt.root_body]
@@ -373,9 +357,12 @@ def parse_mjcf(
     for i in range(root_id + 1, model.nbody):
         if model.body_rootid[i] == root_id:
             keep.append(i)
-    kept = set(keep)
-    index = {b: k for k, b in enumerate(keep)}
+    return root_id, keep
 
+
+def _bodies(model: mujoco.MjModel, keep: list[int], root_id: int, rep: Reporter) -> list[Body]:
+    """Body records, frames and inertias as compiled."""
+    index = {b: k for k, b in enumerate(keep)}
     bodies: list[Body] = []
     for b in keep:
         if model.body_mocapid[b] >= 0:
@@ -397,6 +384,13 @@ def parse_mjcf(
             )
         )
 
+    return bodies
+
+
+def _joints(
+    model: mujoco.MjModel, kept: set[int], root_id: int, path: Path, rep: Reporter
+) -> list[Joint]:
+    """Joint records; fields HRDF has no column for are reported once per field."""
     joints: list[Joint] = []
     unheld_joint: dict[str, list[str]] = {}
     for j in range(model.njnt):
@@ -454,7 +448,20 @@ def parse_mjcf(
             )
         )
 
-    store = MeshStore(opt.work_dir) if opt.work_dir else MeshStore()
+    for attr, jnames in unheld_joint.items():
+        rep.warn(f"joint attribute '{attr}' dropped (no HRDF column) on joints {jnames}")
+    return joints
+
+
+def _geoms(
+    model: mujoco.MjModel,
+    spec: mujoco.MjSpec,
+    kept: set[int],
+    path: Path,
+    store: MeshStore,
+    rep: Reporter,
+) -> tuple[list[MeshGeom], list[SimpleGeom]]:
+    """Mesh geoms (files staged, authored poses restored) and primitive geoms."""
     # Relative to the main file's folder (MuJoCo folds <compiler assetdir> into meshdir).
     meshdir = spec.compiler.meshdir or ""
     base_dir = path.resolve().parent
@@ -563,8 +570,6 @@ def parse_mjcf(
         while nm in used:
             nm = f"{nm}_"
         used.add(nm)
-        from dataclasses import replace
-
         simple[k] = replace(sg, name=nm)
     if materials:
         rep.warn(
@@ -577,6 +582,11 @@ def parse_mjcf(
     if world_geoms:
         rep.warn(f"{world_geoms} geom(s) of the worldbody dropped (scene, not robot)")
 
+    return meshes, simple
+
+
+def _sites(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[Site]:
+    """Sites of the robot's bodies."""
     sites: list[Site] = []
     for s in range(model.nsite):
         b = int(model.site_bodyid[s])
@@ -599,41 +609,16 @@ def parse_mjcf(
             )
         )
 
-    names = {
-        "joint": {j.name for j in joints if j.name},
-        "tendon": {model.tendon(t).name for t in range(model.ntendon) if model.tendon(t).name},
-        "site": {x.name for x in sites},
-        "body": {body_name(model, b) for b in keep} | {"world"},
-        "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
-    }
-    extra_parts: list[ET.Element] = []
-    tendon_section, names["tendon"] = mjcf_extra.tendons(model, names, rep.warn)
-    for section in (
-        tendon_section,
-        mjcf_extra.equalities(model, names, rep.warn),
-        mjcf_extra.contacts(model, names, rep.warn),
-    ):
-        if section is not None:
-            extra_parts.append(section)
-    actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
-    for attr, jnames in unheld_joint.items():
-        rep.warn(f"joint attribute '{attr}' dropped (no HRDF column) on joints {jnames}")
-    option_fields = _unheld_option_fields(model)
-    if option_fields:
-        rep.warn(
-            f"<option> fields {option_fields} dropped (HRDF keeps timestep, gravity, integrator)"
-        )
+    return sites
+
+
+def _sensors(
+    model: mujoco.MjModel, kept_names: dict[str, set[str]], rep: Reporter
+) -> tuple[list[Sensor], list[ET.Element]]:
+    """Sensor records; from the first sensor naming the world body on, ``<sensor>``
+    elements for ``mjcf_extra`` (order kept)."""
     sensors: list[Sensor] = []
     extra_sensors: list[ET.Element] = []
-    kept_names = {
-        "body": {body_name(model, b) for b in keep},
-        "xbody": {body_name(model, b) for b in keep},
-        "site": {x.name for x in sites},
-        "joint": {x.name for x in joints},
-        "actuator": {x.name for x in actuators} | {e.get("name") for e in carried_actuators},
-        "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
-        "tendon": names["tendon"],
-    }
     for s in range(model.nsensor):
         sname = model.sensor(s).name or f"sensor_{s}"
         stype = mujoco.mjtSensor(int(model.sensor_type[s])).name[len("mjSENS_") :].lower()
@@ -686,6 +671,11 @@ def parse_mjcf(
             )
         )
 
+    return sensors, extra_sensors
+
+
+def _report_scene(model: mujoco.MjModel, rep: Reporter) -> None:
+    """Warnings for the model parts HRDF has no place for."""
     for what, count in (("camera", model.ncam), ("light", model.nlight)):
         if count:
             rep.warn(f"{count} {what}(s) dropped (HRDF has no {what}s)")
@@ -702,6 +692,68 @@ def parse_mjcf(
     for what, count in (("height field", model.nhfield), ("texture", model.ntex)):
         if count:
             rep.warn(f"{count} {what}(s) dropped (HRDF geoms carry a colour only)")
+
+
+def parse_mjcf(
+    path: str | os.PathLike, options: MJCFOptions | None = None, *, strict: bool = False
+) -> ParseResult:
+    """Parse an MJCF file into an HRDF (see the module docstring and :class:`MJCFOptions`).
+
+    Raises:
+        ConversionError: unsafe XML, a model MuJoCo cannot compile (MuJoCo's message),
+            a world with several robots and no ``root_body``, or, with ``strict=True``,
+            any warning.
+    """
+    path = Path(path)
+    opt = options or MJCFOptions()
+    rep = Reporter(str(path))
+    parse_xml(path)  # refuse entity tricks before MuJoCo's own (expanding) XML reader
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+        model = spec.compile()
+    except ValueError as exc:
+        raise ConversionError([Problem(str(path), f"MuJoCo cannot load it: {exc}")]) from exc
+
+    root_id, keep = _select_robot(model, path, opt, rep)
+    kept = set(keep)
+    bodies = _bodies(model, keep, root_id, rep)
+    joints = _joints(model, kept, root_id, path, rep)
+    store = MeshStore(opt.work_dir) if opt.work_dir else MeshStore()
+    meshes, simple = _geoms(model, spec, kept, path, store, rep)
+    sites = _sites(model, kept, rep)
+    names = {
+        "joint": {j.name for j in joints if j.name},
+        "tendon": {model.tendon(t).name for t in range(model.ntendon) if model.tendon(t).name},
+        "site": {x.name for x in sites},
+        "body": {body_name(model, b) for b in keep} | {"world"},
+        "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
+    }
+    extra_parts: list[ET.Element] = []
+    tendon_section, names["tendon"] = mjcf_extra.tendons(model, names, rep.warn)
+    for section in (
+        tendon_section,
+        mjcf_extra.equalities(model, names, rep.warn),
+        mjcf_extra.contacts(model, names, rep.warn),
+    ):
+        if section is not None:
+            extra_parts.append(section)
+    actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
+    option_fields = _unheld_option_fields(model)
+    if option_fields:
+        rep.warn(
+            f"<option> fields {option_fields} dropped (HRDF keeps timestep, gravity, integrator)"
+        )
+    kept_names = {
+        "body": {body_name(model, b) for b in keep},
+        "xbody": {body_name(model, b) for b in keep},
+        "site": {x.name for x in sites},
+        "joint": {x.name for x in joints},
+        "actuator": {x.name for x in actuators} | {e.get("name") for e in carried_actuators},
+        "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
+        "tendon": names["tendon"],
+    }
+    sensors, extra_sensors = _sensors(model, kept_names, rep)
+    _report_scene(model, rep)
 
     if carried_actuators:
         section = ET.Element("actuator")
