@@ -9,7 +9,9 @@ found) and then raises one :class:`~robotwright.errors.ConversionError` listing 
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import HRDF
@@ -31,7 +33,8 @@ class ParseResult:
     warnings: list[Problem] = field(default_factory=list)
     source: str = ""
 
-    def __iter__(self):  # allows ``hrdf, warnings = parse_..._with_warnings(...)``
+    def __iter__(self) -> Iterator[Any]:
+        """Unpacks as ``hrdf, warnings = urdf_to_hrdf_with_warnings(...)``."""
         return iter((self.hrdf, self.warnings))
 
 
