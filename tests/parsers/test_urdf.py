@@ -294,3 +294,19 @@ def test_file_uri_and_ament_prefix_path(arm: Path, tmp_path: Path, monkeypatch) 
     path2.write_text(ARM.replace("package://armpkg/", "package:///otherpkg/"))
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(prefix))
     assert len(urdf_to_hrdf(path2, fixed_joints="site").meshes) == 1
+
+
+def test_merge_policy_agrees_with_mujoco_fusestatic(arm: Path) -> None:
+    """A second, independent check of merging a rotated fixed child: MuJoCo's own
+    importer with fusestatic gives the same mass, centre of mass and world inertia."""
+    from robotwright.parsers.reference import urdf_for_mujoco
+
+    text = urdf_for_mujoco(arm).replace('fusestatic="false"', 'fusestatic="true"')
+    fused = view_from_model(mujoco.MjModel.from_xml_string(text))
+    ours = view_from_model(our_mjcf_model(urdf_to_hrdf(arm, fixed_joints="merge")))
+    # MuJoCo also fuses the fixed root into the world; compare the moving bodies.
+    for name in ("upper", "slider", "finger"):
+        assert ours.mass[name] == pytest.approx(fused.mass[name], rel=1e-12)
+        (c1, i1), (c2, i2) = ours.inertia_world[name], fused.inertia_world[name]
+        assert np.abs(c1 - c2).max() <= 1e-12
+        assert np.abs(i1 - i2).max() <= 1e-12 * np.abs(i2).max()
