@@ -50,3 +50,24 @@ def test_roundtrip_command_prints_table(arm_mjcf: Path, probe: Path, capsys) -> 
     # Two joints on one body need massless URDF links, which MuJoCo refuses: exit 1.
     assert main(["roundtrip", str(probe), "--configs", "5"]) == 1
     assert "result:    FAIL" in capsys.readouterr().out
+
+
+def test_convert_massless_links_hint_then_merge(tmp_path: Path, capsys) -> None:
+    urdf = tmp_path / "r" / "urdf" / "tool.urdf"
+    urdf.parent.mkdir(parents=True)
+    urdf.write_text(
+        '<robot name="t"><link name="base"><inertial><mass value="1"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+        '<link name="arm"><inertial><mass value="1"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+        '<link name="tcp"/>'
+        '<joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint>'
+        '<joint name="f" type="fixed"><parent link="arm"/><child link="tcp"/>'
+        '<origin xyz="0 0 .3"/></joint></robot>'
+    )
+    out = tmp_path / "tool.xml"
+    assert main(["convert", str(urdf), "-o", str(out)]) == 2
+    assert "--fixed-joints merge" in capsys.readouterr().err and not out.exists()
+    assert main(["convert", str(urdf), "-o", str(out), "--fixed-joints", "merge"]) == 0
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.site("tcp").id >= 0 and model.nbody == 3

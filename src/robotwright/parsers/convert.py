@@ -12,7 +12,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from robotwright.errors import ConversionError, Problem
+from robotwright.errors import ConversionError, HRDFError, Problem
 from robotwright.hrdf.model import HRDF
 
 
@@ -62,12 +62,24 @@ def convert(
     messages = [str(p) for p in problems]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if out_kind == "hrdf":
-            hrdf.save(dst_p, overwrite=overwrite)
-        else:
-            from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
+        try:
+            if out_kind == "hrdf":
+                hrdf.save(dst_p, overwrite=overwrite)
+            else:
+                from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
 
-            gen_cls = MJCFHumanoidGenerator if out_kind == "mjcf" else URDFHumanoidGenerator
-            gen_cls.from_hrdf(hrdf).export(dst_p, copy_meshes=True, strict=strict)
+                gen_cls = MJCFHumanoidGenerator if out_kind == "mjcf" else URDFHumanoidGenerator
+                gen_cls.from_hrdf(hrdf).export(dst_p, copy_meshes=True, strict=strict)
+        except HRDFError as exc:
+            massless = any(p.column in ("mass", "diag_inertia") for p in exc.problems)
+            hint = (
+                " (massless links: try fixed_joints='merge' / --fixed-joints merge, or "
+                "bound_mass / --bound-mass)"
+                if massless
+                else ""
+            )
+            raise ConversionError(
+                exc.problems, summary=f"cannot write {dst_p}: the robot is not a valid HRDF{hint}"
+            ) from exc
     messages += [str(w.message) for w in caught]
     return messages
