@@ -15,6 +15,7 @@ import shutil
 import tempfile
 import warnings
 from dataclasses import dataclass
+from itertools import repeat
 from pathlib import Path
 from typing import Any
 
@@ -87,10 +88,45 @@ class HRDFWarning(UserWarning):
 
 @dataclass
 class _Table:
-    """Rows of one CSV file after conversion: ``rows[i]`` is a field dict or ``None``."""
+    """Rows of one CSV file after conversion.
 
-    rows: list[dict[str, Any] | None]
+    ``rows[i]`` holds the values of ``fields`` (in that order) or is ``None`` for a row
+    with a problem (already reported).
+    """
+
+    fields: list[str]
+    rows: list[tuple[Any, ...] | None]
     extra_columns: list[str]
+
+
+def _split_plain(text: str) -> list[str] | None:
+    """The lines of ``text`` when ``str.split`` cuts it into the cells ``csv.reader`` reads.
+
+    Without quotes, carriage returns or NUL characters, ``csv.reader`` (excel dialect)
+    splits exactly at every comma and newline, so splitting the text ourselves (several
+    times faster) gives the same cells. Anything else, or an empty first line (csv reads
+    it as ``[]``), returns ``None`` and the csv module reads the file.
+    """
+    if '"' in text or "\r" in text or "\0" in text:
+        return None
+    lines = text.split("\n")
+    if not lines[0]:
+        return None
+    if not lines[-1]:
+        lines.pop()  # the final newline
+    return lines
+
+
+def _flat_columns(lines: list[str], width: int) -> list[list[str]] | None:
+    """Columns of data ``lines`` that all have ``width`` cells (else ``None``).
+
+    When every line has the same number of commas, the cells of the joined text are
+    row-major, so column ``j`` is every ``width``-th cell from ``j``: no per-row lists.
+    """
+    if width < 2 or any(n != width - 1 for n in map(str.count, lines, repeat(","))):
+        return None
+    flat = ",".join(lines).split(",") if lines else []
+    return [flat[j::width] for j in range(width)]
 
 
 def _read_table(
@@ -102,12 +138,20 @@ def _read_table(
     except (OSError, UnicodeDecodeError) as exc:
         problems.append(Problem(fname, f"cannot read file: {exc}"))
         return None
-    reader = csv.reader(io.StringIO(text))
-    try:
-        header = next(reader)
-    except StopIteration:
-        problems.append(Problem(fname, "file is empty: expected a header row"))
-        return None
+    lines = _split_plain(text)
+    columns: list[list[str]] | None = None
+    if lines is not None:
+        header = lines[0].split(",")
+        columns = _flat_columns(lines[1:], len(header))
+        body_rows: Any = (line.split(",") for line in lines[1:])
+    else:
+        reader = csv.reader(io.StringIO(text))
+        try:
+            header = next(reader)
+        except StopIteration:
+            problems.append(Problem(fname, "file is empty: expected a header row"))
+            return None
+        body_rows = reader
     header = [h.strip() for h in header]
     index = {h: i for i, h in enumerate(header)}
     known: set[str] = set()
@@ -137,12 +181,20 @@ def _read_table(
 
     plan = [(col, [index[h] for h in col.headers]) for col in schema if col.headers[0] in index]
     absent = {col.field: col.default for col in schema if col.headers[0] not in index}
-    data = [cells for cells in reader if cells and (len(cells) > 1 or cells[0].strip())]
-    if all(len(cells) == len(header) for cells in data):
-        fast = _convert_table_fast(data, plan, absent, empty_ok_here) if data else []
+    if columns is not None:
+        fast = _convert_table_fast(columns, plan, absent, empty_ok_here)
         if fast is not None:
-            return _Table(rows=list(fast), extra_columns=extra)
-    rows: list[dict[str, Any] | None] = []
+            return _Table(fields=fast[0], rows=fast[1], extra_columns=extra)
+    # Empty lines are skipped (an empty line is [] for csv, [""] for str.split).
+    data = [cells for cells in body_rows if cells and (len(cells) > 1 or cells[0].strip())]
+    if columns is None and data and all(len(cells) == len(header) for cells in data):
+        fast = _convert_table_fast(
+            [list(col) for col in zip(*data, strict=True)], plan, absent, empty_ok_here
+        )
+        if fast is not None:
+            return _Table(fields=fast[0], rows=fast[1], extra_columns=extra)
+    fields = [col.field for col in schema]
+    rows: list[tuple[Any, ...] | None] = []
     for row_no, cells in enumerate(data):
         if len(cells) != len(header):
             problems.append(
@@ -194,26 +246,26 @@ def _read_table(
                     break
             else:
                 record[col.field] = values[0] if col.size == 0 else tuple(values)
-        rows.append(record if ok else None)
-    return _Table(rows=rows, extra_columns=extra)
+        rows.append(tuple([record[f] for f in fields]) if ok else None)
+    return _Table(fields=fields, rows=rows, extra_columns=extra)
 
 
-def _floats_or_none(cells: tuple[str, ...]) -> list[float | None]:
+def _floats_or_none(cells: list[str]) -> list[float | None]:
     return [None if t == "" else float(t) for t in cells]
 
 
 def _convert_table_fast(
-    data: list[list[str]],
+    columns: list[list[str]],
     plan: list[tuple[Column, list[int]]],
     absent: dict[str, Any],
     empty_ok_here: Any,
-) -> list[dict[str, Any]] | None:
-    """Convert a well-formed table column by column; ``None`` sends it to the checking path.
+) -> tuple[list[str], list[tuple[Any, ...]]] | None:
+    """Convert the cell columns of a rectangular table into (fields, row tuples).
 
-    Any unusual cell (empty where not allowed, non-numeric, non-finite, padded) returns
-    ``None`` so that the row-by-row path can report it precisely.
+    ``None`` sends the table to the checking path: any unusual cell (empty where not
+    allowed, non-numeric, non-finite, padded) is reported precisely there.
     """
-    columns = list(zip(*data, strict=True))
+    n = len(columns[0]) if columns else 0
     fields_: list[str] = []
     values: list[list[Any]] = []
     isfinite = math.isfinite
@@ -255,39 +307,126 @@ def _convert_table_fast(
                 vals = list(map(int, columns[idx[0]]))
             else:
                 cells = columns[idx[0]]
-                if cells != tuple(map(str.strip, cells)):
+                if cells != list(map(str.strip, cells)):
                     return None
                 if "" in cells:
                     if not col.empty_ok:
                         return None
                     vals = [col.default if t == "" else t for t in cells]
                 else:
-                    vals = list(cells)
+                    vals = cells  # type: ignore[assignment]
             fields_.append(col.field)
             values.append(vals)
     except ValueError:
         return None
-    n = len(data)
     for name, default in absent.items():
         fields_.append(name)
         values.append([default] * n)
-    return [dict(zip(fields_, row)) for row in zip(*values)]
+    return fields_, list(zip(*values))
 
 
-def _record(cls: type, values: dict[str, Any]) -> Any:
-    """Make a frozen record from a complete, already converted field dict.
+def _records(cls: type, fields: list[str], rows: list[tuple[Any, ...] | None]) -> list[Any]:
+    """Frozen records of ``cls`` from complete, already converted rows (``None`` stays).
 
     The schema covers every field (tested), so the dataclass ``__init__`` adds nothing
     but ~2 us per record of frozen-attribute overhead, a quarter of the load time.
     """
-    obj = object.__new__(cls)
-    obj.__dict__.update(values)
-    return obj
+    new = object.__new__
+    out: list[Any] = []
+    for row in rows:
+        if row is None:
+            out.append(None)
+            continue
+        obj = new(cls)
+        obj.__dict__.update(zip(fields, row))
+        out.append(obj)
+    return out
+
+
+class _NotPlainYAML(Exception):
+    """The document uses more than plain maps, lists and core scalars (see _plain_yaml)."""
+
+
+_PLAIN_SCALARS = {
+    tag: yaml.constructor.SafeConstructor.yaml_constructors[tag]
+    for tag in (
+        "tag:yaml.org,2002:null",
+        "tag:yaml.org,2002:bool",
+        "tag:yaml.org,2002:int",
+        "tag:yaml.org,2002:float",
+        "tag:yaml.org,2002:str",
+    )
+}
+_YAML_MAP = "tag:yaml.org,2002:map"
+_YAML_STR = "tag:yaml.org,2002:str"
+_YAML_NULL = "tag:yaml.org,2002:null"
+_YAML_INT = "tag:yaml.org,2002:int"
+_YAML_SEQ = "tag:yaml.org,2002:seq"
+
+
+def _plain_yaml(loader: Any, node: yaml.Node, seen: set[int]) -> Any:
+    """Build the Python value of a composed document made of plain maps, lists and scalars.
+
+    PyYAML's generic constructor (generators per node, recursion and alias bookkeeping)
+    is half of the meta.yaml load time. Scalars still go through PyYAML's own safe
+    constructors, so values are identical; anything else (other tags, merge keys ``<<``,
+    aliases of collections) raises :class:`_NotPlainYAML` and the caller hands the node
+    to PyYAML's constructor, which then does all the work.
+    """
+    kind = type(node)
+    if kind is yaml.ScalarNode:
+        # What construct_yaml_str and construct_yaml_null return for a scalar node.
+        if node.tag == _YAML_STR:
+            return node.value
+        if node.tag == _YAML_NULL:
+            return None
+        if node.tag == _YAML_INT:
+            # Plain decimals (no sign, leading zero, '_', base prefix or ':'), for which
+            # construct_yaml_int is int(); the other forms go through it below.
+            v = node.value
+            if v.isdigit() and v.isascii() and (v[0] != "0" or v == "0"):
+                return int(v)
+            if v[:1] == "-" and v[1:].isdigit() and v.isascii() and v[1] != "0":
+                return int(v)
+        build = _PLAIN_SCALARS.get(node.tag)
+        if build is None:
+            raise _NotPlainYAML
+        return build(loader, node)
+    if id(node) in seen:  # an alias: PyYAML shares one object between its uses
+        raise _NotPlainYAML
+    seen.add(id(node))
+    if kind is yaml.SequenceNode and node.tag == _YAML_SEQ:
+        return [_plain_yaml(loader, item, seen) for item in node.value]
+    if kind is yaml.MappingNode and node.tag == _YAML_MAP:
+        out = {}
+        for key, value in node.value:
+            # Keys go through the scalar branch: merge (<<) and value (=) keys have tags
+            # of their own there, and collection keys are not plain scalars.
+            if type(key) is not yaml.ScalarNode:
+                raise _NotPlainYAML
+            out[_plain_yaml(loader, key, seen)] = _plain_yaml(loader, value, seen)
+        return out
+    raise _NotPlainYAML
+
+
+def _parse_yaml(text: str) -> Any:
+    """``yaml.load(text, Loader=_YAML_LOADER)``, with a faster build of plain documents."""
+    loader = _YAML_LOADER(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        try:
+            return _plain_yaml(loader, node, set())
+        except _NotPlainYAML:
+            return loader.construct_document(node)
+    finally:
+        loader.dispose()
 
 
 def _load_yaml(path: Path, problems: list[Problem]) -> Any:
     try:
-        return yaml.load(path.read_text(encoding="utf-8"), Loader=_YAML_LOADER)
+        return _parse_yaml(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         problems.append(Problem(path.name, f"cannot parse YAML: {exc}"))
         return None
@@ -489,53 +628,45 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
 
     records: dict[str, list] = {}
     for stem, table in tables.items():
-        if table is None:
-            records[stem] = []
-            continue
-        cls = _RECORD_TYPES[stem]
-        if stem == "body":
-            # "id" is checked against the row position below; "parent" comes from meta.yaml.
-            records[stem] = [
-                None
-                if row is None
-                else _record(cls, {**{k: v for k, v in row.items() if k != "id"}, "parent": -1})
-                for row in table.rows
-            ]
-        else:
-            records[stem] = [None if row is None else _record(cls, row) for row in table.rows]
+        if stem != "body":
+            records[stem] = (
+                [] if table is None else _records(_RECORD_TYPES[stem], table.fields, table.rows)
+            )
 
     # Body ids must match row order: hurodes silently uses row order, we refuse to guess.
-    body_rows = tables["body"].rows
-    bodies: list[Body] = []
-    for i, (row, rec) in enumerate(zip(body_rows, records["body"], strict=True)):
-        if row is None:
-            bodies.append(None)  # type: ignore[arg-type]
-            continue
-        if row["id"] != i:
+    body_table = tables["body"]
+    id_at = body_table.fields.index("id")
+    for i, row in enumerate(body_table.rows):
+        if row is not None and row[id_at] != i:
             problems.append(
                 Problem(
                     "body.csv",
-                    f"id {row['id']} does not match the row position {i}: rows must be in id order",
+                    f"id {row[id_at]} does not match the row position {i}: rows must be in id order",
                     row=i,
                     column="id",
                 )
             )
-        bodies.append(rec)
-    if parent_ids is not None:
-        if len(parent_ids) != len(bodies):
-            problems.append(
-                Problem(
-                    "meta.yaml",
-                    f"body_parent_id has {len(parent_ids)} entries, body.csv has {len(bodies)} rows",
-                    column="body_parent_id",
-                )
+    n_bodies = len(body_table.rows)
+    if parent_ids is not None and len(parent_ids) != n_bodies:
+        problems.append(
+            Problem(
+                "meta.yaml",
+                f"body_parent_id has {len(parent_ids)} entries, body.csv has {n_bodies} rows",
+                column="body_parent_id",
             )
-        else:
-            for b, p in zip(bodies, parent_ids, strict=True):
-                if b is not None:
-                    # Records made a few lines above and not yet shared: set in place
-                    # (dataclasses.replace costs a third of the table reading time).
-                    object.__setattr__(b, "parent", p)
+        )
+        parent_ids = None
+    # "id" was checked above; the "parent" field comes from meta.yaml (-1 when unusable).
+    body_fields = ["parent" if f == "id" else f for f in body_table.fields]
+    parents = parent_ids if parent_ids is not None else [-1] * n_bodies
+    bodies: list[Body] = _records(
+        Body,
+        body_fields,
+        [
+            None if row is None else (*row[:id_at], parent, *row[id_at + 1 :])
+            for row, parent in zip(body_table.rows, parents, strict=True)
+        ],
+    )
 
     joints: list[Joint] = [j for j in records["joint"] if j is not None]
     floating = ext.get("floating_base", True if hurodes_format else None)

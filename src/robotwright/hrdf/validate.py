@@ -31,6 +31,12 @@ from robotwright.hrdf.model import (
 QUAT_NORM_TOL = 1e-4
 INERTIA_TRIANGLE_RTOL = 1e-9
 AXIS_NORM_MIN = 1e-9
+#: The per-row checks below start with a quick pass over the row, written as exactly the
+#: negation of every check that follows it, so that messages are built only for rows
+#: with a problem. Tests turn it off to compare both ways on broken rows.
+_QUICK_PASS = True
+#: size values a simple geom type uses (the others are ignored); 3 for the rest.
+_SIZE_USED = {"sphere": 1, "capsule": 2, "cylinder": 2}
 
 
 def _quat_problem(q: Sequence[float]) -> str | None:
@@ -87,13 +93,19 @@ def _check_tree(hrdf: HRDF) -> list[Problem]:
     if bad_parent:
         return out
     reported: set[int] = set()
+    parents = [b.parent for b in hrdf.bodies]
+    # Bodies already known to reach the root: a walk that meets one stops there, so a
+    # valid tree costs O(n) instead of O(n * depth). Walks into a cycle never add to it.
+    rooted: set[int] = set()
     for start in range(n):
         seen: list[int] = []
         i = start
-        while i != -1 and i not in seen:
+        while i != -1 and i not in rooted and i not in seen:
             seen.append(i)
-            i = hrdf.bodies[i].parent
-        if i != -1:
+            i = parents[i]
+        if i == -1 or i in rooted:
+            rooted.update(seen)
+        else:
             cycle = seen[seen.index(i) :]
             if not reported.intersection(cycle):
                 reported.update(cycle)
@@ -112,7 +124,27 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
     out: list[Problem] = []
     for name in sorted(_duplicates(b.name for b in hrdf.bodies)):
         out.append(Problem("body.csv", f"duplicate body name '{name}'", column="name"))
+    hypot = math.hypot
+    k = 1.0 - INERTIA_TRIANGLE_RTOL
     for i, b in enumerate(hrdf.bodies):
+        # Quick pass: exactly the negation of every check below, so the per-row messages
+        # are built only for rows that have a problem (most loads have none).
+        d = b.diag_inertia
+        if (
+            _QUICK_PASS
+            and b.name
+            and b.mass > 0
+            and not abs(hypot(*b.quat) - 1.0) > QUAT_NORM_TOL
+            and not abs(hypot(*b.inertial_quat) - 1.0) > QUAT_NORM_TOL
+            and len(d) == 3
+            and d[0] > 0
+            and d[1] > 0
+            and d[2] > 0
+            and not d[0] + d[1] < d[2] * k
+            and not d[1] + d[2] < d[0] * k
+            and not d[2] + d[0] < d[1] * k
+        ):
+            continue
         if not b.name:
             out.append(Problem("body.csv", "empty body name", row=i, column="name"))
         if not b.mass > 0:
@@ -162,6 +194,29 @@ def _check_joints(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
                 )
             continue
         row += 1
+        # Quick pass: exactly the negation of every check below (see _check_bodies).
+        ax, rng = j.axis, j.range
+        if (
+            _QUICK_PASS
+            and j.name is not None
+            and j.name != ""
+            and j.type in JOINT_TYPES
+            and j.body in body_names
+            and (
+                j.type not in ("hinge", "slide")
+                or (
+                    len(ax) == 3
+                    and not math.sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]) < AXIS_NORM_MIN
+                )
+            )
+            and (rng is None or not rng[0] > rng[1])
+            and not j.armature < 0
+            and not j.viscous_friction < 0
+            and not j.static_friction < 0
+            and not j.dynamic_friction < 0
+            and not j.stiffness < 0
+        ):
+            continue
         if j.name is None or j.name == "":
             out.append(Problem("joint.csv", "empty joint name", row=row, column="name"))
         if j.type not in JOINT_TYPES:
@@ -214,6 +269,19 @@ def _check_actuators(hrdf: HRDF) -> list[Problem]:
     for name in sorted(_duplicates(a.name for a in hrdf.actuators)):
         out.append(Problem("actuator.csv", f"duplicate actuator name '{name}'", column="name"))
     for i, a in enumerate(hrdf.actuators):
+        # Quick pass: exactly the negation of every check below (see _check_bodies).
+        cr, fr = a.ctrl_range, a.force_range
+        if (
+            _QUICK_PASS
+            and a.joint in joint_names
+            and a.type in ACTUATOR_TYPES
+            and (a.peak_torque is None or not a.peak_torque <= 0)
+            and (cr is None or not cr[0] > cr[1])
+            and (fr is None or not fr[0] > fr[1])
+            and not (a.type == "position" and a.p_gain is None)
+            and not (a.type == "velocity" and a.d_gain is None)
+        ):
+            continue
         if a.joint not in joint_names:
             out.append(
                 Problem("actuator.csv", f"unknown joint '{a.joint}'", row=i, column="joint_name")
@@ -278,22 +346,41 @@ def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
     return str(hrdf.mesh_path(mesh))
 
 
-def _is_file(path: str, listings: dict[str, set[str]]) -> bool:
-    """Existence check through one directory listing per folder (meshes share a folder)."""
-    folder, _, name = path.rpartition(os.sep)
-    if folder not in listings:
+def _listing(folder: str, listings: dict[str, set[str]]) -> set[str]:
+    """Names of the files in ``folder``, listed once per check (meshes share a folder)."""
+    names = listings.get(folder)
+    if names is None:
         try:
-            listings[folder] = {e.name for e in os.scandir(folder) if e.is_file()}
+            names = {e.name for e in os.scandir(folder) if e.is_file()}
         except OSError:
-            listings[folder] = set()
-    return name in listings[folder]
+            names = set()
+        listings[folder] = names
+    return names
+
+
+def _is_file(path: str, listings: dict[str, set[str]]) -> bool:
+    """Existence check through one directory listing per folder."""
+    folder, _, name = path.rpartition(os.sep)
+    return name in _listing(folder, listings)
 
 
 def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Problem]:
     out: list[Problem] = []
     listings: dict[str, set[str]] = {}
+    hypot = math.hypot
     for table, rows in (("mesh.csv", hrdf.meshes), ("simple_geom.csv", hrdf.simple_geoms)):
         for i, g in enumerate(rows):
+            # Quick pass: exactly the negation of every check below (see _check_bodies).
+            if (
+                _QUICK_PASS
+                and g.body in body_names
+                and not abs(hypot(*g.quat) - 1.0) > QUAT_NORM_TOL
+                and min(g.rgba) >= 0.0
+                and max(g.rgba) <= 1.0
+                and g.condim in (1, 3, 4, 6)
+                and not g.static_friction < 0
+            ):
+                continue
             if g.body not in body_names:
                 out.append(Problem(table, f"unknown body '{g.body}'", row=i, column="body_name"))
             msg = _quat_problem(g.quat)
@@ -328,7 +415,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
                 )
             )
             continue
-        used = {"sphere": 1, "capsule": 2, "cylinder": 2}.get(g.type, 3)
+        used = _SIZE_USED.get(g.type, 3)
         if any(not v > 0 for v in g.size[:used]):
             out.append(
                 Problem(
@@ -340,11 +427,16 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             )
     for name in sorted(_duplicates(g.name for g in hrdf.simple_geoms)):
         out.append(Problem("simple_geom.csv", f"duplicate geom name '{name}'", column="name"))
+    unit = (1.0, 1.0, 1.0)
+    ext = hrdf.meta.mesh_file_type
+    default_dir = None  # the folder of meshes/<name>.<ext> paths, when _mesh_file uses it
+    if hrdf.root_dir is not None and os.sep not in str(ext):
+        default_dir = f"{hrdf.root_dir}{os.sep}meshes"
     for i, m in enumerate(hrdf.meshes):
         if not m.name:
             out.append(Problem("mesh.csv", "empty mesh name", row=i, column="name"))
             continue
-        if any(not s > 0 for s in m.scale):
+        if m.scale != unit and any(not s > 0 for s in m.scale):
             out.append(
                 Problem("mesh.csv", f"scale {m.scale}: expected > 0", row=i, column="scale0")
             )
@@ -360,6 +452,15 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             )
             continue
         if check_files:
+            # What _mesh_file and _is_file do, without building the path of every row.
+            if (
+                _QUICK_PASS
+                and default_dir is not None
+                and m.file is None
+                and os.sep not in m.name
+                and f"{m.name}.{ext}" in _listing(default_dir, listings)
+            ):
+                continue
             path = _mesh_file(hrdf, m)
             if not _is_file(path, listings):
                 out.append(
