@@ -584,6 +584,10 @@ def _roundtrip(
         ours = view_from_model(our_mjcf_model(result.hrdf))
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
+        if "mass" in str(exc) and source_kind(path) == "urdf":
+            report.error += (
+                "\nhint: massless links; try --fixed-joints merge, or --bound-mass/--bound-inertia"
+            )
         return report
     collision_only = source_kind(path) == "urdf"  # MuJoCo's URDF import drops visuals
     for r in compare_views(ref, ours, configs=configs, mimic=mimic, collision_only=collision_only):
