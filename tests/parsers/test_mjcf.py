@@ -116,3 +116,24 @@ def test_saved_folder_holds_meshes_and_reloads(probe: Path, tmp_path: Path) -> N
     a = view_from_model(our_mjcf_model(hrdf))
     b = view_from_model(our_mjcf_model(again))
     assert all(r.ok for r in compare_views(a, b, configs=5))
+
+
+def test_massless_frame_becomes_site(tmp_path: Path) -> None:
+    path = tmp_path / "frame.xml"
+    path.write_text(
+        '<mujoco><worldbody><body name="base"><geom size=".1" mass="1"/>'
+        '<body name="link" pos="0 0 .2"><joint name="j" axis="0 1 0"/><geom size=".05"/>'
+        '<body name="cam_frame" pos=".1 0 .05" euler="0.3 0.2 0.1">'
+        '<site name="lens" pos="0 0 .01"/><geom type="box" size=".01 .01 .01" mass="0"'
+        ' contype="0" conaffinity="0"/></body></body></body></worldbody></mujoco>'
+    )
+    _, warnings = mjcf_to_hrdf_with_warnings(path)
+    assert any("massless" in str(w) and "cam_frame" in str(w) for w in warnings)
+    hrdf = mjcf_to_hrdf(path, massless_frames="site")
+    assert [b.name for b in hrdf.bodies] == ["base", "link"]
+    assert {s.name: s.body for s in hrdf.sites} == {"lens": "link", "cam_frame": "link"}
+    source = mujoco.MjModel.from_xml_path(str(path))
+    rows = compare_views(view_from_model(source), view_from_model(our_mjcf_model(hrdf)), configs=10)
+    assert all(r.ok for r in rows), rows
+    with pytest.raises(ValueError, match="massless_frames"):
+        mjcf_to_hrdf(path, massless_frames="merge")

@@ -12,6 +12,8 @@ def _options(args: argparse.Namespace) -> dict:
         opts["fixed_joints"] = args.fixed_joints
     if getattr(args, "root_body", None):
         opts["root_body"] = args.root_body
+    if getattr(args, "massless_frames", None):
+        opts["massless_frames"] = args.massless_frames
     for name in ("bound_mass", "bound_inertia"):
         if getattr(args, name, None) is not None:
             opts[name] = getattr(args, name)
@@ -21,6 +23,11 @@ def _options(args: argparse.Namespace) -> dict:
 
 
 def _repair_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--massless-frames",
+        choices=("keep", "site"),
+        help="MJCF: turn massless leaf frame bodies into sites",
+    )
     p.add_argument("--balance-inertia", action="store_true", help="URDF: MuJoCo's balanceinertia")
     p.add_argument("--bound-mass", type=float, help="URDF: raise masses below this (kg)")
     p.add_argument("--bound-inertia", type=float, help="URDF: raise moments below this (kg m^2)")

@@ -67,10 +67,20 @@ class MJCFOptions:
             several top-level bodies (the others are dropped with a warning). ``None``:
             the only top-level body.
         work_dir: folder where meshes are staged (default: a new temp folder).
+        massless_frames: ``"keep"`` (default) or ``"site"``: a massless leaf body without
+            joints that nothing else names (a camera or tool frame) becomes a site on its
+            parent named after it, its sites and (massless) geoms moved to the parent.
+            HRDF checks require mass > 0 on every body, so ``"keep"`` leaves such a robot
+            invalid (reported).
     """
 
     root_body: str | None = None
     work_dir: Path | None = None
+    massless_frames: str = "keep"
+
+    def __post_init__(self) -> None:
+        if self.massless_frames not in ("keep", "site"):
+            raise ValueError(f"massless_frames={self.massless_frames!r}: expected 'keep' or 'site'")
 
 
 _DEFAULT_MODEL = mujoco.MjModel.from_xml_string(
@@ -360,11 +370,74 @@ def _select_robot(
     return root_id, keep
 
 
-def _bodies(model: mujoco.MjModel, keep: list[int], root_id: int, rep: Reporter) -> list[Body]:
-    """Body records, frames and inertias as compiled."""
-    index = {b: k for k, b in enumerate(keep)}
+def _named_bodies(model: mujoco.MjModel) -> set[int]:
+    """Bodies other elements refer to (sensors, actuators, equality, excludes)."""
+    out: set[int] = set()
+    body_types = (mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_XBODY)
+    for s in range(model.nsensor):
+        if model.sensor_objtype[s] in body_types:
+            out.add(int(model.sensor_objid[s]))
+        if model.sensor_reftype[s] in body_types:
+            out.add(int(model.sensor_refid[s]))
+    for a in range(model.nu):
+        if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_BODY:
+            out.add(int(model.actuator_trnid[a, 0]))
+    for e in range(model.neq):
+        if model.eq_type[e] in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD) and (
+            model.eq_objtype[e] != mujoco.mjtObj.mjOBJ_SITE
+        ):
+            out.update((int(model.eq_obj1id[e]), int(model.eq_obj2id[e])))
+    for sig in model.exclude_signature:
+        out.update((int(sig) >> 16, int(sig) & 0xFFFF))
+    return out
+
+
+def _frames_as_sites(
+    model: mujoco.MjModel, keep: list[int], root_id: int, opt: MJCFOptions
+) -> set[int]:
+    """Bodies that become sites under ``massless_frames="site"``."""
+    if opt.massless_frames != "site":
+        return set()
+    parents = {int(model.body_parentid[b]) for b in keep if b != root_id}
+    named = _named_bodies(model)
+    return {
+        b
+        for b in keep
+        if b != root_id
+        and model.body_mass[b] == 0
+        and model.body_jntnum[b] == 0
+        and b not in parents
+        and b not in named
+    }
+
+
+def _reparent(
+    model: mujoco.MjModel, b: int, pos, quat, frames: set[int]
+) -> tuple[int, tuple[float, float, float], tuple[float, float, float, float]]:
+    """(body id, pos, quat) of a pose on body ``b``, moved to its parent when ``b`` is a
+    frame turned into a site."""
+    if b not in frames:
+        return b, _t3(pos), _t4(quat)
+    rot = inr.quat_to_mat(model.body_quat[b])
+    new_pos = model.body_pos[b] + rot @ np.asarray(pos, dtype=float)
+    return int(model.body_parentid[b]), _t3(new_pos), inr.mul_quat(model.body_quat[b], quat)
+
+
+def _bodies(
+    model: mujoco.MjModel, keep: list[int], root_id: int, frames: set[int], rep: Reporter
+) -> list[Body]:
+    """Body records, frames and inertias as compiled (``frames`` are left out)."""
+    bodies_ids = [b for b in keep if b not in frames]
+    index = {b: k for k, b in enumerate(bodies_ids)}
     bodies: list[Body] = []
-    for b in keep:
+    for b in bodies_ids:
+        if model.body_mass[b] <= 0 or model.body_inertia[b].min() <= 0:
+            rep.warn(
+                f"massless or zero-inertia body (mass {float(model.body_mass[b])}): HRDF "
+                "checks need mass > 0 and moments > 0; massless_frames='site' turns a "
+                "massless leaf frame into a site",
+                f'<body name="{body_name(model, b)}">',
+            )
         if model.body_mocapid[b] >= 0:
             rep.warn("mocap flag dropped", f'<body name="{body_name(model, b)}">')
         if model.body_gravcomp[b] != 0:
@@ -459,6 +532,7 @@ def _geoms(
     kept: set[int],
     path: Path,
     store: MeshStore,
+    frames: set[int],
     rep: Reporter,
 ) -> tuple[list[MeshGeom], list[SimpleGeom]]:
     """Mesh geoms (files staged, authored poses restored) and primitive geoms."""
@@ -547,19 +621,23 @@ def _geoms(
             conj = np.array([mq[0], -mq[1], -mq[2], -mq[3]])
             quat = inr.mul_quat(model.geom_quat[g], conj)
             pos = model.geom_pos[g] - inr.quat_to_mat(quat) @ model.mesh_pos[mid]
+            owner, pos, quat = _reparent(model, b, pos, quat, frames)
+            common["body"] = body_name(model, owner)
             meshes.append(
                 MeshGeom(
-                    name=mname, file=rel, scale=_t3(m_spec.scale), pos=_t3(pos), quat=quat, **common
+                    name=mname, file=rel, scale=_t3(m_spec.scale), pos=pos, quat=quat, **common
                 )
             )
         else:
+            owner, pos, quat = _reparent(model, b, model.geom_pos[g], model.geom_quat[g], frames)
+            common["body"] = body_name(model, owner)
             simple.append(
                 SimpleGeom(
                     name="",
                     type=_GEOM[gt],
                     size=_t3(model.geom_size[g]),
-                    pos=_t3(model.geom_pos[g]),
-                    quat=_t4(model.geom_quat[g]),
+                    pos=pos,
+                    quat=quat,
                     **common,
                 )
             )
@@ -585,8 +663,8 @@ def _geoms(
     return meshes, simple
 
 
-def _sites(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[Site]:
-    """Sites of the robot's bodies."""
+def _sites(model: mujoco.MjModel, kept: set[int], frames: set[int], rep: Reporter) -> list[Site]:
+    """Sites of the robot's bodies, and one per frame body turned into a site."""
     sites: list[Site] = []
     for s in range(model.nsite):
         b = int(model.site_bodyid[s])
@@ -596,12 +674,13 @@ def _sites(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[Site]:
             continue
         if not model.site(s).name:
             rep.warn(f"unnamed site named '{sname}'", f"site #{s}")
+        owner, pos, quat = _reparent(model, b, model.site_pos[s], model.site_quat[s], frames)
         sites.append(
             Site(
                 name=sname,
-                body=body_name(model, b),
-                pos=_t3(model.site_pos[s]),
-                quat=_t4(model.site_quat[s]),
+                body=body_name(model, owner),
+                pos=pos,
+                quat=quat,
                 type=_SITE.get(int(model.site_type[s]), "sphere"),
                 size=_t3(model.site_size[s]),
                 rgba=_t4(np.clip(model.site_rgba[s], 0.0, 1.0)),
@@ -609,6 +688,19 @@ def _sites(model: mujoco.MjModel, kept: set[int], rep: Reporter) -> list[Site]:
             )
         )
 
+    for b in sorted(frames):
+        rep.warn(
+            "massless frame body turned into a site on its parent (massless_frames='site')",
+            f'<body name="{body_name(model, b)}">',
+        )
+        sites.append(
+            Site(
+                name=body_name(model, b),
+                body=body_name(model, int(model.body_parentid[b])),
+                pos=_t3(model.body_pos[b]),
+                quat=_t4(model.body_quat[b]),
+            )
+        )
     return sites
 
 
@@ -716,16 +808,17 @@ def parse_mjcf(
 
     root_id, keep = _select_robot(model, path, opt, rep)
     kept = set(keep)
-    bodies = _bodies(model, keep, root_id, rep)
+    frames = _frames_as_sites(model, keep, root_id, opt)
+    bodies = _bodies(model, keep, root_id, frames, rep)
     joints = _joints(model, kept, root_id, path, rep)
     store = MeshStore(opt.work_dir) if opt.work_dir else MeshStore()
-    meshes, simple = _geoms(model, spec, kept, path, store, rep)
-    sites = _sites(model, kept, rep)
+    meshes, simple = _geoms(model, spec, kept, path, store, frames, rep)
+    sites = _sites(model, kept, frames, rep)
     names = {
         "joint": {j.name for j in joints if j.name},
         "tendon": {model.tendon(t).name for t in range(model.ntendon) if model.tendon(t).name},
         "site": {x.name for x in sites},
-        "body": {body_name(model, b) for b in keep} | {"world"},
+        "body": {body_name(model, b) for b in keep if b not in frames} | {"world"},
         "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
     }
     extra_parts: list[ET.Element] = []
@@ -744,8 +837,8 @@ def parse_mjcf(
             f"<option> fields {option_fields} dropped (HRDF keeps timestep, gravity, integrator)"
         )
     kept_names = {
-        "body": {body_name(model, b) for b in keep},
-        "xbody": {body_name(model, b) for b in keep},
+        "body": {body_name(model, b) for b in keep if b not in frames},
+        "xbody": {body_name(model, b) for b in keep if b not in frames},
         "site": {x.name for x in sites},
         "joint": {x.name for x in joints},
         "actuator": {x.name for x in actuators} | {e.get("name") for e in carried_actuators},
