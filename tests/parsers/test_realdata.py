@@ -186,3 +186,32 @@ def test_jvrc_dae_meshes_roundtrip() -> None:
     report = roundtrip(path, configs=20, fixed_joints="merge")
     assert report.ok, report.table()
     assert any("converted to STL" in w for w in report.warnings)
+
+
+def test_g1_full_circle_mjcf_urdf_mjcf(tmp_path: Path) -> None:
+    """G1 MJCF -> HRDF -> our URDF -> parsed again -> our MJCF: the same robot as the
+    source (body masses, inertias, FK; the URDF carries sites as links, merged back)."""
+    import mujoco
+
+    from robotwright.parsers.convert import convert
+    from robotwright.parsers.reference import view_from_model
+    from robotwright.parsers.roundtrip import compare_views
+
+    path = TESTDATA / "unitree_g1/xmls/g1.xml"
+    if not path.is_file():
+        pytest.skip(f"mjlab data not fetched (python tools/fetch_test_data.py): {path}")
+    convert(path, tmp_path / "g1.urdf")
+    convert(tmp_path / "g1.urdf", tmp_path / "g1_again.xml", fixed_joints="merge")
+    source = view_from_model(mujoco.MjModel.from_xml_path(str(path)))
+    again = view_from_model(mujoco.MjModel.from_xml_path(str(tmp_path / "g1_again.xml")))
+    rows = {r.check: r for r in compare_views(source, again, configs=20, full=True)}
+    for key in (
+        "bodies (ref/ours)",
+        "body masses max rel.err",
+        "inertia tensors max rel.err",
+        "joint axes max err",
+        "joint ranges max err",
+    ):
+        assert rows[key].ok, rows[key]
+    fk = next(r for k, r in rows.items() if k.startswith("FK"))
+    assert fk.ok, fk
