@@ -8,6 +8,7 @@ on its own.
 from __future__ import annotations
 
 import os
+import tempfile
 import warnings
 from pathlib import Path
 from typing import Any
@@ -58,6 +59,21 @@ def convert(
     out_kind = file_kind(dst_p, existing=False)
     if dst_p.exists() and not overwrite:
         raise FileExistsError(f"{dst_p} exists (pass overwrite=True / --overwrite)")
+    if "work_dir" in options or file_kind(src_p, existing=True) == "hrdf":
+        return _convert(src_p, dst_p, out_kind, strict, overwrite, options)
+    # The output gets its own copies of the meshes: staging lives only for the call.
+    with tempfile.TemporaryDirectory(prefix="robotwright-convert-") as tmp:
+        return _convert(src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp})
+
+
+def _convert(
+    src_p: Path,
+    dst_p: Path,
+    out_kind: str,
+    strict: bool,
+    overwrite: bool,
+    options: dict[str, Any],
+) -> list[str]:
     hrdf, problems = load_any(src_p, strict=strict, **options)
     messages = [str(p) for p in problems]
     with warnings.catch_warnings(record=True) as caught:
