@@ -250,6 +250,111 @@ def test_yaml_fast_build_matches_on_robot_meta_and_mutations() -> None:
                 assert expected == got, text
 
 
+def _random_data(rng: random.Random, depth: int = 0):
+    """Nested data; mostly what the block parser's subset holds once dumped, sometimes not
+    (bool words as strings get quoted, empty collections are written in flow style)."""
+    words = ["a", "b_c", "y", "n", "_x", "x1", "robotwright-hrdf/1", "a.b", "x-y"]
+    odd = ["on", "NO", "null", "", "1", "0.5", "a b", "-", [], {}]
+    scalars = [
+        lambda: rng.choice(words),
+        lambda: rng.randint(-50, 50),
+        lambda: rng.choice([0.0, -0.0, 1.0, -1.5, 1e-5, 2.5e20, 0.20000000298023224]),
+        lambda: rng.uniform(-10, 10),
+        lambda: None,
+        lambda: rng.choice([True, False]),
+    ]
+    if rng.random() < 0.03:
+        return rng.choice(odd)
+    if depth > 0 and (depth >= 3 or rng.random() < 0.4):
+        return rng.choice(scalars)()
+    if rng.random() < 0.5:
+        return [_random_data(rng, depth + 1) for _ in range(rng.randint(1, 4))]
+    return {rng.choice(words[:6]): _random_data(rng, depth + 1) for _ in range(rng.randint(1, 4))}
+
+
+def _check_block_parser(text: str) -> bool:
+    """If the block parser accepts ``text``, PyYAML reads the same value; True if accepted."""
+    try:
+        value = hio._parse_block_yaml(text)
+    except hio._NotBlockYAML:
+        return False
+    expected = _pyyaml(text)
+    assert expected[0] == "ok", text
+    assert _same_value(expected[1], value), text
+    return True
+
+
+def test_block_yaml_parser_matches_pyyaml_on_dumped_and_mutated_documents() -> None:
+    rng = random.Random(5)
+    accepted = 0
+    alphabet = ":- \n_.0123456789abeyonNT/"
+    for _ in range(1500):
+        text = yaml.safe_dump(_random_data(rng), default_flow_style=False)
+        accepted += _check_block_parser(text)
+        for _ in range(3):
+            chars = list(text)
+            for _ in range(rng.randint(1, 2)):
+                at = rng.randrange(len(chars) + 1)
+                op = rng.random()
+                if op < 0.4 and at < len(chars):
+                    del chars[at]
+                elif op < 0.8:
+                    chars.insert(at, rng.choice(alphabet))
+                elif at < len(chars):
+                    chars[at] = rng.choice(alphabet)
+            _check_block_parser("".join(chars))
+    assert accepted > 500  # the subset covers what safe_dump writes for such data
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "on: yes\nOff: NO\nnull: Null\ny: n\nTRUE: false\nnull: 2\n",
+        "a:\n- 1\n- -2\n- 0\n- -0\n- 1.50\n- -0.0\n- 1.0e-05\n- 1.0E+20\n",
+        "a:\n  - x\n  - y\nb:\n- c: 1\n  d:\n  - 2\n  e: f\n- g\n",
+        "a:\nb:\n  c:\nd: 1\n",
+    ],
+)
+def test_block_yaml_parser_reads_its_subset_like_pyyaml(text: str) -> None:
+    assert _check_block_parser(text)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "a: 1\n  b: 2\n",  # continuation line
+        "a: b\n  c\n",  # multi-line plain scalar
+        "- a\n  - b\n",
+        "a:\n    b: 1\n  c: 2\n",
+        "  a: 1\n",  # indented document
+        "a: 1\n\nb: 2\n",  # blank line
+        "a: 1 \n",  # trailing space
+        "a:  1\n",
+        "a:1\n",
+        "- - 1\n",
+        "-\n  a: 1\n",
+        "a: 1e5\n",  # a string for PyYAML's YAML 1.1 resolver
+        "a: 0x10\n",
+        "a: 007\n",
+        "a: 1_000\n",
+        "a: +1\n",
+        "a: .5\n",
+        "a: 12:30\n",
+        "...\n",
+        "a: b: c\n",
+        "1: a\n",
+    ],
+)
+def test_block_yaml_parser_leaves_everything_else_to_pyyaml(text: str) -> None:
+    assert not _check_block_parser(text)
+    assert _same_value(_pyyaml(text), _ours(text))
+
+
+def test_block_yaml_parser_reads_every_robot_meta() -> None:
+    for folder in _robot_dirs():
+        assert _check_block_parser((folder / "meta.yaml").read_text()), folder
+
+
 # ---------------------------------------------------------------------- validation
 
 
