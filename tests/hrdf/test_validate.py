@@ -295,3 +295,24 @@ def test_cli_validate_ok(arm: Path) -> None:
         [sys.executable, "-m", "robotwright", "validate", str(arm)], capture_output=True, text=True
     )
     assert run.returncode == 0 and "valid" in run.stdout
+
+
+def test_massless_body_without_joints_is_allowed(arm: Path) -> None:
+    # A frame link (e.g. a URDF tool or sensor frame) welded to its parent: no joints.
+    def add_body(rows: list[list[str]]) -> None:
+        row = rows[-1][:]
+        h = rows[0]
+        for col in ("diag_inertia0", "diag_inertia1", "diag_inertia2", "mass"):
+            row[h.index(col)] = "0.0"
+        row[h.index("name")] = "tool_frame"
+        row[h.index("id")] = str(len(rows) - 1)
+        rows.append(row)
+
+    edit_csv(arm / "body.csv", add_body)
+    edit_meta(arm, lambda m: m.update(body_parent_id=[*m["body_parent_id"], 6]))
+    assert HRDF.from_dir(arm).body("tool_frame").mass == 0.0
+
+
+def test_massless_body_needs_zero_inertia_and_no_joint(arm: Path) -> None:
+    set_cell(arm / "body.csv", 6, "mass", "0.0")  # wrist_3_link moves: needs mass
+    assert has(errors_of(arm), "body.csv", "mass 0.0 kg: expected > 0", row=6, column="mass")

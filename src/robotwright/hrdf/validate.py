@@ -126,6 +126,7 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
         out.append(Problem("body.csv", f"duplicate body name '{name}'", column="name"))
     hypot = math.hypot
     k = 1.0 - INERTIA_TRIANGLE_RTOL
+    moving = {j.body for j in hrdf.joints}
     for i, b in enumerate(hrdf.bodies):
         # Quick pass: exactly the negation of every check below, so the per-row messages
         # are built only for rows that have a problem (most loads have none).
@@ -147,13 +148,22 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
             continue
         if not b.name:
             out.append(Problem("body.csv", "empty body name", row=i, column="name"))
-        if not b.mass > 0:
-            out.append(Problem("body.csv", f"mass {b.mass} kg: expected > 0", row=i, column="mass"))
+        # A body without joints is welded to its parent: MuJoCo accepts it massless (URDF
+        # frame links, sensor mounts), provided its inertia is zero too.
+        welded = b.name not in moving
+        massless_frame = welded and b.mass == 0.0 and all(v == 0.0 for v in b.diag_inertia)
+        if not b.mass > 0 and not massless_frame:
+            hint = " (or 0, with zero inertia, for a body without joints)" if welded else ""
+            out.append(
+                Problem("body.csv", f"mass {b.mass} kg: expected > 0{hint}", row=i, column="mass")
+            )
         for col, q in (("quat", b.quat), ("inertial_quat", b.inertial_quat)):
             msg = _quat_problem(q)
             if msg:
                 out.append(Problem("body.csv", msg, row=i, column=col))
         d = b.diag_inertia
+        if massless_frame:
+            continue
         if any(not v > 0 for v in d):
             out.append(
                 Problem(
