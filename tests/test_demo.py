@@ -19,9 +19,9 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
         text=True,
     )
     assert run.returncode == 0, run.stderr
-    assert "[5/5] semantic LiDAR scan" in run.stdout
+    assert "[6/6] semantic LiDAR scan" in run.stdout
     summary = json.loads((out / "summary.json").read_text())
-    assert len(summary) == 5
+    assert len(summary) == 6
 
     for name, nu in (("mini_humanoid", 20), ("arm6", 6)):
         model = mujoco.MjModel.from_xml_path(str(out / "robots" / f"{name}.xml"))
@@ -48,3 +48,5 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
     hit = np.isfinite(dist)
     assert (scan["mesh_ids"][hit] >= 0).all() and (labels[~hit] == 0).all()
     assert (out / "lidar" / "scan.png").stat().st_size > 20_000
+    rt = (out / "robots" / "roundtrip_mini_humanoid_urdf.txt").read_text()
+    assert rt.rstrip().endswith("result:    PASS") and "FAIL" not in rt

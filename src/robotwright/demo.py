@@ -67,6 +67,22 @@ def step_export(out: Path, ctx: dict[str, Any]) -> str:
     return "; ".join(written)
 
 
+def step_roundtrip(out: Path, ctx: dict[str, Any]) -> str:
+    from robotwright.parsers.roundtrip import roundtrip
+
+    lines = []
+    for source in ("mini_humanoid.urdf", "arm6.xml"):
+        report = roundtrip(out / "robots" / source, configs=20)
+        (out / "robots" / f"roundtrip_{source.replace('.', '_')}.txt").write_text(
+            report.table() + "\n", encoding="utf-8"
+        )
+        if not report.ok:
+            failed = "; ".join(f"{r.check}: {r.value}" for r in report.failures())
+            raise RuntimeError(f"round trip of {source} failed: {report.error or failed}")
+        lines.append(f"{source} -> HRDF -> MJCF/URDF: {len(report.rows)} checks pass")
+    return "; ".join(lines)
+
+
 def step_limb(out: Path, ctx: dict[str, Any]) -> str:
     from robotwright.grammar import default_grammar, demo_limb_design
     from robotwright.grammar.build import build_hrdf
@@ -185,6 +201,7 @@ def furnish(world: World) -> World:
 STEPS: list[tuple[str, Callable[[Path, dict[str, Any]], str]]] = [
     ("bundled robots (HRDF)", step_hrdf),
     ("export to MJCF and URDF (generators)", step_export),
+    ("parse the exports back and compare in MuJoCo (parsers)", step_roundtrip),
     ("grow a limb with the grammar and mount it", step_limb),
     ("compose a scene and furnish it (composite + Things)", step_scene),
     ("semantic LiDAR scan (sensors)", step_lidar),

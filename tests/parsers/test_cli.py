@@ -52,7 +52,7 @@ def test_roundtrip_command_prints_table(arm_mjcf: Path, probe: Path, capsys) -> 
     assert "result:    FAIL" in capsys.readouterr().out
 
 
-def test_convert_massless_links_hint_then_merge(tmp_path: Path, capsys) -> None:
+def test_convert_keeps_massless_frame_link_or_merges_it(tmp_path: Path, capsys) -> None:
     urdf = tmp_path / "r" / "urdf" / "tool.urdf"
     urdf.parent.mkdir(parents=True)
     urdf.write_text(
@@ -66,8 +66,11 @@ def test_convert_massless_links_hint_then_merge(tmp_path: Path, capsys) -> None:
         '<origin xyz="0 0 .3"/></joint></robot>'
     )
     out = tmp_path / "tool.xml"
-    assert main(["convert", str(urdf), "-o", str(out)]) == 2
-    assert "--fixed-joints merge" in capsys.readouterr().err and not out.exists()
+    # Default policy keeps the fixed child as a welded, massless frame body.
+    assert main(["convert", str(urdf), "-o", str(out)]) == 0
+    kept = mujoco.MjModel.from_xml_path(str(out))
+    assert kept.body("tcp").mass[0] == 0.0 and kept.nbody == 4
+    out = tmp_path / "tool_merged.xml"
     assert main(["convert", str(urdf), "-o", str(out), "--fixed-joints", "merge"]) == 0
     model = mujoco.MjModel.from_xml_path(str(out))
     assert model.site("tcp").id >= 0 and model.nbody == 3

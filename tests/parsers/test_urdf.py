@@ -194,7 +194,8 @@ def test_strict_lists_every_warning(arm: Path) -> None:
     with pytest.raises(ConversionError) as err:
         urdf_to_hrdf(arm, strict=True)
     text = str(err.value)
-    assert "<gazebo>" in text and "effort/velocity" in text and "massless" in text
+    assert "3 element(s)" in text
+    assert "<gazebo>" in text and "effort/velocity" in text and "ASCII STL" in text
 
 
 def test_warnings_are_logged(arm: Path, caplog) -> None:

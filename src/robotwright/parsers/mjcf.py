@@ -431,11 +431,14 @@ def _bodies(
     index = {b: k for k, b in enumerate(bodies_ids)}
     bodies: list[Body] = []
     for b in bodies_ids:
-        if model.body_mass[b] <= 0 or model.body_inertia[b].min() <= 0:
+        # A body with no mass and no inertia at all is a frame: fine while welded (the
+        # HRDF checks refuse it on a moving joint). Anything partly massless is reported.
+        frame = model.body_mass[b] == 0 and model.body_inertia[b].max() == 0
+        if (model.body_mass[b] <= 0 or model.body_inertia[b].min() <= 0) and not frame:
             rep.warn(
-                f"massless or zero-inertia body (mass {float(model.body_mass[b])}): HRDF "
-                "checks need mass > 0 and moments > 0; massless_frames='site' turns a "
-                "massless leaf frame into a site",
+                f"zero-inertia or massless body (mass {float(model.body_mass[b])}): HRDF "
+                "checks need mass > 0 and moments > 0 (or both zero on a welded frame); "
+                "massless_frames='site' turns a massless leaf frame into a site",
                 f'<body name="{body_name(model, b)}">',
             )
         if model.body_mocapid[b] >= 0:

@@ -553,11 +553,15 @@ def _body_record(
         new = tuple(max(v, opt.bound_inertia) for v in diag)
         rep.warn(f"principal moments {diag} raised to bound_inertia: {new}", where)
         diag = new
-    if mass <= 0 or min(diag) <= 0:
+    # A link with no mass and no inertia at all is a frame: fine while welded (the HRDF
+    # checks refuse it on a moving joint). Anything partly massless is reported.
+    frame = mass == 0 and max(diag) == 0
+    if (mass <= 0 or min(diag) <= 0) and not frame:
         rep.warn(
-            f"massless or zero-inertia body (mass {mass}, moments {diag}): HRDF checks "
-            "need mass > 0 and moments > 0; fixed_joints='merge' folds fixed links into "
-            "their parent, bound_mass/bound_inertia raise them",
+            f"zero-inertia or massless body (mass {mass}, moments {diag}): HRDF checks "
+            "need mass > 0 and moments > 0 (or both zero on a welded frame); "
+            "fixed_joints='merge' folds fixed links into their parent, "
+            "bound_mass/bound_inertia raise them",
             where,
         )
     pose = b["pose"]
