@@ -49,4 +49,4 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
     assert (scan["mesh_ids"][hit] >= 0).all() and (labels[~hit] == 0).all()
     assert (out / "lidar" / "scan.png").stat().st_size > 20_000
     rt = (out / "robots" / "roundtrip_mini_humanoid_urdf.txt").read_text()
-    assert rt.rstrip().endswith("result:    PASS") and "FAIL" not in rt
+    assert "result:    PASS" in rt and "FAIL" not in rt
