@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import mujoco
@@ -96,7 +97,14 @@ def test_g1_matches_hurodes_export(g1_hrdf_dir):
         np.testing.assert_allclose(da.xquat[idx_o], db.xquat[idx_r], atol=1e-9)
 
 
-def _urdf_vs_mjcf(hrdf: HRDF, tmp_path, n: int = 20) -> None:
+def _urdf_vs_mjcf(
+    hrdf: HRDF, tmp_path, n: int = 20, site_links: dict[str, str] | None = None
+) -> None:
+    """Our URDF (MuJoCo tag) loaded by MuJoCo vs our MJCF: masses, inertias, and the
+    pose of every body and site at ``n`` random configurations (joints set by name, so
+    hinge/slide ``ref`` offsets must be applied by the URDF). ``site_links``: site name ->
+    link name where the URDF renamed the site's link."""
+    site_links = site_links or {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConversionWarning)
         mj = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
@@ -105,19 +113,11 @@ def _urdf_vs_mjcf(hrdf: HRDF, tmp_path, n: int = 20) -> None:
     ur = mujoco.MjModel.from_xml_path(str(path))
     assert ur.body_mass.sum() == pytest.approx(mj.body_mass.sum(), abs=1e-6)
     assert ur.nq == mj.nq
-    # Inertia tensors about the centre of mass, in the world frame at qpos0.
+    # Inertia tensors about the centre of mass, in the world frame at MJCF's qpos0 (the
+    # same joint values in the URDF, whose own zero differs where a joint has a ref).
     da, db = mujoco.MjData(mj), mujoco.MjData(ur)
-    mujoco.mj_kinematics(mj, da)
-    mujoco.mj_kinematics(ur, db)
-    for b in hrdf.bodies:
-        i, j = mj.body(b.name).id, ur.body(b.name).id
-        ta = da.ximat[i].reshape(3, 3) @ np.diag(mj.body_inertia[i]) @ da.ximat[i].reshape(3, 3).T
-        tb = db.ximat[j].reshape(3, 3) @ np.diag(ur.body_inertia[j]) @ db.ximat[j].reshape(3, 3).T
-        np.testing.assert_allclose(ta, tb, atol=1e-9, err_msg=b.name)
-        np.testing.assert_allclose(da.xipos[i], db.xipos[j], atol=1e-9)
-    rng = np.random.default_rng(1)
-    for _ in range(n):
-        q = _random_qpos(mj, rng)
+
+    def set_q(q: np.ndarray) -> None:
         da.qpos[:] = q
         for jid in range(mj.njnt):
             name = mj.joint(jid).name
@@ -127,15 +127,29 @@ def _urdf_vs_mjcf(hrdf: HRDF, tmp_path, n: int = 20) -> None:
             db.qpos[b : b + size] = q[a : a + size]
         mujoco.mj_kinematics(mj, da)
         mujoco.mj_kinematics(ur, db)
+
+    set_q(mj.qpos0)
+    for b in hrdf.bodies:
+        i, j = mj.body(b.name).id, ur.body(b.name).id
+        ta = da.ximat[i].reshape(3, 3) @ np.diag(mj.body_inertia[i]) @ da.ximat[i].reshape(3, 3).T
+        tb = db.ximat[j].reshape(3, 3) @ np.diag(ur.body_inertia[j]) @ db.ximat[j].reshape(3, 3).T
+        np.testing.assert_allclose(ta, tb, atol=1e-9, err_msg=b.name)
+        np.testing.assert_allclose(da.xipos[i], db.xipos[j], atol=1e-9)
+    rng = np.random.default_rng(1)
+    for _ in range(n):
+        set_q(_random_qpos(mj, rng))
         for body in hrdf.bodies:
             i, j = mj.body(body.name).id, ur.body(body.name).id
-            # The URDF link frame sits at the last joint anchor; compare body frames via
-            # the centre of mass (frame-independent) and the orientation.
+            # Each body's link frame is its MJCF body frame (also with joint anchors off
+            # the body origin, and with joint refs).
+            np.testing.assert_allclose(da.xpos[i], db.xpos[j], atol=1e-6, err_msg=body.name)
             np.testing.assert_allclose(da.xipos[i], db.xipos[j], atol=1e-6)
-            assert _same_quat(da.xquat[i], db.xquat[j]) < 1e-6
+            assert _same_quat(da.xquat[i], db.xquat[j]) < 1e-6, body.name
         for s in range(mj.nsite):
+            link = site_links.get(mj.site(s).name, mj.site(s).name)
+            np.testing.assert_allclose(da.site_xpos[s], db.xpos[ur.body(link).id], atol=1e-6)
             np.testing.assert_allclose(
-                da.site_xpos[s], db.xpos[ur.body(mj.site(s).name).id], atol=1e-6
+                da.site_xmat[s], db.xmat[ur.body(link).id], atol=1e-6, err_msg=link
             )
 
 
@@ -171,3 +185,33 @@ def test_root_with_hinge_joints_urdf_matches_mjcf(synth_fixed, tmp_path):
     ]
     h = dataclasses.replace(synth_fixed, joints=root_joints + synth_fixed.joints)
     _urdf_vs_mjcf(h, tmp_path, n=30)
+
+
+def _with_refs(hrdf: HRDF) -> HRDF:
+    refs = {"j1a": 0.4, "j1b": -0.9, "j2": 0.05, "j3": -0.7}
+    joints = [dataclasses.replace(j, ref=refs.get(j.name or "", 0.0)) for j in hrdf.joints]
+    return dataclasses.replace(hrdf, joints=joints)
+
+
+def test_joint_ref_baked_into_urdf_origin_matches_mjcf(synth_urdf_safe, tmp_path):
+    """MJCF places a body at its pos/quat when q = ref; the URDF origin carries the motion
+    by -ref, so both give the same FK at every q (hinges, a slide, several joints on one
+    body, anchors off the body origin)."""
+    hrdf = _with_refs(synth_urdf_safe)
+    mj = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
+    assert mj.qpos0[mj.joint("j1a").qposadr[0]] == pytest.approx(0.4)  # refs reach MuJoCo
+    _urdf_vs_mjcf(hrdf, tmp_path, n=50)
+    with pytest.warns(ConversionWarning, match=r"joint 'j2': ref 0.05 baked into the joint"):
+        URDFHumanoidGenerator.from_hrdf(hrdf).generate()
+
+
+def test_joint_ref_fixed_base(synth_fixed, tmp_path):
+    _urdf_vs_mjcf(_with_refs(synth_fixed), tmp_path)
+
+
+def test_site_named_like_a_body_becomes_suffixed_link(synth_urdf_safe, tmp_path):
+    site = dataclasses.replace(synth_urdf_safe.sites[0], name="link1")
+    hrdf = dataclasses.replace(synth_urdf_safe, sites=[site], sensors=[])
+    with pytest.warns(ConversionWarning, match=r"'link1' -> 'link1_site'"):
+        URDFHumanoidGenerator.from_hrdf(hrdf).generate()
+    _urdf_vs_mjcf(hrdf, tmp_path, site_links={"link1": "link1_site"})

@@ -11,7 +11,7 @@ import pytest
 
 from robotwright.errors import ConversionError, ConversionWarning
 from robotwright.generators import URDFHumanoidGenerator
-from robotwright.generators.urdf import DUMMY_LINK_MASS
+from robotwright.generators.urdf import DUMMY_LINK_INERTIA, DUMMY_LINK_MASS
 from robotwright.hrdf.model import HRDF
 
 yourdfpy = pytest.importorskip("yourdfpy")
@@ -80,14 +80,27 @@ def test_joint_types_limits_dynamics(synth_urdf_safe):
     assert joints["j1b"].find("parent").get("link") == "link1_dummy1"
 
 
-def test_dummy_links_massless_unless_for_mujoco(synth_urdf_safe):
-    plain = ET.fromstring(_export(synth_urdf_safe))
-    dummy = next(link for link in plain.findall("link") if link.get("name") == "link1_dummy1")
-    assert dummy.find("inertial") is None
-    tagged = ET.fromstring(_export(synth_urdf_safe, add_mujoco_tag=True))
-    dummy = next(link for link in tagged.findall("link") if link.get("name") == "link1_dummy1")
-    assert float(dummy.find("inertial/mass").get("value")) == DUMMY_LINK_MASS
-    assert tagged.find("mujoco/compiler").get("strippath") == "false"
+def test_dummy_links_carry_tiny_mass_and_are_reported(synth_urdf_safe):
+    """MuJoCo refuses and SDFormat drops massless moving links: dummy links always get
+    1e-9 kg (with or without the MuJoCo tag), and the warning names them."""
+    with pytest.warns(ConversionWarning, match=r"body 'link1' .*'link1_dummy1'.* 1e-09 kg"):
+        text = URDFHumanoidGenerator.from_hrdf(synth_urdf_safe).export()
+    for root in (ET.fromstring(text), ET.fromstring(_export(synth_urdf_safe, add_mujoco_tag=True))):
+        dummy = next(link for link in root.findall("link") if link.get("name") == "link1_dummy1")
+        assert float(dummy.find("inertial/mass").get("value")) == DUMMY_LINK_MASS
+        assert float(dummy.find("inertial/inertia").get("ixx")) == DUMMY_LINK_INERTIA
+    assert root.find("mujoco/compiler").get("strippath") == "false"
+
+
+def test_anchor_off_body_origin_ends_in_dummy_and_fixed_joint(synth_urdf_safe):
+    # link3's hinge is anchored at (0, 0, 0.01): link3's link keeps the body frame.
+    root = ET.fromstring(_export(synth_urdf_safe))
+    joints = {j.get("name"): j for j in root.findall("joint")}
+    assert joints["j3"].find("child").get("link") == "link3_dummy1"
+    anchor = joints["link3_anchor_joint"]
+    assert anchor.get("type") == "fixed"
+    assert anchor.find("child").get("link") == "link3"
+    assert [float(v) for v in anchor.find("origin").get("xyz").split()] == [0, 0, -0.01]
 
 
 def test_full_inertia_tensor(synth_urdf_safe):
@@ -135,15 +148,23 @@ def test_ball_joint_ellipsoid_restitution_reported(synth):
         assert what in text
 
 
-def test_site_name_equal_to_body_name_is_an_error(synth_urdf_safe):
+def test_site_name_equal_to_body_name_gets_site_suffix(synth_urdf_safe):
     import dataclasses
 
-    from robotwright.errors import GeneratorError
-
     site = dataclasses.replace(synth_urdf_safe.sites[0], name="link1")
-    bad = dataclasses.replace(synth_urdf_safe, sites=[site], sensors=[])
-    with pytest.raises(GeneratorError, match=r"site/IMU name\(s\) \['link1'\] equal a body name"):
-        URDFHumanoidGenerator.from_hrdf(bad).export()
+    body_link = dataclasses.replace(site, name="link2_site", body="link2")
+    bad = dataclasses.replace(synth_urdf_safe, sites=[site, body_link], sensors=[])
+    with pytest.warns(ConversionWarning, match=r"renamed.*'link1' -> 'link1_site'"):
+        root = ET.fromstring(URDFHumanoidGenerator.from_hrdf(bad).export())
+    names = [link.get("name") for link in root.findall("link")]
+    assert len(names) == len(set(names))
+    joints = {j.get("name"): j for j in root.findall("joint")}
+    assert joints["link1_site_joint"].find("parent").get("link") == "tool"  # the site's body
+    assert joints["link1_site_joint"].find("child").get("link") == "link1_site"
+    assert joints["link2_site_joint"].find("child").get("link") == "link2_site"
+    # Deterministic: the same names every time.
+    again = ET.fromstring(_export(bad))
+    assert [link.get("name") for link in again.findall("link")] == names
 
 
 def test_urdf_prefix_names_links_joints_materials(synth_urdf_safe):

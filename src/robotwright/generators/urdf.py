@@ -13,15 +13,20 @@ Mapping:
   (a change of meaning: reported). ``<limit>`` carries the range and, from the joint's
   actuator, ``effort`` (peak torque or force range) and ``velocity`` (peak velocity);
   ``<dynamics damping friction>`` from viscous/dynamic friction.
-- A body with several joints becomes a chain of links ``<body>_dummy<k>`` (no mass, or
-  1e-9 kg with ``add_mujoco_tag`` because MuJoCo rejects massless moving bodies), one per
+- A body with several joints becomes a chain of links ``<body>_dummy<k>``, one per
   joint; joint anchors (``Joint.pos``) become the joint origins, so the kinematics are
-  those of the MJCF model.
-- Sites and IMUs -> massless links on fixed joints (tool and sensor frames).
+  those of the MJCF model. Each dummy link gets 1e-9 kg and 1e-12 kg m^2 (MuJoCo refuses
+  massless moving links and SDFormat/Gazebo drops them); reported.
+- A hinge/slide ``ref`` (MJCF: the body is at its ``pos``/``quat`` when q = ref) is baked
+  into the joint origin as a motion of -ref about/along the axis, so the URDF joint
+  coordinate, its limits and the FK at any q equal MJCF's; URDF has no initial position,
+  so its default pose is q = 0, not q = ref (reported).
+- Sites and IMUs -> massless links on fixed joints (tool and sensor frames); a site named
+  like a body (or the world link) becomes ``<site>_site`` (reported).
 - Capsules have no URDF form: each is written as a cylinder plus two end spheres (the
   same shape) and reported; ellipsoids are dropped and reported.
 
-Everything URDF cannot hold (armature, stiffness, springref/ref, actuator types and gains,
+Everything URDF cannot hold (armature, stiffness, springref, actuator types and gains,
 geom friction/contact bits/condim/groups, collision colours, restitution, sensors,
 ``mjcf_extra``) is listed in one :class:`ConversionWarning` (``strict=True``: raised as
 :class:`ConversionError`).
@@ -29,6 +34,7 @@ geom friction/contact bits/condim/groups, collision colours, restitution, sensor
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 
@@ -45,8 +51,9 @@ from robotwright.generators.urdf_base import (
 from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
 from robotwright.hrdf.model import HRDF, Actuator, Body, Geom, Joint, MeshGeom, SimpleGeom
 
-#: Mass (kg) and inertia (kg m^2) of the links that split a multi-joint body, when the
-#: URDF is meant for MuJoCo (which rejects massless moving bodies).
+#: Mass (kg) and inertia (kg m^2) of the links that split a multi-joint body: MuJoCo
+#: rejects massless moving bodies and SDFormat (Gazebo) drops massless links with their
+#: joints, so the chain would break there. 1e-9 kg changes no FK and no realistic total mass.
 DUMMY_LINK_MASS = 1e-9
 DUMMY_LINK_INERTIA = 1e-12
 _IDENTITY = (1.0, 0.0, 0.0, 0.0)
@@ -128,6 +135,11 @@ class _RobotWriter:
         self.for_mujoco, self.relative, self.losses = for_mujoco, relative, losses
         self.materials: dict[tuple[float, ...], str] = {}
         self.mesh_refs: dict[str, str] = {}
+        # Names already used per kind; generated names avoid them (see _fresh).
+        self.link_names: set[str] = set()
+        self.joint_names: set[str] = set()
+        #: site/IMU name -> the name of the link that carries it (before the prefix).
+        self.frame_links: dict[str, str] = {}
 
     def p(self, name: str) -> str:
         return prefixed(self.prefix, name)
@@ -144,7 +156,7 @@ class _RobotWriter:
         ``parent_link`` at its own pose composed with ``placement`` (pos, quat), welded
         there when ``fixed_root``."""
         hrdf = self.hrdf
-        self._check_names()
+        self._reserve_names()
         joints: dict[str, list[Joint]] = {}
         for j in hrdf.joints:
             joints.setdefault(j.body, []).append(j)
@@ -201,7 +213,10 @@ class _RobotWriter:
                 if free or not own:
                     name = free[0].name if free and free[0].name else None
                     if name is None:
-                        name = "floating_base" if free else f"{b.name}_world_joint"
+                        name = self._fresh(
+                            "floating_base" if free else f"{b.name}_world_joint",
+                            self.joint_names,
+                        )
                     if free:
                         self._joint_losses(free[0])
                     jtype = "floating" if free and not fixed_root else "fixed"
@@ -223,11 +238,13 @@ class _RobotWriter:
                 )
             links.append(self._link(b, offset[idx], geoms.get(b.name, [])))
             for name, fpos, fquat in frames.get(b.name, ()):
-                links.append(ET.Element("link", {"name": self.p(name)}))
-                el = ET.Element("joint", {"name": self.p(f"{name}_joint"), "type": "fixed"})
+                link_name = self.frame_links[name]
+                links.append(ET.Element("link", {"name": self.p(link_name)}))
+                jname = self._fresh(f"{link_name}_joint", self.joint_names)
+                el = ET.Element("joint", {"name": self.p(jname), "type": "fixed"})
                 _origin(el, _sub(fpos, offset[idx]), fquat)
                 ET.SubElement(el, "parent", {"link": self.p(b.name)})
-                ET.SubElement(el, "child", {"link": self.p(name)})
+                ET.SubElement(el, "child", {"link": self.p(link_name)})
                 jnts.append(el)
         for mat_rgba, mat_name in self.materials.items():
             m = ET.SubElement(root, "material", {"name": mat_name})
@@ -236,20 +253,50 @@ class _RobotWriter:
         root.extend(jnts)
 
     # -- names ----------------------------------------------------------------------------
-    def _check_names(self) -> None:
+    def _reserve_names(self) -> None:
+        """Reserve body and joint names, and name the link of every site/IMU frame.
+
+        URDF has one namespace for links, while MJCF keeps sites apart from bodies: a
+        site named like a body (or ``world``) gets the link ``<site>_site`` (``_site2``,
+        ... if that is taken too), reported."""
         hrdf = self.hrdf
         bodies = {b.name for b in hrdf.bodies}
-        frame_names = [s.name for s in hrdf.sites] + [n for n, new in imu_sites(hrdf) if new]
-        clash = sorted((bodies | {WORLD_LINK}) & set(frame_names))
-        if clash:
-            raise GeneratorError(
-                f"robot '{hrdf.name}': site/IMU name(s) {clash} equal a body name; URDF "
-                "writes sites as links, so their names must differ"
-            )
         if WORLD_LINK in bodies:
             raise GeneratorError(
                 f"robot '{hrdf.name}': a body is named '{WORLD_LINK}', which URDF reserves"
             )
+        self.link_names = bodies | {WORLD_LINK}
+        self.joint_names = {j.name for j in hrdf.joints if j.name}
+        self.frame_links = {}
+        frame_names = [s.name for s in hrdf.sites] + [n for n, new in imu_sites(hrdf) if new]
+        renamed = []
+        for name in frame_names:
+            if name in self.link_names:
+                link = self._fresh(f"{name}_site", self.link_names)
+                renamed.append(f"'{name}' -> '{link}'")
+            else:
+                link = name
+                self.link_names.add(name)
+            self.frame_links[name] = link
+        if renamed:
+            self.losses.append(
+                Problem(
+                    "site.csv",
+                    f"site/IMU frame link(s) renamed, their names being body link names "
+                    f"(URDF has one namespace for links): {', '.join(renamed)}",
+                    column="name",
+                )
+            )
+
+    @staticmethod
+    def _fresh(name: str, taken: set[str]) -> str:
+        """``name`` if unused, else ``name2``, ``name3``, ...; reserved in ``taken``."""
+        out, k = name, 1
+        while out in taken:
+            k += 1
+            out = f"{name}{k}"
+        taken.add(out)
+        return out
 
     # -- joints ---------------------------------------------------------------------------
     def _body_joints(
@@ -266,7 +313,8 @@ class _RobotWriter:
         return the offset of ``b``'s link frame from its body frame."""
         body_xyz = _sub(b.pos, parent_off)
         if not own:
-            el = ET.Element("joint", {"name": self.p(f"{b.name}_fixed_joint"), "type": "fixed"})
+            jname = self._fresh(f"{b.name}_fixed_joint", self.joint_names)
+            el = ET.Element("joint", {"name": self.p(jname), "type": "fixed"})
             _origin(el, body_xyz, b.quat)
             ET.SubElement(el, "parent", {"link": parent_link})
             ET.SubElement(el, "child", {"link": self.p(b.name)})
@@ -274,15 +322,30 @@ class _RobotWriter:
             return _ZERO
         chain = self._expand(own)
         prev_link, prev_anchor = parent_link, None
+        dummies: list[str] = []
+        # A URDF joint turns its child link about the link's origin: when the last anchor
+        # is off the body origin, the chain ends in a dummy link at the anchor and the
+        # body's link hangs from it (fixed) at the body frame, so every body link keeps
+        # its MJCF body frame.
+        anchored = any(float(v) != 0.0 for v in own[-1].pos)
         for k, (j, jname, jtype, axis, rng) in enumerate(chain):
             last = k == len(chain) - 1
-            child = self.p(b.name) if last else self.p(f"{b.name}_dummy{k + 1}")
-            el = ET.Element("joint", {"name": self.p(jname), "type": jtype})
-            if prev_anchor is None:
-                xyz = tuple(x + y for x, y in zip(body_xyz, rotate(b.quat, j.pos), strict=True))
-                _origin(el, xyz, b.quat)
+            if last and not anchored:
+                child = self.p(b.name)
             else:
-                _origin(el, _sub(j.pos, prev_anchor))
+                child = self.p(self._fresh(f"{b.name}_dummy{k + 1}", self.link_names))
+                dummies.append(child)
+            el = ET.Element("joint", {"name": self.p(jname), "type": jtype})
+            # MuJoCo moves the body by q - ref: the origin carries the motion by -ref.
+            ref_xyz, ref_quat = _ref_motion(j)
+            if prev_anchor is None:
+                xyz = tuple(
+                    x + y
+                    for x, y in zip(body_xyz, rotate(b.quat, _add(j.pos, ref_xyz)), strict=True)
+                )
+                _origin(el, xyz, _qmul(b.quat, ref_quat))
+            else:
+                _origin(el, _add(_sub(j.pos, prev_anchor), ref_xyz), ref_quat)
             ET.SubElement(el, "parent", {"link": prev_link})
             ET.SubElement(el, "child", {"link": child})
             ET.SubElement(el, "axis", {"xyz": fmt_vec(axis)})
@@ -295,12 +358,31 @@ class _RobotWriter:
             if dyn:
                 ET.SubElement(el, "dynamics", dyn)
             jnts.append(el)
-            if not last:
+            if child in dummies:
                 links.append(self._dummy_link(child))
             prev_link, prev_anchor = child, j.pos
+        if anchored:
+            jname = self._fresh(f"{b.name}_anchor_joint", self.joint_names)
+            el = ET.Element("joint", {"name": self.p(jname), "type": "fixed"})
+            _origin(el, tuple(-float(v) for v in own[-1].pos))
+            ET.SubElement(el, "parent", {"link": prev_link})
+            ET.SubElement(el, "child", {"link": self.p(b.name)})
+            jnts.append(el)
+        if dummies:
+            self.losses.append(
+                Problem(
+                    "joint.csv",
+                    f"body '{b.name}' ({len(chain)} joint(s)"
+                    + (", anchor off the body origin" if anchored else "")
+                    + f"): written through link(s) {dummies} of {DUMMY_LINK_MASS:g} kg and {DUMMY_LINK_INERTIA:g} "
+                    "kg m^2 each (massless moving links are refused by MuJoCo and dropped by "
+                    "SDFormat)",
+                    column="body",
+                )
+            )
         for j in own:
             self._joint_losses(j)
-        return (float(own[-1].pos[0]), float(own[-1].pos[1]), float(own[-1].pos[2]))
+        return _ZERO
 
     def _expand(
         self, own: list[Joint]
@@ -323,9 +405,8 @@ class _RobotWriter:
                     ("y", (0.0, 1.0, 0.0)),
                     ("z", (0.0, 0.0, 1.0)),
                 ):
-                    out.append(
-                        (j, f"{name}_{axis_name}", "revolute" if rng else "continuous", axis, rng)
-                    )
+                    jname = self._fresh(f"{name}_{axis_name}", self.joint_names)
+                    out.append((j, jname, "revolute" if rng else "continuous", axis, rng))
             elif j.type == "slide":
                 out.append((j, name, "prismatic", j.axis, j.range))
             else:
@@ -364,11 +445,21 @@ class _RobotWriter:
             ET.SubElement(el, "limit", attrs)
 
     def _joint_losses(self, j: Joint) -> None:
+        if j.ref and j.type in ("hinge", "slide"):
+            self.losses.append(
+                Problem(
+                    "joint.csv",
+                    f"joint '{j.name}': ref {j.ref} baked into the joint origin (same joint "
+                    "coordinate, limits and FK as MJCF); URDF has no initial position, so "
+                    "its default pose is q = 0, not q = ref",
+                    column="ref",
+                )
+            )
         for field_name, value in (
             ("armature", j.armature),
             ("stiffness", j.stiffness),
             ("springref", j.springref),
-            ("ref", j.ref),
+            ("ref", j.ref if j.type not in ("hinge", "slide") else 0.0),
         ):
             if value:
                 self.losses.append(
@@ -414,18 +505,18 @@ class _RobotWriter:
             )
 
     # -- links ----------------------------------------------------------------------------
-    def _dummy_link(self, name: str) -> ET.Element:
+    @staticmethod
+    def _dummy_link(name: str) -> ET.Element:
         link = ET.Element("link", {"name": name})
-        if self.for_mujoco:
-            inertial = ET.SubElement(link, "inertial")
-            _origin(inertial, _ZERO)
-            ET.SubElement(inertial, "mass", {"value": fmt_float(DUMMY_LINK_MASS)})
-            d = fmt_float(DUMMY_LINK_INERTIA)
-            ET.SubElement(
-                inertial,
-                "inertia",
-                {"ixx": d, "ixy": "0", "ixz": "0", "iyy": d, "iyz": "0", "izz": d},
-            )
+        inertial = ET.SubElement(link, "inertial")
+        _origin(inertial, _ZERO)
+        ET.SubElement(inertial, "mass", {"value": fmt_float(DUMMY_LINK_MASS)})
+        d = fmt_float(DUMMY_LINK_INERTIA)
+        ET.SubElement(
+            inertial,
+            "inertia",
+            {"ixx": d, "ixy": "0", "ixz": "0", "iyy": d, "iyz": "0", "izz": d},
+        )
         return link
 
     def _link(
@@ -560,6 +651,23 @@ def _effort_velocity(act: Actuator | None) -> tuple[float | None, float | None]:
     return effort, act.peak_velocity
 
 
+def _add(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float]:
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _ref_motion(j: Joint) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """The joint's motion by ``-ref`` (translation in m, rotation as w, x, y, z) in its body
+    frame: hinge -> rotation about the axis, slide -> translation along the unit axis."""
+    if not j.ref or j.type not in ("hinge", "slide"):
+        return _ZERO, _IDENTITY
+    n = math.sqrt(sum(float(v) * float(v) for v in j.axis))
+    u = (j.axis[0] / n, j.axis[1] / n, j.axis[2] / n)
+    if j.type == "slide":
+        return (-j.ref * u[0], -j.ref * u[1], -j.ref * u[2]), _IDENTITY
+    s = math.sin(-j.ref / 2)
+    return _ZERO, (math.cos(-j.ref / 2), s * u[0], s * u[1], s * u[2])
+
+
 def _qmul(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:
     aw, ax, ay, az = a
     bw, bx, by, bz = b
@@ -585,4 +693,4 @@ def _dfs(hrdf: HRDF) -> list[int]:
     return out
 
 
-__all__ = ["DUMMY_LINK_MASS", "URDFHumanoidGenerator"]
+__all__ = ["DUMMY_LINK_INERTIA", "DUMMY_LINK_MASS", "URDFHumanoidGenerator"]
