@@ -173,3 +173,30 @@ def test_urdf_prefix_names_links_joints_materials(synth_urdf_safe):
     assert all(n == "world" or n.startswith("r_") for n in names), names
     refs = [e.get("link") for e in root.iter() if e.tag in ("parent", "child")]
     assert all(r == "world" or r.startswith("r_") for r in refs)
+
+
+def test_dummy_and_frame_link_maps(synth_urdf_safe):
+    """Readers of the file can tell added links from bodies: dummy links name the body
+    they split, frame links the site they carry (prefixed like every link)."""
+    import dataclasses
+
+    site = dataclasses.replace(synth_urdf_safe.sites[0], name="link1")
+    hrdf = dataclasses.replace(synth_urdf_safe, sites=[site], sensors=[])
+    gen = URDFHumanoidGenerator.from_hrdf(hrdf)
+    assert gen.dummy_links == {} and gen.frame_links == {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConversionWarning)
+        root = ET.fromstring(gen.export(prefix="r"))
+    # link1: two joints, the last anchored off the origin; link3: one anchored hinge.
+    assert gen.dummy_links == {
+        "r_link1_dummy1": "link1",
+        "r_link1_dummy2": "link1",
+        "r_link3_dummy1": "link3",
+    }
+    assert gen.frame_links["link1"] == "r_link1_site"
+    links = {link.get("name") for link in root.findall("link")}
+    assert set(gen.dummy_links) | set(gen.frame_links.values()) <= links
+    bodies = {f"r_{b.name}" for b in hrdf.bodies}
+    assert links == bodies | set(gen.dummy_links) | set(gen.frame_links.values()) | {"world"}
+    gen.destroy()
+    assert gen.dummy_links == {} and gen.frame_links == {}

@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import replace
+from typing import Any
 
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
@@ -77,7 +78,25 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
 
         gen = URDFHumanoidGenerator.from_robot_name("arm6")
         gen.export("out/arm6.urdf", add_mujoco_tag=True)
+
+    After ``generate``/``export``, two maps tell readers of the file which links are not
+    bodies of the robot: :attr:`dummy_links` (link name -> the body whose joints it
+    splits, including anchor links) and :attr:`frame_links` (site/IMU name -> its link
+    name; differs from the site name only where it was renamed). Both are empty until
+    a tree is generated and are dropped with it.
     """
+
+    dummy_links: dict[str, str]
+    frame_links: dict[str, str]
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.dummy_links = {}
+        self.frame_links = {}
+
+    def _destroy(self) -> None:
+        self.dummy_links = {}
+        self.frame_links = {}
 
     def _robot_name(self) -> str:
         return self.hrdf.name if self.hrdf is not None else "robot"
@@ -111,7 +130,10 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
             ET.SubElement(mj, "compiler", self.mujoco_compiler_attrs())
         if world_link:
             ET.SubElement(root, "link", {"name": WORLD_LINK})
-        _RobotWriter(self, hrdf, prefix, add_mujoco_tag, relative_mesh_path, losses).write(root)
+        writer = _RobotWriter(self, hrdf, prefix, add_mujoco_tag, relative_mesh_path, losses)
+        writer.write(root)
+        self.dummy_links = dict(writer.dummy_links)
+        self.frame_links = {k: writer.p(v) for k, v in writer.frame_links.items()}
         _report(hrdf, "URDF", losses, strict)
 
 
@@ -140,6 +162,8 @@ class _RobotWriter:
         self.joint_names: set[str] = set()
         #: site/IMU name -> the name of the link that carries it (before the prefix).
         self.frame_links: dict[str, str] = {}
+        #: dummy link name (prefixed) -> the body whose joints it splits.
+        self.dummy_links: dict[str, str] = {}
 
     def p(self, name: str) -> str:
         return prefixed(self.prefix, name)
@@ -360,6 +384,7 @@ class _RobotWriter:
             jnts.append(el)
             if child in dummies:
                 links.append(self._dummy_link(child))
+                self.dummy_links[child] = b.name
             prev_link, prev_anchor = child, j.pos
         if anchored:
             jname = self._fresh(f"{b.name}_anchor_joint", self.joint_names)
