@@ -13,8 +13,9 @@ from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import Any
 
+from robotwright._atomic import copy_file_atomic, write_text_atomic
 from robotwright.errors import GeneratorError
-from robotwright.generators.xmlfmt import copy_file_atomic, to_xml_string, write_text_atomic
+from robotwright.generators.xmlfmt import to_xml_string
 
 #: Folder (next to the exported file) that ``export(copy_meshes=True)`` copies meshes to.
 MESH_COPY_DIR = "meshes"

@@ -7,8 +7,6 @@ cylinders are drawn as thick segments and boxes as outlines.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -20,6 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
+from robotwright._atomic import atomic_open  # noqa: E402
 from robotwright.grammar.build import Limb  # noqa: E402
 
 
@@ -102,13 +101,9 @@ def draw_limb(
     ax.set_zlabel("z (m)")
     ax.set_title(title or f"{limb.name}: {limb.dof} DoF, design {limb.design.hash()}", fontsize=9)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=path.parent)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=dpi)
-        os.replace(tmp, path)
+        with atomic_open(path, "wb") as fh:
+            fig.savefig(fh, format="png", dpi=dpi)
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path

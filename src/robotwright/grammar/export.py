@@ -4,11 +4,10 @@ a temporary folder that is renamed into place."""
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 import warnings
 from pathlib import Path
 
+from robotwright._atomic import atomic_dir
 from robotwright.errors import ConversionWarning
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.derive import replay
@@ -59,9 +58,7 @@ def export_design(
     tree = replay(grammar, design)
     limb: Limb = build(grammar, design, name=name)
     hrdf = limb.to_hrdf()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with atomic_dir(out) as tmp:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConversionWarning)
             export_mjcf(hrdf, tmp / f"{name}.xml")
@@ -82,10 +79,4 @@ def export_design(
                 q=display_pose(limb),
                 title=f"{name} {design.hash()}: {limb.dof} DoF (hinges at +-0.5 rad)",
             )
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return out

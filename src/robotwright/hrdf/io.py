@@ -12,7 +12,6 @@ import io
 import math
 import os
 import shutil
-import tempfile
 import warnings
 from dataclasses import dataclass
 from itertools import repeat
@@ -21,6 +20,7 @@ from typing import Any
 
 import yaml
 
+from robotwright._atomic import atomic_dir
 from robotwright.errors import HRDFError, Problem
 from robotwright.hrdf.model import (
     FORMAT_VERSION,
@@ -749,25 +749,6 @@ def meta_dict(hrdf: HRDF) -> dict[str, Any]:
     return out
 
 
-def _atomic_dir_write(target: Path, fill: Any, overwrite: bool) -> None:
-    if target.exists() and not overwrite:
-        raise FileExistsError(f"{target} exists (pass overwrite=True to replace it)")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
-    try:
-        fill(tmp)
-        if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old.", dir=target.parent))
-            os.replace(target, old / "x")
-            os.replace(tmp, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, target)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-
-
 def _with_folder_mesh_paths(hrdf: HRDF) -> HRDF:
     """A view of ``hrdf`` whose mesh ``file`` entries are paths inside the folder.
 
@@ -836,5 +817,8 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
         if hrdf.mjcf_extra:
             (tmp / EXTRA_MJCF_FILE).write_text(hrdf.mjcf_extra, encoding="utf-8")
 
-    _atomic_dir_write(target, fill, overwrite)
+    if target.exists() and not overwrite:
+        raise FileExistsError(f"{target} exists (pass overwrite=True to replace it)")
+    with atomic_dir(target) as tmp:
+        fill(tmp)
     return target

@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robotwright._atomic import atomic_path
+
 #: Extensions MuJoCo decodes itself.
 MUJOCO_MESH_EXTENSIONS = frozenset({".stl", ".obj", ".msh"})
 #: MuJoCo's STL decoder refuses files with more faces than this.
@@ -80,9 +82,8 @@ class MeshStore:
         ext = ".obj" if faces > HEAVY_FACES else ".stl"
         name = self._unique(stem, ext)
         dest = self.root / "meshes" / name
-        tmp = dest.with_name(dest.name + ".tmp")
-        mesh.export(str(tmp), file_type=ext[1:])
-        os.replace(tmp, dest)
+        with atomic_path(dest) as tmp:
+            mesh.export(str(tmp), file_type=ext[1:])
         return f"meshes/{name}", faces
 
     def add(self, source: Path) -> StagedMesh:

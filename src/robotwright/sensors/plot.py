@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+
+from robotwright._atomic import atomic_open
 
 __all__ = ["plot_scan"]
 
@@ -95,14 +95,9 @@ def plot_scan(
     fig.suptitle(title or f"LiDAR scan: {len(points)} points")
     fig.tight_layout(rect=(0, 0.07, 1, 0.97))
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent or ".")
     try:
-        with os.fdopen(fd, "wb") as fh:
+        with atomic_open(path, "wb") as fh:
             fig.savefig(fh, format="png", dpi=110)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
     finally:
         plt.close(fig)
     return path

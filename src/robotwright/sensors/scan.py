@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -11,6 +9,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright._atomic import atomic_open
 from robotwright.sensors.config import SemanticLidarCfg
 from robotwright.sensors.patterns import pattern_from_name
 from robotwright.sensors.plot import plot_scan
@@ -22,14 +21,8 @@ __all__ = ["scan_to_files", "save_npz"]
 def save_npz(path: str | Path, **arrays: np.ndarray) -> Path:
     """Write arrays to ``path`` (.npz) through a temporary file, so no partial file is left."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent or ".")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    with atomic_open(path, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
     return path
 
 

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import mujoco
 import numpy as np
 
+from robotwright._atomic import atomic_open
 from robotwright.errors import RobotwrightError
 from robotwright.things.attrs import Choice, Flag, Integer, Real, Vector
 from robotwright.things.base import BaseThing
@@ -240,15 +240,8 @@ class World(BaseThing):
             (out_dir / "assets").mkdir(exist_ok=True)
             for src, rel in copies.items():
                 shutil.copyfile(src, out_dir / "assets" / rel)
-        fd, tmp = tempfile.mkstemp(dir=out_dir, prefix=f".{path.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                fh.write(text)
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        with atomic_open(path, "w") as fh:
+            fh.write(text)
         return path
 
     # ------------------------------------------------------------------ reading

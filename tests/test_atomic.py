@@ -1,0 +1,84 @@
+"""All-or-nothing writing: success replaces the target, failure leaves nothing behind."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from robotwright._atomic import (
+    atomic_dir,
+    atomic_open,
+    atomic_path,
+    copy_file_atomic,
+    write_text_atomic,
+)
+
+
+class Boom(Exception):
+    pass
+
+
+def test_write_text_atomic_creates_folder_and_replaces(tmp_path: Path) -> None:
+    target = tmp_path / "sub" / "a.xml"
+    write_text_atomic(target, "first é")
+    write_text_atomic(target, "second")
+    assert target.read_text(encoding="utf-8") == "second"
+    assert sorted(p.name for p in target.parent.iterdir()) == ["a.xml"]
+
+
+def test_atomic_open_failure_keeps_old_file_and_no_temp(tmp_path: Path) -> None:
+    target = tmp_path / "a.txt"
+    target.write_text("old", encoding="utf-8")
+    with pytest.raises(Boom), atomic_open(target, "w") as fh:
+        fh.write("half")
+        raise Boom
+    assert target.read_text(encoding="utf-8") == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["a.txt"]
+
+
+def test_atomic_open_binary_and_bad_mode(tmp_path: Path) -> None:
+    target = tmp_path / "b.bin"
+    with atomic_open(target, "wb") as fh:
+        fh.write(b"\x00\x01")
+    assert target.read_bytes() == b"\x00\x01"
+    with pytest.raises(ValueError, match="mode must be 'w' or 'wb'"), atomic_open(target, "a"):
+        pass
+
+
+def test_atomic_path_failure_leaves_no_file(tmp_path: Path) -> None:
+    target = tmp_path / "m.stl"
+    with pytest.raises(Boom), atomic_path(target) as tmp:
+        tmp.write_bytes(b"partial")
+        raise Boom
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_copy_file_atomic(tmp_path: Path) -> None:
+    src = tmp_path / "src.bin"
+    src.write_bytes(b"mesh")
+    dst = tmp_path / "out" / "dst.bin"
+    copy_file_atomic(src, dst)
+    assert dst.read_bytes() == b"mesh"
+    with pytest.raises(FileNotFoundError):
+        copy_file_atomic(tmp_path / "missing.bin", dst)
+    assert dst.read_bytes() == b"mesh"
+    assert [p.name for p in dst.parent.iterdir()] == ["dst.bin"]
+
+
+def test_atomic_dir_replaces_existing_folder_only_on_success(tmp_path: Path) -> None:
+    target = tmp_path / "parent" / "robot"
+    with atomic_dir(target) as tmp:
+        (tmp / "meta.yaml").write_text("v: 1\n", encoding="utf-8")
+    assert (target / "meta.yaml").read_text(encoding="utf-8") == "v: 1\n"
+
+    with pytest.raises(Boom), atomic_dir(target) as tmp:
+        (tmp / "meta.yaml").write_text("v: 2\n", encoding="utf-8")
+        raise Boom
+    assert (target / "meta.yaml").read_text(encoding="utf-8") == "v: 1\n"
+    assert [p.name for p in target.parent.iterdir()] == ["robot"]
+
+    with atomic_dir(target) as tmp:
+        (tmp / "other.csv").write_text("x\n", encoding="utf-8")
+    assert sorted(p.name for p in target.iterdir()) == ["other.csv"]
+    assert [p.name for p in target.parent.iterdir()] == ["robot"]
