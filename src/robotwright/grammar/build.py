@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from robotwright._rotations import mat_to_quat
 from robotwright.errors import GrammarError, Problem
 from robotwright.grammar.design import Design, DesignNode
 from robotwright.grammar.dh import DHRow, fk, rot_x
@@ -48,11 +49,9 @@ def trans(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
 
 
 def mat2quat(R: np.ndarray) -> tuple[float, float, float, float]:
-    q = np.zeros(4)
-    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R, dtype=float).reshape(9))
-    if q[0] < 0:
-        q = -q  # one sign convention, so equal rotations give equal text
-    return tuple(float(v) for v in _clean(q))  # type: ignore[return-value]
+    """Quaternion (w >= 0, so equal rotations give equal text) of a rotation matrix, with
+    float noise rounded away."""
+    return tuple(float(v) for v in _clean(np.array(mat_to_quat(R))))  # type: ignore[return-value]
 
 
 def _clean(v: np.ndarray) -> np.ndarray:

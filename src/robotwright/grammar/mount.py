@@ -11,6 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from robotwright._rotations import compose_pose
 from robotwright.errors import GrammarError, Problem
 from robotwright.hrdf.model import HRDF
 
@@ -18,31 +19,12 @@ Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 
 
-def _quat_mul(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array(
-        [
-            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-        ]
-    )
-
-
-def _rotate(q: Sequence[float], v: Sequence[float]) -> np.ndarray:
-    qv = np.array([0.0, *v])
-    qc = np.array([q[0], -q[1], -q[2], -q[3]])
-    return _quat_mul(_quat_mul(q, qv), qc)[1:]
-
-
 def _compose(
     pos_a: Sequence[float], quat_a: Sequence[float], pos_b: Sequence[float], quat_b: Sequence[float]
 ) -> tuple[Vec3, Quat]:
-    """Pose a then pose b (b expressed in a's frame)."""
-    p = np.asarray(pos_a, dtype=float) + _rotate(quat_a, pos_b)
-    q = _quat_mul(quat_a, quat_b)
+    """Pose a then pose b (b expressed in a's frame), as plain floats with a unit quaternion."""
+    qa = np.asarray(quat_a, dtype=float)
+    p, q = compose_pose(pos_a, qa / np.linalg.norm(qa), pos_b, quat_b)
     q = q / np.linalg.norm(q)
     return tuple(float(x) for x in p), tuple(float(x) for x in q)  # type: ignore[return-value]
 

@@ -10,42 +10,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import mujoco
 import numpy as np
 
+# mul_quat and rpy_to_quat are re-exported: the parsers call them as ``inertia.<name>``.
+from robotwright._rotations import mat_to_quat, mul_quat, quat_to_mat, rpy_to_quat  # noqa: F401
 from robotwright.hrdf.model import Quat, Vec3
-
-
-def quat_to_mat(quat: Sequence[float]) -> np.ndarray:
-    """3x3 rotation matrix of a (w, x, y, z) quaternion (normalised first)."""
-    q = np.asarray(quat, dtype=float)
-    q = q / np.linalg.norm(q)
-    out = np.zeros(9)
-    mujoco.mju_quat2Mat(out, q)
-    return out.reshape(3, 3)
-
-
-def mat_to_quat(mat: np.ndarray) -> Quat:
-    """(w, x, y, z) quaternion of a proper 3x3 rotation matrix, with w >= 0."""
-    q = np.zeros(4)
-    mujoco.mju_mat2Quat(q, np.ascontiguousarray(mat, dtype=float).reshape(9))
-    if q[0] < 0:
-        q = -q
-    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
-
-
-def rpy_to_quat(rpy: Sequence[float]) -> Quat:
-    """Quaternion of URDF roll-pitch-yaw (rad): R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    q = np.zeros(4)
-    mujoco.mju_euler2Quat(q, np.asarray(rpy, dtype=float), "XYZ")
-    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
-
-
-def mul_quat(a: Sequence[float], b: Sequence[float]) -> Quat:
-    """Quaternion product ``a * b`` (rotation b then a, in a's frame)."""
-    out = np.zeros(4)
-    mujoco.mju_mulQuat(out, np.asarray(a, dtype=float), np.asarray(b, dtype=float))
-    return (float(out[0]), float(out[1]), float(out[2]), float(out[3]))
 
 
 def full_inertia(diag: Sequence[float], quat: Sequence[float]) -> np.ndarray:

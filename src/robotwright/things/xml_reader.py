@@ -32,6 +32,7 @@ import defusedxml.ElementTree as SafeET
 import mujoco
 import numpy as np
 
+from robotwright._rotations import compose_pose
 from robotwright.errors import ConversionError, ConversionWarning, Problem, RobotwrightError
 from robotwright.things import actuators as A
 from robotwright.things import sensors as S
@@ -60,20 +61,6 @@ def _enum(value: Any, prefix: str) -> str:
 def _f32(values: Any) -> list[float]:
     """float32 spec fields back to the shortest decimal that MJCF text would give."""
     return [float(np.format_float_positional(np.float32(v), unique=True)) for v in values]
-
-
-def _compose(pos_a: Any, quat_a: Any, pos_b: Any, quat_b: Any) -> tuple[np.ndarray, np.ndarray]:
-    pos = np.zeros(3)
-    quat = np.zeros(4)
-    mujoco.mju_mulPose(
-        pos,
-        quat,
-        np.asarray(pos_a, float),
-        np.asarray(quat_a, float),
-        np.asarray(pos_b, float),
-        np.asarray(quat_b, float),
-    )
-    return pos, quat
 
 
 class _Reader:
@@ -115,7 +102,7 @@ class _Reader:
     ) -> tuple[np.ndarray, np.ndarray]:
         frame = elem.frame
         while frame is not None:
-            pos, quat = _compose(frame.pos, self.quat(frame), pos, quat)
+            pos, quat = compose_pose(frame.pos, self.quat(frame), pos, quat)
             frame = frame.frame
         return pos, quat
 

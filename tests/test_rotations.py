@@ -1,0 +1,36 @@
+"""Shared rotation helpers against independent matrix arithmetic."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robotwright._rotations import compose_pose, mat_to_quat, mul_quat, quat_to_mat
+
+
+def _random_unit_quat(rng: np.random.Generator) -> np.ndarray:
+    q = rng.normal(size=4)
+    return q / np.linalg.norm(q)
+
+
+def test_compose_pose_matches_homogeneous_transforms() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        qa, qb = _random_unit_quat(rng), _random_unit_quat(rng)
+        pa, pb = rng.normal(size=3), rng.normal(size=3)
+        pos, quat = compose_pose(pa, qa, pb, qb)
+        ta, tb = np.eye(4), np.eye(4)
+        ta[:3, :3], ta[:3, 3] = quat_to_mat(qa), pa
+        tb[:3, :3], tb[:3, 3] = quat_to_mat(qb), pb
+        expected = ta @ tb
+        assert np.abs(pos - expected[:3, 3]).max() < 1e-12
+        assert np.abs(quat_to_mat(quat) - expected[:3, :3]).max() < 1e-12
+        assert np.abs(quat_to_mat(mul_quat(qa, qb)) - expected[:3, :3]).max() < 1e-12
+
+
+def test_mat_to_quat_picks_nonnegative_w_and_round_trips() -> None:
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        q = _random_unit_quat(rng)
+        back = np.array(mat_to_quat(quat_to_mat(q)))
+        assert back[0] >= 0.0
+        assert np.abs(back - np.sign(q[0]) * q).max() < 1e-12
