@@ -501,21 +501,41 @@ def our_mjcf_model(hrdf: HRDF) -> mujoco.MjModel:
         return MJCFHumanoidGenerator.from_hrdf(hrdf).to_model(add_scene=False)
 
 
-def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
-    """Our URDF of ``hrdf`` loaded by MuJoCo (every link kept, inertia from <inertial>)."""
+def _our_urdf(hrdf: HRDF) -> tuple[mujoco.MjModel, dict[str, str], dict[str, str]]:
+    """Our URDF of ``hrdf`` loaded by MuJoCo, with the generator's added links: dummy
+    links (link -> the body it splits) and frame links (site -> its link)."""
     import warnings
 
     from robotwright.generators import URDFHumanoidGenerator
 
     with tempfile.TemporaryDirectory(prefix="robotwright-rt-") as tmp:
         out = Path(tmp) / "robot.urdf"
+        gen = URDFHumanoidGenerator.from_hrdf(hrdf)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            URDFHumanoidGenerator.from_hrdf(hrdf).export(out)
+            gen.export(out)
         from robotwright.parsers.reference import urdf_for_mujoco
 
         text = urdf_for_mujoco(out)
-        return mujoco.MjModel.from_xml_string(text)
+        return mujoco.MjModel.from_xml_string(text), dict(gen.dummy_links), dict(gen.frame_links)
+
+
+def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
+    """Our URDF of ``hrdf`` loaded by MuJoCo (every link kept, inertia from <inertial>)."""
+    return _our_urdf(hrdf)[0]
+
+
+def our_urdf_view(hrdf: HRDF) -> RobotView:
+    """View of our URDF in MuJoCo without the links the URDF form adds: dummy links
+    (their 1e-9 kg each stays in the total mass) and site links renamed because a body
+    has the site's name (the reference's FK of that name is the body)."""
+    model, dummy_links, frame_links = _our_urdf(hrdf)
+    view = view_from_model(model)
+    drop = set(dummy_links) | {link for site, link in frame_links.items() if link != site}
+    view.bodies = [b for b in view.bodies if b not in drop]
+    view.inertia_world = {k: v for k, v in view.inertia_world.items() if k not in drop}
+    view.mass = {k: v for k, v in view.mass.items() if k not in drop or k in dummy_links}
+    return view
 
 
 def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:
@@ -595,7 +615,7 @@ def _roundtrip(
         report.rows.append(r)
     if urdf:
         try:
-            ours_u = view_from_model(our_urdf_model(result.hrdf))
+            ours_u = our_urdf_view(result.hrdf)
         except ImportError:
             report.rows.append(Row("URDF: generator", "not available", False))
             return report
