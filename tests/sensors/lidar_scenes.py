@@ -55,6 +55,10 @@ class RaysPattern(PatternCfg):
         return self._origins, self._dirs
 
 
+def geom_id(model: mujoco.MjModel, name: str) -> int:
+    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+
+
 def analytic_model() -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_string(ANALYTIC_XML)
 

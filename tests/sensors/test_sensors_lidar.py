@@ -7,7 +7,7 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from lidar_scenes import ANALYTIC_XML, RaysPattern, forward, random_envs
+from lidar_scenes import ANALYTIC_XML, RaysPattern, forward, geom_id, random_envs
 
 from robotwright.errors import SensorError
 from robotwright.sensors import GridPatternCfg, LidarCfg, LidarSensor, LivoxPatternCfg
@@ -17,10 +17,6 @@ AXES = [(1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0), (0, 0, -1), (0, 0, 1)]
 # floor 1 below, nothing above.
 EXPECTED = [2.5, 2.5, 2.8, 2.5, 1.0, math.inf]
 EXPECTED_GEOMS = ["ball", "crate_geom", "pillar_geom", "cube", "floor", None]
-
-
-def _geom(model, name):
-    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
 
 
 @pytest.mark.parametrize("threads", [1, 2])
@@ -38,7 +34,7 @@ def test_primitive_and_mesh_distances_are_exact(analytic_model, threads):
     assert np.isnan(pts[0, 5]).all()
     assert sensor.get_hit_mask().tolist() == [[True] * 5 + [False]]
     ids = sensor._raw_geom_ids[0].tolist()
-    assert ids == [_geom(analytic_model, n) if n else -1 for n in EXPECTED_GEOMS]
+    assert ids == [geom_id(analytic_model, n) if n else -1 for n in EXPECTED_GEOMS]
 
 
 def test_heightfield_distance_is_exact(analytic_model):
@@ -49,7 +45,7 @@ def test_heightfield_distance_is_exact(analytic_model):
     sensor.update()
     np.testing.assert_allclose(sensor.get_distances()[0, 0], 2.0 - 0.4 * (1 - 0.2) / 2, atol=1e-6)
     np.testing.assert_array_equal(analytic_model.hfield_data[[0, 8]], [1.0, 0.0])
-    assert sensor._raw_geom_ids[0, 0] == _geom(analytic_model, "terrain_hf")
+    assert sensor._raw_geom_ids[0, 0] == geom_id(analytic_model, "terrain_hf")
 
 
 def test_grid_pattern_per_ray_origins(analytic_model):
@@ -70,7 +66,7 @@ def test_grid_pattern_per_ray_origins(analytic_model):
 
 def test_robot_excluded_by_default(analytic_model):
     data = forward(analytic_model)[0]
-    torso = _geom(analytic_model, "torso")
+    torso = geom_id(analytic_model, "torso")
     on = LidarSensor(
         LidarCfg(prim_path="lidar_site", pattern_cfg=RaysPattern(AXES)), analytic_model, data
     )

@@ -5,7 +5,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from lidar_scenes import RaysPattern, forward, random_envs
+from lidar_scenes import RaysPattern, forward, geom_id, random_envs
 
 from robotwright.errors import SensorError
 from robotwright.sensors import (
@@ -16,10 +16,6 @@ from robotwright.sensors import (
 )
 
 AXES = [(1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0), (0, 0, -1), (0, 0, 1)]
-
-
-def _geom(model, name):
-    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
 
 
 def test_labels_from_names_default_mapping(clutter_model):
@@ -39,14 +35,14 @@ def test_labels_from_names_default_mapping(clutter_model):
         "lamp_shade": 0,  # unknown
     }
     for name, cls in expect.items():
-        assert sensor.mesh_id_to_semantic_class[_geom(clutter_model, name)] == cls, name
+        assert sensor.mesh_id_to_semantic_class[geom_id(clutter_model, name)] == cls, name
     # Unnamed geoms classified through their body path.
     body = mujoco.mj_name2id(clutter_model, mujoco.mjtObj.mjOBJ_BODY, "tomato_soup_can_1")
     g = int(np.flatnonzero(clutter_model.geom_bodyid == body)[0])
     assert sensor.geom_path(g) == f"/world/tomato_soup_can_1/geom{g}"
     assert sensor.mesh_id_to_semantic_class[g] == 2
     # The robot's own geoms are not hittable, so not in the map.
-    assert _geom(clutter_model, "base") not in sensor.mesh_id_to_semantic_class
+    assert geom_id(clutter_model, "base") not in sensor.mesh_id_to_semantic_class
     assert sensor.class_names == ("unknown", "terrain", "dynamic_obstacle", "valuable")
 
 
@@ -64,7 +60,7 @@ def test_classify_mesh_path_rules(clutter_model):
         SemanticLidarCfg(prim_path="lidar"), clutter_model, forward(clutter_model)
     )
     assert (
-        default.geom_path(_geom(clutter_model, "sofa_seat"))
+        default.geom_path(geom_id(clutter_model, "sofa_seat"))
         == "/world/sofa_1/sofa_seat/SM_Sofa_mesh"
     )
 
@@ -86,7 +82,7 @@ def test_labels_exact_per_ray(analytic_model):
     # +x ball, +y crate, -x pillar (unknown), -y cube (mesh name), floor, miss.
     assert s.get_semantic_labels().tolist() == [[2, 2, 0, 3, 1, 0]]
     names = ["ball", "crate_geom", "pillar_geom", "cube", "floor"]
-    assert s.get_mesh_ids().tolist() == [[_geom(analytic_model, n) for n in names] + [-1]]
+    assert s.get_mesh_ids().tolist() == [[geom_id(analytic_model, n) for n in names] + [-1]]
     assert isinstance(s.data, SemanticLidarData)
     assert s.data.semantic_labels.dtype == np.int32
 
