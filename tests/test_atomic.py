@@ -10,9 +10,11 @@ from robotwright._atomic import (
     atomic_dir,
     atomic_open,
     atomic_path,
+    check_output_path,
     copy_file_atomic,
     write_text_atomic,
 )
+from robotwright.errors import OutputPathError, RobotwrightError
 
 
 class Boom(Exception):
@@ -82,3 +84,30 @@ def test_atomic_dir_replaces_existing_folder_only_on_success(tmp_path: Path) -> 
         (tmp / "other.csv").write_text("x\n", encoding="utf-8")
     assert sorted(p.name for p in target.iterdir()) == ["other.csv"]
     assert [p.name for p in target.parent.iterdir()] == ["robot"]
+
+
+def test_output_that_is_a_folder_is_refused_before_writing(tmp_path):
+    (tmp_path / "out.xml").mkdir()
+    with pytest.raises(OutputPathError, match="out.xml: is a folder; expected the path of a file"):
+        write_text_atomic(tmp_path / "out.xml", "x")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.xml"]
+
+
+def test_output_under_a_file_is_refused_naming_the_file(tmp_path):
+    (tmp_path / "a.txt").write_text("keep", encoding="utf-8")
+    target = tmp_path / "a.txt" / "sub" / "out.xml"
+    with pytest.raises(OutputPathError, match=r"a\.txt is a file, not a folder"):
+        check_output_path(target)
+    with pytest.raises(OutputPathError), atomic_dir(tmp_path / "a.txt" / "d"):
+        pass
+    assert (tmp_path / "a.txt").read_text(encoding="utf-8") == "keep"
+
+
+def test_output_in_a_missing_folder_is_an_error_for_atomic_path(tmp_path):
+    with (
+        pytest.raises(OutputPathError, match="cannot write in folder"),
+        atomic_path(tmp_path / "missing" / "x.bin"),
+    ):
+        pass
+    assert isinstance(OutputPathError("x"), RobotwrightError)
+    assert isinstance(OutputPathError("x"), OSError)

@@ -16,7 +16,44 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["atomic_dir", "atomic_open", "atomic_path", "copy_file_atomic", "write_text_atomic"]
+from robotwright.errors import OutputPathError
+
+__all__ = [
+    "atomic_dir",
+    "atomic_open",
+    "atomic_path",
+    "check_output_path",
+    "copy_file_atomic",
+    "write_text_atomic",
+]
+
+
+def check_output_path(path: str | os.PathLike[str], *, folder: bool = False) -> None:
+    """Raise :class:`OutputPathError` when ``path`` cannot become a file (or a folder).
+
+    Catches, before any work is done, the mistakes that would otherwise surface as a
+    bare ``OSError`` half-way through: a file output that is an existing folder, and a
+    parent path one of whose components is a file. A missing parent folder is fine
+    (writers create it).
+    """
+    path = Path(path)
+    if not folder and path.is_dir():
+        raise OutputPathError(f"{path}: is a folder; expected the path of a file to write")
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise OutputPathError(f"{path}: cannot create it: {parent} is a file, not a folder")
+            break
+
+
+def _mkstemp(path: Path, **kw: Any) -> tuple[int, str]:
+    check_output_path(path)
+    try:
+        return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent, **kw)
+    except OSError as exc:
+        raise OutputPathError(
+            f"{path}: cannot write in folder {path.parent}: {exc.strerror or exc}"
+        ) from exc
 
 
 @contextmanager
@@ -28,7 +65,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     The folder of ``path`` must exist.
     """
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = _mkstemp(path)
     os.close(fd)
     try:
         yield Path(tmp)
@@ -52,6 +89,7 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
 
 def write_text_atomic(path: Path, text: str) -> None:
     """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`."""
+    check_output_path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_open(path, "w") as fh:
         fh.write(text)
@@ -59,6 +97,7 @@ def write_text_atomic(path: Path, text: str) -> None:
 
 def copy_file_atomic(src: Path, dst: Path) -> None:
     """Copy ``src`` to ``dst``, creating its folder; see :func:`atomic_path`."""
+    check_output_path(dst)
     dst.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(dst) as tmp:
         shutil.copyfile(src, tmp)
@@ -73,8 +112,14 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
     temporary folder is removed and ``target`` is left as it was. Creates the parent folder.
     """
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    check_output_path(target, folder=True)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    except OSError as exc:
+        raise OutputPathError(
+            f"{target}: cannot create a folder in {target.parent}: {exc.strerror or exc}"
+        ) from exc
     try:
         yield tmp
         if target.exists():

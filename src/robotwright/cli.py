@@ -45,6 +45,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except RobotwrightError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        # The file system refused a path the user gave (permissions, disk full, a file
+        # where a folder is needed): name the path, no traceback.
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

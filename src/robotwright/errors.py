@@ -71,5 +71,17 @@ class GrammarError(ProblemsError):
     """A grammar, component library or design is invalid (names file, rule/component, field)."""
 
 
+class OutputPathError(RobotwrightError, OSError):
+    """An output path cannot be written: it exists (without overwrite), it is a folder
+    where a file is expected (or the reverse), or a component of its folder is a file.
+
+    Also an ``OSError`` (``FileExistsError`` callers keep working through the subclass
+    :class:`OutputExistsError`)."""
+
+
+class OutputExistsError(OutputPathError, FileExistsError):
+    """The output exists and replacing it was not allowed."""
+
+
 class ConversionWarning(UserWarning):
     """An element was dropped or approximated during a conversion (named in the message)."""

@@ -61,3 +61,15 @@ def test_export_prints_conversion_notes_as_warnings(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("warning: robot 'arm6' to URDF:")
     assert "capsule" in err
+
+
+@pytest.mark.parametrize("command", ["export", "compose"])
+def test_output_that_is_a_folder_or_under_a_file_is_a_clear_error(tmp_path, capsys, command):
+    (tmp_path / "taken").mkdir()
+    (tmp_path / "plain.txt").write_text("keep", encoding="utf-8")
+    assert main([command, "arm6", "-o", str(tmp_path / "taken")]) == 2
+    assert "taken: is a folder; expected the path of a file" in capsys.readouterr().err
+    assert main([command, "arm6", "-o", str(tmp_path / "plain.txt" / "out.xml")]) == 2
+    assert "plain.txt is a file, not a folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain.txt", "taken"]
+    assert not any((tmp_path / "taken").iterdir())
