@@ -118,3 +118,38 @@ def test_cli_warp_engine_matches_mujoco(tmp_path):
     assert same.mean() >= 0.999
     hit = same & (out["mujoco"][0] >= 0)
     np.testing.assert_allclose(out["warp"][1][hit], out["mujoco"][1][hit], atol=1e-5)
+
+
+def test_cli_bad_png_path_fails_before_writing_the_npz(tmp_path, capsys):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    (tmp_path / "plain.txt").write_text("x", encoding="utf-8")
+    npz = tmp_path / "scan.npz"
+    rc = main(["lidar", str(scene), "--sensor", "lidar", "-o", str(npz), "--png",
+               str(tmp_path / "plain.txt" / "scan.png")])  # fmt: skip
+    assert rc == 2
+    assert "plain.txt is a file, not a folder" in capsys.readouterr().err
+    assert not npz.exists()
+    rc = main(["lidar", str(scene), "--sensor", "lidar", "-o", str(tmp_path / "no" / "s.npz")])
+    assert rc == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain.txt", "scene.xml"]
+
+
+def test_cli_refuses_xml_entities_and_bad_view_radius(tmp_path, capsys):
+    bomb = tmp_path / "bomb.xml"
+    bomb.write_text(
+        '<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;">]>'
+        '<mujoco model="&b;"><worldbody><body name="s"><geom size=".1"/></body>'
+        "</worldbody></mujoco>",
+        encoding="utf-8",
+    )
+    assert main(["lidar", str(bomb), "--sensor", "s", "-o", str(tmp_path / "s.npz")]) == 2
+    assert "unsafe XML refused" in capsys.readouterr().err
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    rc = main(["lidar", str(scene), "--sensor", "lidar", "--png", str(tmp_path / "s.png"),
+               "--view-radius", "-2"])  # fmt: skip
+    assert rc == 2
+    assert "--view-radius: expected a positive distance" in capsys.readouterr().err
+    assert not (tmp_path / "s.npz").exists() and not (tmp_path / "s.png").exists()

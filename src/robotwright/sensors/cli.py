@@ -8,7 +8,9 @@ from pathlib import Path
 
 import mujoco
 
-from robotwright.errors import SensorError
+from robotwright._atomic import check_output_path
+from robotwright.errors import ConversionError, SensorError
+from robotwright.parsers.xmlsafe import parse_xml
 from robotwright.sensors.patterns import PATTERN_NAMES
 from robotwright.sensors.scan import scan_to_files
 
@@ -66,6 +68,21 @@ def run(args: argparse.Namespace) -> int:
         raise SensorError("nothing to write: give -o SCAN.npz and/or --png SCAN.png")
     if not args.scene.is_file():
         raise SensorError(f"{args.scene}: scene file not found")
+    if args.view_radius is not None and not args.view_radius > 0:
+        raise SensorError(
+            f"--view-radius: expected a positive distance [m], got {args.view_radius}"
+        )
+    # Both outputs are checked before the scan, so a bad --png leaves no .npz behind.
+    for out in (args.output, args.png):
+        if out is not None:
+            check_output_path(out)
+            if not out.parent.is_dir():
+                raise SensorError(f"{out}: folder {out.parent} does not exist")
+    try:
+        # MuJoCo's own parser expands XML entities: refuse them first (entity bombs).
+        parse_xml(args.scene)
+    except ConversionError as exc:
+        raise SensorError(f"{args.scene}: {exc.problems[0].message}") from exc
     mapping = None
     if args.mapping is not None:
         try:
