@@ -32,7 +32,7 @@ MASSLESS = (
     "(passes with bound_mass/bound_inertia, see test_repaired_robots_match_yourdfpy)"
 )
 EXPECTED_FAILURES: dict[str, str] = {
-    "alex_description/urdf/alex_nub_hands.urdf": "mesh 'nub' has inside-out shells: MuJoCo's default (legacy) mesh volume is ~0 and it refuses the source and our MJCF (compiles with inertia='convex'/'shell' on that mesh or with its normals fixed; a mesh repair, not a generator defect)",
+    "alex_description/urdf/alex_nub_hands.urdf": "nub.obj holds 4 objects and MuJoCo reads the first only, an open 29-face shell whose volume it refuses, in the source and in our MJCF (passes with join_obj_objects, see test_split_obj_robot_passes_with_join_obj_objects)",
     "alex_description/urdf/alex_psyonic_hands.urdf": "mimic joints name a joint ('index_q1') that does not exist; the mimic is dropped, yourdfpy still couples them",
     "human_description/robots/human.urdf": MASSLESS,
     "icub_description/robots/icub.urdf": MASSLESS,
@@ -98,6 +98,21 @@ def test_repaired_robots_match_yourdfpy(rel: str) -> None:
     )
     assert report.ok, report.table()
     assert any("raised to bound" in w or "balanced" in w for w in report.warnings)
+
+
+def test_split_obj_robot_passes_with_join_obj_objects() -> None:
+    """alex_nub_hands' nub.obj is split into 4 objects; joined (every triangle kept) the
+    mesh compiles, and the robot matches yourdfpy (MuJoCo refuses the source)."""
+    rel = "alex_description/urdf/alex_nub_hands.urdf"
+    if not (ERD / rel).is_file():
+        pytest.skip(f"example-robot-data absent: {ERD / rel}")
+    report = roundtrip(
+        ERD / rel, configs=CORPUS_CONFIGS, fixed_joints="merge", join_obj_objects=True
+    )
+    assert report.ok, report.table()
+    assert report.reference.startswith("yourdfpy")
+    nub = [w for w in report.warnings if "nub.obj" in w]
+    assert nub and "4 objects (faces [29, 58, 75, 1242])" in nub[0] and "joined" in nub[0]
 
 
 @pytest.mark.parametrize(

@@ -17,8 +17,9 @@ def _options(args: argparse.Namespace) -> dict:
     for name in ("bound_mass", "bound_inertia"):
         if getattr(args, name, None) is not None:
             opts[name] = getattr(args, name)
-    if getattr(args, "balance_inertia", False):
-        opts["balance_inertia"] = True
+    for name in ("balance_inertia", "join_obj_objects"):
+        if getattr(args, name, False):
+            opts[name] = True
     return opts
 
 
@@ -31,6 +32,11 @@ def _repair_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--balance-inertia", action="store_true", help="URDF: MuJoCo's balanceinertia")
     p.add_argument("--bound-mass", type=float, help="URDF: raise masses below this (kg)")
     p.add_argument("--bound-inertia", type=float, help="URDF: raise moments below this (kg m^2)")
+    p.add_argument(
+        "--join-obj-objects",
+        action="store_true",
+        help="join the objects of a multi-object OBJ mesh into one (MuJoCo reads the first only)",
+    )
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -11,6 +11,11 @@ under unique names, so that two source files with the same base name never colli
   trimesh, triangles unchanged (``process=False``: no merging, no cleaning), to binary
   STL, or to OBJ above :data:`HEAVY_FACES` faces. Scene transforms of the file are
   applied; materials and textures of the file are dropped (callers report it).
+- An OBJ split into several objects (``o``/``g`` lines) is read by MuJoCo as its first
+  object only (the other triangles are lost, often leaving an open shell whose volume
+  MuJoCo refuses). With ``join_obj_objects`` it is converted the same way, every
+  object's triangles kept in one file; without it, it is linked and its object face
+  counts are recorded so that callers can report the loss.
 """
 
 from __future__ import annotations
@@ -48,21 +53,29 @@ class StagedMesh:
         source: the original file.
         rel: path relative to the staging folder (``meshes/<name>.<ext>``).
         converted: why the file was rewritten (``"format"``, ``"ascii-stl"``,
-            ``"heavy-stl"``, ``"mirrored"``), or ``None`` for a link/copy of the source.
+            ``"heavy-stl"``, ``"obj-objects"``, ``"mirrored"``), or ``None`` for a
+            link/copy of the source.
         faces: face count when known (converted files and binary STL headers), else None.
+        obj_objects: faces per object of an OBJ holding several (see
+            :func:`obj_object_faces`), else ``()``.
     """
 
     source: Path
     rel: str
     converted: str | None
     faces: int | None = None
+    obj_objects: tuple[int, ...] = ()
 
 
 @dataclass
 class MeshStore:
-    """Stages mesh files into ``root/meshes``; one entry per distinct source (and mirror)."""
+    """Stages mesh files into ``root/meshes``; one entry per distinct source (and mirror).
+
+    ``join_obj_objects``: convert OBJ files holding several objects into one mesh with
+    all their triangles (MuJoCo reads the first object only)."""
 
     root: Path = field(default_factory=lambda: Path(tempfile.mkdtemp(prefix="robotwright-mesh-")))
+    join_obj_objects: bool = False
     staged: dict[str, StagedMesh] = field(default_factory=dict)
     _used: set[str] = field(default_factory=set)
 
@@ -94,6 +107,7 @@ class MeshStore:
             return self.staged[key]
         ext = source.suffix.lower()
         faces = stl_face_count(source)
+        objects = obj_object_faces(source) if ext == ".obj" else ()
         reason = None
         if ext not in MUJOCO_MESH_EXTENSIONS:
             reason = "format"
@@ -101,6 +115,8 @@ class MeshStore:
             reason = "ascii-stl"
         elif ext == ".stl" and faces > HEAVY_FACES:
             reason = "heavy-stl"
+        elif objects and self.join_obj_objects:
+            reason = "obj-objects"
         if reason is None:
             name = self._unique(_safe_stem(source), ext)
             dest = self.root / "meshes" / name
@@ -110,10 +126,10 @@ class MeshStore:
                 os.link(source, dest)
             except OSError:
                 shutil.copyfile(source, dest)
-            entry = StagedMesh(source, f"meshes/{name}", None, faces)
+            entry = StagedMesh(source, f"meshes/{name}", None, faces, objects)
         else:
             rel, faces = self._write(load_triangles(source), _safe_stem(source))
-            entry = StagedMesh(source, rel, reason, faces)
+            entry = StagedMesh(source, rel, reason, faces, objects)
         self.staged[key] = entry
         return entry
 
@@ -132,8 +148,18 @@ class MeshStore:
         return entry
 
 
+def mesh_store(work_dir: Path | None, join_obj_objects: bool = False) -> MeshStore:
+    """A store in ``work_dir`` (a new temporary folder when None)."""
+    if work_dir:
+        return MeshStore(Path(work_dir), join_obj_objects)
+    return MeshStore(join_obj_objects=join_obj_objects)
+
+
 def conversion_note(staged: StagedMesh) -> str | None:
-    """The warning text for a converted mesh (None for a plain link/copy)."""
+    """The warning text for a converted mesh, or for a linked OBJ whose objects after the
+    first MuJoCo does not read (None for a plain link/copy)."""
+    if staged.converted is None:
+        return _objects_note(staged)
     target = staged.rel.rsplit(".", 1)[-1].upper()
     return {
         "format": f"converted to {target} ({staged.rel}); triangles kept, the file's "
@@ -142,8 +168,45 @@ def conversion_note(staged: StagedMesh) -> str | None:
         "STL only); triangles unchanged",
         "heavy-stl": f"{staged.faces} faces, over MuJoCo's STL limit of {HEAVY_FACES}: "
         f"rewritten as OBJ ({staged.rel}); triangles unchanged",
+        "obj-objects": f"{len(staged.obj_objects)} objects (faces {list(staged.obj_objects)}), "
+        f"of which MuJoCo reads the first only: joined into one {target} ({staged.rel}); "
+        "triangles unchanged, the file's normals/texture coordinates dropped",
         "mirrored": None,
     }.get(staged.converted or "")
+
+
+def _objects_note(staged: StagedMesh) -> str | None:
+    if not staged.obj_objects:
+        return None
+    first, total = staged.obj_objects[0], sum(staged.obj_objects)
+    return (
+        f"holds {len(staged.obj_objects)} objects; MuJoCo reads the first only ({first} of "
+        f"{total} faces), and so does the converted robot (join_obj_objects joins them)"
+    )
+
+
+def obj_object_faces(path: Path) -> tuple[int, ...]:
+    """Face counts of the objects of an OBJ file when it holds more than one, else ``()``.
+
+    An object starts at an ``o`` or ``g`` line, as in MuJoCo's OBJ decoder; objects
+    without faces are left out."""
+    counts: list[int] = []
+    current = 0
+    try:
+        with path.open("rb") as f:
+            for line in f:
+                head = line[:2]
+                if head in (b"f ", b"f\t"):
+                    current += 1
+                elif head in (b"o ", b"g ", b"o\t", b"g\t", b"o\n", b"g\n"):
+                    if current:
+                        counts.append(current)
+                    current = 0
+    except OSError:
+        return ()
+    if current:
+        counts.append(current)
+    return tuple(counts) if len(counts) > 1 else ()
 
 
 def stl_face_count(path: Path) -> int | None:

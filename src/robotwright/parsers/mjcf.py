@@ -37,7 +37,12 @@ from robotwright.hrdf.model import (
 )
 from robotwright.parsers import inertia as inr
 from robotwright.parsers import mjcf_extra
-from robotwright.parsers.meshes import MeshConversionError, MeshStore, conversion_note
+from robotwright.parsers.meshes import (
+    MeshConversionError,
+    MeshStore,
+    conversion_note,
+    mesh_store,
+)
 from robotwright.parsers.reference import body_name, joint_name
 from robotwright.parsers.report import ParseResult, Reporter
 from robotwright.parsers.xmlsafe import parse_xml
@@ -72,11 +77,17 @@ class MJCFOptions:
             parent named after it, its sites and (massless) geoms moved to the parent.
             HRDF checks require mass > 0 on every body, so ``"keep"`` leaves such a robot
             invalid (reported).
+        join_obj_objects: convert an OBJ mesh split into several objects (``o``/``g``
+            lines), of which MuJoCo reads the first only, into one mesh holding every
+            object's triangles unchanged (each such mesh is reported; the robot then
+            differs from the source as MuJoCo compiles it). Without it the loss is
+            reported.
     """
 
     root_body: str | None = None
     work_dir: Path | None = None
     massless_frames: str = "keep"
+    join_obj_objects: bool = False
 
     def __post_init__(self) -> None:
         if self.massless_frames not in ("keep", "site"):
@@ -814,7 +825,7 @@ def parse_mjcf(
     frames = _frames_as_sites(model, keep, root_id, opt)
     bodies = _bodies(model, keep, root_id, frames, rep)
     joints = _joints(model, kept, root_id, path, rep)
-    store = MeshStore(opt.work_dir) if opt.work_dir else MeshStore()
+    store = mesh_store(opt.work_dir, opt.join_obj_objects)
     meshes, simple = _geoms(model, spec, kept, path, store, frames, rep)
     sites = _sites(model, kept, frames, rep)
     names = {

@@ -34,7 +34,7 @@ from robotwright.hrdf.model import (
 )
 from robotwright.parsers import inertia as inr
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
-from robotwright.parsers.meshes import MeshConversionError, MeshStore, conversion_note
+from robotwright.parsers.meshes import MeshConversionError, conversion_note, mesh_store
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import ParseResult, Reporter
 from robotwright.parsers.xmlsafe import describe, parse_xml
@@ -68,6 +68,10 @@ class URDFOptions:
             ``boundinertia``.
         floating_base: give the root body a free joint (URDF has no floating base unless
             a ``floating`` joint attaches it to a ``world`` link).
+        join_obj_objects: convert an OBJ mesh split into several objects (``o``/``g``
+            lines), of which MuJoCo reads the first only, into one mesh holding every
+            object's triangles unchanged (each such mesh is reported; without the option
+            the loss is reported).
     """
 
     fixed_joints: FixedPolicy = "keep"
@@ -79,6 +83,7 @@ class URDFOptions:
     bound_mass: float | None = None
     bound_inertia: float | None = None
     floating_base: bool = False
+    join_obj_objects: bool = False
 
     def __post_init__(self) -> None:
         if self.fixed_joints not in FIXED_POLICIES:
@@ -188,7 +193,7 @@ class _URDFReader:
         self.path = path
         self.opt = options
         self.rep = rep
-        self.store = MeshStore(options.work_dir) if options.work_dir else MeshStore()
+        self.store = mesh_store(options.work_dir, options.join_obj_objects)
         self.materials: dict[str, tuple[float, float, float, float]] = {}
         self.unresolved: list[Problem] = []
         self.mesh_names: dict[tuple[str, tuple[float, float, float]], str] = {}

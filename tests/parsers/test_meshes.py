@@ -1,0 +1,118 @@
+"""Mesh staging: OBJ files split into several objects, which MuJoCo reads in part."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+import trimesh
+
+from robotwright.errors import ConversionError
+from robotwright.parsers import urdf_to_hrdf_with_warnings
+from robotwright.parsers.meshes import obj_object_faces
+from robotwright.parsers.roundtrip import our_mjcf_model
+
+TET_V = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\n"
+# One closed, outward-wound tetrahedron whose first face sits in its own object, as
+# CAD exports split a part: MuJoCo reads only that face, an open shell of no volume.
+SPLIT_TET = TET_V + "o lid\nf 1 3 2\ng rest\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+WHOLE_TET = TET_V + "o only\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+URDF = """<robot name="r">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <collision><geometry><mesh filename="{mesh}"/></geometry></collision></link>
+</robot>
+"""
+
+
+def _robot(tmp_path: Path, obj_text: str) -> Path:
+    (tmp_path / "part.obj").write_text(obj_text)
+    path = tmp_path / "r.urdf"
+    path.write_text(URDF.format(mesh="part.obj"))
+    return path
+
+
+def _mesh_model(file: Path) -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_string(
+        f'<mujoco><asset><mesh name="m" file="{file}"/></asset><worldbody><body>'
+        '<joint/><geom type="mesh" mesh="m"/></body></worldbody></mujoco>'
+    )
+
+
+def test_mujoco_reads_only_the_first_object_of_an_obj(tmp_path: Path) -> None:
+    """The premise of the repair: MuJoCo keeps the first object's faces only."""
+    (tmp_path / "two.obj").write_text(
+        TET_V + "v 1 0 0\nv 1.1 0 0\nv 1 0.1 0\nv 1 0 0.1\n"
+        "o a\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\no b\nf 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n"
+    )
+    assert _mesh_model(tmp_path / "two.obj").mesh_facenum[0] == 4
+    (tmp_path / "split.obj").write_text(SPLIT_TET)
+    with pytest.raises(ValueError, match="volume"):
+        _mesh_model(tmp_path / "split.obj")
+
+
+def test_obj_object_faces_counts_objects_and_groups(tmp_path: Path) -> None:
+    (tmp_path / "a.obj").write_text(SPLIT_TET)
+    (tmp_path / "b.obj").write_text("g empty\n" + WHOLE_TET)  # a faceless group is no object
+    assert obj_object_faces(tmp_path / "a.obj") == (1, 3)
+    assert obj_object_faces(tmp_path / "b.obj") == ()
+
+
+def test_split_obj_without_option_is_linked_and_its_loss_reported(tmp_path: Path) -> None:
+    path = _robot(tmp_path, SPLIT_TET)
+    hrdf, warnings = urdf_to_hrdf_with_warnings(path, work_dir=tmp_path / "work")
+    staged = tmp_path / "work" / hrdf.meshes[0].file
+    assert os.path.samefile(staged, tmp_path / "part.obj")
+    text = [str(w) for w in warnings if "part.obj" in str(w)]
+    assert len(text) == 1 and "MuJoCo reads the first only (1 of 4 faces)" in text[0]
+    with pytest.raises(ValueError, match="volume"):
+        our_mjcf_model(hrdf)
+
+
+def test_join_obj_objects_keeps_every_triangle_and_compiles(tmp_path: Path) -> None:
+    path = _robot(tmp_path, SPLIT_TET)
+    hrdf, warnings = urdf_to_hrdf_with_warnings(
+        path, work_dir=tmp_path / "work", join_obj_objects=True
+    )
+    staged = tmp_path / "work" / hrdf.meshes[0].file
+    assert staged.suffix == ".stl"
+    text = [str(w) for w in warnings if "part.obj" in str(w)]
+    assert len(text) == 1 and "2 objects (faces [1, 3])" in text[0] and "joined" in text[0]
+    source = trimesh.load(str(tmp_path / "part.obj"), force="mesh", process=False)
+    joined = trimesh.load(str(staged), force="mesh", process=False)
+    # Same triangles, corner for corner and in the same winding; STL holds float32, as
+    # MuJoCo's own mesh vertices do.
+    np.testing.assert_array_equal(joined.triangles, source.triangles.astype(np.float32))
+    assert joined.volume == pytest.approx(0.1**3 / 6, rel=1e-6)
+    model = our_mjcf_model(hrdf)
+    assert model.mesh_facenum[0] == 4
+    with pytest.raises(ConversionError, match=r"part\.obj.*2 objects"):
+        urdf_to_hrdf_with_warnings(
+            path, work_dir=tmp_path / "strict", join_obj_objects=True, strict=True
+        )
+
+
+def test_single_object_obj_stays_linked_with_the_option(tmp_path: Path) -> None:
+    path = _robot(tmp_path, WHOLE_TET)
+    hrdf, warnings = urdf_to_hrdf_with_warnings(
+        path, work_dir=tmp_path / "work", join_obj_objects=True
+    )
+    assert os.path.samefile(tmp_path / "work" / hrdf.meshes[0].file, tmp_path / "part.obj")
+    assert not [w for w in warnings if "part.obj" in str(w)]
+    assert our_mjcf_model(hrdf).mesh_facenum[0] == 4
+
+
+def test_convert_and_roundtrip_commands_take_join_obj_objects(tmp_path: Path, capsys) -> None:
+    from robotwright.cli import main
+
+    path = _robot(tmp_path, SPLIT_TET)
+    assert main(["roundtrip", str(path), "--configs", "2"]) == 1
+    assert main(["roundtrip", str(path), "--configs", "2", "--join-obj-objects"]) == 0
+    out = tmp_path / "out.xml"
+    assert main(["convert", str(path), "-o", str(out), "--join-obj-objects"]) == 0
+    assert "joined into one STL" in capsys.readouterr().out
+    assert mujoco.MjModel.from_xml_path(str(out)).mesh_facenum[0] == 4
