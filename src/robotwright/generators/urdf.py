@@ -42,6 +42,7 @@ from typing import Any
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf import _report, imu_sites
+from robotwright.generators.placement import qmul
 from robotwright.generators.urdf_base import (
     WORLD_LINK,
     URDFGeneratorBase,
@@ -231,7 +232,7 @@ class _RobotWriter:
                             ppos[1] + placement[0][1],
                             ppos[2] + placement[0][2],
                         ),
-                        quat=_qmul(placement[1], b.quat),
+                        quat=qmul(placement[1], b.quat),
                     )
                 free = [j for j in joints.get(b.name, ()) if j.type == "free"]
                 if free or not own:
@@ -367,7 +368,7 @@ class _RobotWriter:
                     x + y
                     for x, y in zip(body_xyz, rotate(b.quat, _add(j.pos, ref_xyz)), strict=True)
                 )
-                _origin(el, xyz, _qmul(b.quat, ref_quat))
+                _origin(el, xyz, qmul(b.quat, ref_quat))
             else:
                 _origin(el, _add(_sub(j.pos, prev_anchor), ref_xyz), ref_quat)
             ET.SubElement(el, "parent", {"link": prev_link})
@@ -691,17 +692,6 @@ def _ref_motion(j: Joint) -> tuple[tuple[float, float, float], tuple[float, floa
         return (-j.ref * u[0], -j.ref * u[1], -j.ref * u[2]), _IDENTITY
     s = math.sin(-j.ref / 2)
     return _ZERO, (math.cos(-j.ref / 2), s * u[0], s * u[1], s * u[2])
-
-
-def _qmul(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
 
 
 def _dfs(hrdf: HRDF) -> list[int]:
