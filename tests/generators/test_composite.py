@@ -167,6 +167,31 @@ def test_rejects_non_mjcf_generator():
         MJCFGeneratorComposite({"u": URDFHumanoidGenerator.from_robot_name("arm6")})
 
 
+@pytest.mark.parametrize(
+    ("composite", "robot", "other"),
+    [
+        (MJCFGeneratorComposite, MJCFHumanoidGenerator, URDFHumanoidGenerator),
+        (URDFGeneratorComposite, URDFHumanoidGenerator, MJCFHumanoidGenerator),
+    ],
+)
+def test_both_composites_check_members_alike(composite, robot, other):
+    """MJCF and URDF composites share one check of their robots and placements."""
+    gen = robot.from_robot_name("arm6")
+    with pytest.raises(GeneratorError, match=rf"{composite.__name__}: no generators given"):
+        composite({})
+    with pytest.raises(GeneratorError, match=rf"generator 'u' is a {other.__name__}"):
+        composite({"u": other.from_robot_name("arm6")})
+    with pytest.raises(GeneratorError, match=r"unknown robot 'b'; robots: \['a'\]"):
+        composite({"a": gen}, placements={"b": (0, 0, 0)})
+    with pytest.raises(GeneratorError, match=r"attached to unknown robot 'z'; robots: \['a'\]"):
+        composite({"a": gen}, placements={"a": Placement(parent="z", frame="f")})
+    with pytest.raises(GeneratorError, match=r"placement of 'a': expected \(x, y, z\[, yaw\]\)"):
+        composite({"a": gen}, placements={"a": (1, 2)})
+    comp = composite([gen, gen], placements={"generator1": (1.0, 2.0, 3.0, 0.5)})
+    assert list(comp.generators) == ["generator0", "generator1"]
+    assert comp.placements["generator1"] == Placement((1.0, 2.0, 3.0), 0.5)
+
+
 def test_placement_validation():
     with pytest.raises(GeneratorError, match="3 finite numbers"):
         Placement((0.0, float("nan"), 0.0))

@@ -20,7 +20,7 @@ from typing import Any
 
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.mjcf_base import MJCFGeneratorBase, name_clashes
-from robotwright.generators.placement import Placement, compose, qrot
+from robotwright.generators.placement import Placement, compose, composite_members, qrot
 from robotwright.generators.xmlfmt import fmt_vec, prefixed
 from robotwright.hrdf.model import SimulatorConfig
 
@@ -148,39 +148,11 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
         simulator_config: SimulatorConfig | None = None,
     ) -> None:
         super().__init__(simulator_config=simulator_config)
-        if isinstance(generators, Mapping):
-            self.generators: dict[str, MJCFGeneratorBase] = dict(generators)
-        else:
-            self.generators = {f"generator{i}": g for i, g in enumerate(generators)}
-        if not self.generators:
-            raise GeneratorError("MJCFGeneratorComposite: no generators given")
-        for key, gen in self.generators.items():
-            if not isinstance(gen, MJCFGeneratorBase):
-                raise GeneratorError(
-                    f"MJCFGeneratorComposite: generator '{key}' is a {type(gen).__name__}, "
-                    "expected an MJCF generator"
-                )
-        self.placements: dict[str, Placement] = {}
-        for key, value in (placements or {}).items():
-            if key not in self.generators:
-                raise GeneratorError(
-                    f"placement for unknown robot '{key}'; robots: {list(self.generators)}"
-                )
-            if isinstance(value, Placement):
-                self.placements[key] = value
-            else:
-                v = [float(x) for x in value]
-                if len(v) not in (3, 4):
-                    raise GeneratorError(f"placement of '{key}': expected (x, y, z[, yaw])")
-                self.placements[key] = Placement(
-                    pos=(v[0], v[1], v[2]), yaw=v[3] if len(v) == 4 else 0.0
-                )
-        for key, p in self.placements.items():
-            if p.parent is not None and p.parent not in self.generators:
-                raise GeneratorError(
-                    f"robot '{key}' is attached to unknown robot '{p.parent}'; robots: "
-                    f"{list(self.generators)}"
-                )
+        self.generators: dict[str, MJCFGeneratorBase]
+        self.placements: dict[str, Placement]
+        self.generators, self.placements = composite_members(
+            "MJCFGeneratorComposite", generators, placements, MJCFGeneratorBase, "an MJCF generator"
+        )
         self._check_attach_cycles()
         self._own_simulator_config = simulator_config
 

@@ -14,7 +14,7 @@ from typing import Any
 
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mjcf import _report
-from robotwright.generators.placement import Placement
+from robotwright.generators.placement import Placement, composite_members
 from robotwright.generators.urdf import URDFHumanoidGenerator, _RobotWriter
 from robotwright.generators.urdf_base import WORLD_LINK, URDFGeneratorBase
 from robotwright.generators.xmlfmt import prefixed
@@ -38,34 +38,15 @@ class URDFGeneratorComposite(URDFGeneratorBase):
         name: str = "scene",
     ) -> None:
         super().__init__()
-        if isinstance(generators, Mapping):
-            self.generators: dict[str, URDFHumanoidGenerator] = dict(generators)
-        else:
-            self.generators = {f"generator{i}": g for i, g in enumerate(generators)}
-        if not self.generators:
-            raise GeneratorError("URDFGeneratorComposite: no generators given")
-        for key, gen in self.generators.items():
-            if not isinstance(gen, URDFHumanoidGenerator):
-                raise GeneratorError(
-                    f"URDFGeneratorComposite: generator '{key}' is a {type(gen).__name__}, "
-                    "expected a URDFHumanoidGenerator"
-                )
-        self.placements: dict[str, Placement] = {}
-        for key, value in (placements or {}).items():
-            if key not in self.generators:
-                raise GeneratorError(f"placement for unknown robot '{key}'")
-            if isinstance(value, Placement):
-                self.placements[key] = value
-            else:
-                v = [float(x) for x in value]
-                if len(v) not in (3, 4):
-                    raise GeneratorError(f"placement of '{key}': expected (x, y, z[, yaw])")
-                self.placements[key] = Placement(
-                    pos=(v[0], v[1], v[2]), yaw=v[3] if len(v) == 4 else 0.0
-                )
-        for key, p in self.placements.items():
-            if p.parent is not None and p.parent not in self.generators:
-                raise GeneratorError(f"robot '{key}' is attached to unknown robot '{p.parent}'")
+        self.generators: dict[str, URDFHumanoidGenerator]
+        self.placements: dict[str, Placement]
+        self.generators, self.placements = composite_members(
+            "URDFGeneratorComposite",
+            generators,
+            placements,
+            URDFHumanoidGenerator,
+            "a URDFHumanoidGenerator",
+        )
         self.name = name
 
     @property

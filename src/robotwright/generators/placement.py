@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 from robotwright.errors import GeneratorError
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
+G = TypeVar("G")
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,47 @@ class Placement:
         return cls(
             pos=(values[0], values[1], values[2]), yaw=values[3] if len(values) == 4 else 0.0
         )
+
+
+def composite_members(
+    owner: str,
+    generators: Mapping[str, G] | Sequence[G],
+    placements: Mapping[str, Placement | Sequence[float]] | None,
+    kind: type,
+    expected: str,
+) -> tuple[dict[str, G], dict[str, Placement]]:
+    """The robots of composite ``owner`` keyed (a sequence is keyed ``generator0``, ...)
+    and their placements (``(x, y, z[, yaw])`` tuples become :class:`Placement`), checked:
+    at least one robot, each an instance of ``kind`` (else "expected ``expected``"), and
+    every placement and attachment parent naming one of the robots."""
+    if isinstance(generators, Mapping):
+        gens = dict(generators)
+    else:
+        gens = {f"generator{i}": g for i, g in enumerate(generators)}
+    if not gens:
+        raise GeneratorError(f"{owner}: no generators given")
+    for key, gen in gens.items():
+        if not isinstance(gen, kind):
+            raise GeneratorError(
+                f"{owner}: generator '{key}' is a {type(gen).__name__}, expected {expected}"
+            )
+    placed: dict[str, Placement] = {}
+    for key, value in (placements or {}).items():
+        if key not in gens:
+            raise GeneratorError(f"placement for unknown robot '{key}'; robots: {list(gens)}")
+        if isinstance(value, Placement):
+            placed[key] = value
+        else:
+            v = [float(x) for x in value]
+            if len(v) not in (3, 4):
+                raise GeneratorError(f"placement of '{key}': expected (x, y, z[, yaw])")
+            placed[key] = Placement(pos=(v[0], v[1], v[2]), yaw=v[3] if len(v) == 4 else 0.0)
+    for key, p in placed.items():
+        if p.parent is not None and p.parent not in gens:
+            raise GeneratorError(
+                f"robot '{key}' is attached to unknown robot '{p.parent}'; robots: {list(gens)}"
+            )
+    return gens, placed
 
 
 def qmul(a: tuple[float, ...], b: tuple[float, ...]) -> Quat:
