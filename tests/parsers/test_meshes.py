@@ -11,7 +11,7 @@ import pytest
 import trimesh
 
 from robotwright.errors import ConversionError
-from robotwright.parsers import urdf_to_hrdf_with_warnings
+from robotwright.parsers import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
 from robotwright.parsers.meshes import obj_object_faces
 from robotwright.parsers.roundtrip import our_mjcf_model
 
@@ -43,12 +43,15 @@ def _mesh_model(file: Path) -> mujoco.MjModel:
     )
 
 
+TWO_TETS = (
+    TET_V + "v 1 0 0\nv 1.1 0 0\nv 1 0.1 0\nv 1 0 0.1\n"
+    "o a\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\no b\nf 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n"
+)
+
+
 def test_mujoco_reads_only_the_first_object_of_an_obj(tmp_path: Path) -> None:
     """The premise of the repair: MuJoCo keeps the first object's faces only."""
-    (tmp_path / "two.obj").write_text(
-        TET_V + "v 1 0 0\nv 1.1 0 0\nv 1 0.1 0\nv 1 0 0.1\n"
-        "o a\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\no b\nf 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n"
-    )
+    (tmp_path / "two.obj").write_text(TWO_TETS)
     assert _mesh_model(tmp_path / "two.obj").mesh_facenum[0] == 4
     (tmp_path / "split.obj").write_text(SPLIT_TET)
     with pytest.raises(ValueError, match="volume"):
@@ -116,3 +119,20 @@ def test_convert_and_roundtrip_commands_take_join_obj_objects(tmp_path: Path, ca
     assert main(["convert", str(path), "-o", str(out), "--join-obj-objects"]) == 0
     assert "joined into one STL" in capsys.readouterr().out
     assert mujoco.MjModel.from_xml_path(str(out)).mesh_facenum[0] == 4
+
+
+def test_mjcf_source_with_split_obj_reported_and_joined_by_option(tmp_path: Path) -> None:
+    (tmp_path / "two.obj").write_text(TWO_TETS)
+    path = tmp_path / "m.xml"
+    path.write_text(
+        '<mujoco><asset><mesh name="two" file="two.obj"/></asset><worldbody>'
+        '<body name="b"><joint/><geom type="mesh" mesh="two"/></body></worldbody></mujoco>'
+    )
+    hrdf, warnings = mjcf_to_hrdf_with_warnings(path, work_dir=tmp_path / "a")
+    assert any("reads the first only (4 of 8 faces)" in str(w) for w in warnings)
+    assert our_mjcf_model(hrdf).mesh_facenum[0] == 4  # as MuJoCo reads the source
+    hrdf, warnings = mjcf_to_hrdf_with_warnings(
+        path, work_dir=tmp_path / "b", join_obj_objects=True
+    )
+    assert any("two.obj': 2 objects (faces [4, 4])" in str(w) for w in warnings)
+    assert our_mjcf_model(hrdf).mesh_facenum[0] == 8
