@@ -8,6 +8,7 @@ import mujoco
 import pytest
 
 from robotwright.cli import main
+from robotwright.parsers.convert import convert
 
 
 def test_convert_mjcf_to_hrdf_to_urdf_and_mjcf(probe: Path, tmp_path: Path, capsys) -> None:
@@ -27,11 +28,16 @@ def test_convert_mjcf_to_hrdf_to_urdf_and_mjcf(probe: Path, tmp_path: Path, caps
     assert urdf.is_file()
 
 
-def test_convert_refuses_to_overwrite_and_unknown_types(probe: Path, tmp_path: Path) -> None:
+def test_convert_refuses_to_overwrite_and_unknown_types(
+    probe: Path, tmp_path: Path, capsys
+) -> None:
     out = tmp_path / "x.xml"
     out.write_text("keep me")
-    with pytest.raises(FileExistsError):
-        main(["convert", str(probe), "-o", str(out)])
+    # A clean exit 2 naming the file and the flag, not a FileExistsError traceback.
+    assert main(["convert", str(probe), "-o", str(out)]) == 2
+    assert f"{out} exists (pass overwrite=True / --overwrite)" in capsys.readouterr().err
+    with pytest.raises(FileExistsError):  # the library call still raises a FileExistsError
+        convert(probe, out)
     assert out.read_text() == "keep me"
     assert main(["convert", str(probe), "-o", str(tmp_path / "x.obj")]) == 2
 
@@ -74,3 +80,11 @@ def test_convert_keeps_massless_frame_link_or_merges_it(tmp_path: Path, capsys) 
     assert main(["convert", str(urdf), "-o", str(out), "--fixed-joints", "merge"]) == 0
     model = mujoco.MjModel.from_xml_path(str(out))
     assert model.site("tcp").id >= 0 and model.nbody == 3
+
+
+def test_convert_urdf_only_option_on_mjcf_source_is_named(probe: Path, tmp_path: Path, capsys):
+    out = tmp_path / "x.urdf"
+    assert main(["convert", str(probe), "-o", str(out), "--bound-mass", "0.01"]) == 2
+    err = capsys.readouterr().err
+    assert "bound_mass (--bound-mass) do not apply to a MJCF source" in err
+    assert "Traceback" not in err and not out.exists()

@@ -21,7 +21,7 @@ from typing import Any
 import yaml
 
 from robotwright._atomic import atomic_dir
-from robotwright.errors import HRDFError, Problem
+from robotwright.errors import HRDFError, OutputExistsError, Problem
 from robotwright.hrdf.model import (
     FORMAT_VERSION,
     HRDF,
@@ -818,7 +818,7 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
             (tmp / EXTRA_MJCF_FILE).write_text(hrdf.mjcf_extra, encoding="utf-8")
 
     if target.exists() and not overwrite:
-        raise FileExistsError(f"{target} exists (pass overwrite=True to replace it)")
+        raise OutputExistsError(f"{target} exists (pass overwrite=True to replace it)")
     with atomic_dir(target) as tmp:
         fill(tmp)
     return target

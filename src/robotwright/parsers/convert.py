@@ -13,7 +13,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from robotwright.errors import ConversionError, HRDFError, Problem
+from robotwright.errors import ConversionError, HRDFError, OutputExistsError, Problem
 from robotwright.hrdf.model import HRDF
 
 
@@ -38,9 +38,28 @@ def load_any(path: Path, *, strict: bool = False, **options: Any) -> tuple[HRDF,
     kind = file_kind(path, existing=True)
     if kind == "hrdf":
         return HRDF.from_dir(path), []
+    _check_options(path, kind, options)
     parse = urdf_to_hrdf_with_warnings if kind == "urdf" else mjcf_to_hrdf_with_warnings
     result = parse(path, strict=strict, **options)
     return result.hrdf, result.warnings
+
+
+def _check_options(path: Path, kind: str, options: dict[str, Any]) -> None:
+    """Name an option that does not apply to this kind of source (e.g. ``bound_mass``
+    for an MJCF) instead of failing inside the options dataclass with a TypeError."""
+    import dataclasses
+
+    from robotwright.parsers.mjcf import MJCFOptions
+    from robotwright.parsers.urdf import URDFOptions
+
+    cls = URDFOptions if kind == "urdf" else MJCFOptions
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(options) - known)
+    if unknown:
+        flags = ", ".join(f"{k} (--{k.replace('_', '-')})" for k in unknown)
+        raise ConversionError(
+            [Problem(str(path), f"option(s) {flags} do not apply to a {kind.upper()} source")]
+        )
 
 
 def convert(
@@ -58,7 +77,7 @@ def convert(
     src_p, dst_p = Path(src), Path(dst)
     out_kind = file_kind(dst_p, existing=False)
     if dst_p.exists() and not overwrite:
-        raise FileExistsError(f"{dst_p} exists (pass overwrite=True / --overwrite)")
+        raise OutputExistsError(f"{dst_p} exists (pass overwrite=True / --overwrite)")
     if "work_dir" in options or file_kind(src_p, existing=True) == "hrdf":
         return _convert(src_p, dst_p, out_kind, strict, overwrite, options)
     # The output gets its own copies of the meshes: staging lives only for the call.
