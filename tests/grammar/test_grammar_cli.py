@@ -121,3 +121,50 @@ def test_show_prints_tree_dh_and_dot(tmp_path, capsys):
     design.write_text("# grammar=srl\nr2 @0: C=universal(limit=1.5708)\n")
     assert main(["grammar", "show", str(design)]) == 2
     assert "step 0" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["search", "--budget", "-5"], "--budget: expected an integer >= 1, got -5"),
+        (["search", "--budget", "0"], "--budget: expected an integer >= 1, got 0"),
+        (["search", "--beam-width", "0"], "--beam-width: expected an integer >= 1, got 0"),
+        (["search", "--max-links", "-1"], "--max-links: expected an integer >= 0, got -1"),
+        (["search", "--workers", "0"], "--workers: expected an integer >= 1, got 0"),
+        (["sample", "-n", "0", "-o", "OUT"], "-n: expected an integer >= 1, got 0"),
+        (["sample", "--max-links", "-2", "-o", "OUT"], "expected an integer >= 0, got -2"),
+        (["count", "--max-links", "x"], "--max-links: expected an integer, got 'x'"),
+    ],
+)
+def test_bad_numbers_are_usage_errors(tmp_path, capsys, argv, expected):
+    argv = [str(tmp_path / "out") if a == "OUT" else a for a in argv]
+    with pytest.raises(SystemExit) as exc:
+        main(["grammar", *argv])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert expected in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_export_and_search_never_replace_a_file_or_a_foreign_folder(tmp_path, capsys):
+    assert (
+        main(["grammar", "sample", "--seed", "1", "-o", str(tmp_path / "s"), "--no-picture"]) == 0
+    )
+    design = next((tmp_path / "s").glob("*/design.txt"))
+    capsys.readouterr()
+    keep = tmp_path / "notes.txt"
+    keep.write_text("mine", encoding="utf-8")
+    foreign = tmp_path / "photos"
+    foreign.mkdir()
+    (foreign / "a.jpg").write_text("x", encoding="utf-8")
+    assert main(["grammar", "export", str(design), "-o", str(keep)]) == 2
+    assert "notes.txt: is a file; expected a folder for the design" in capsys.readouterr().err
+    assert main(["grammar", "export", str(design), "-o", str(foreign)]) == 2
+    assert "holds no design.txt: not replacing it" in capsys.readouterr().err
+    assert main(["grammar", "search", "--budget", "2", "-o", str(keep)]) == 2
+    assert main(["grammar", "sample", "-o", str(keep), "--no-picture"]) == 2
+    assert "is a file; expected a folder" in capsys.readouterr().err
+    assert keep.read_text(encoding="utf-8") == "mine"
+    assert [p.name for p in foreign.iterdir()] == ["a.jpg"]
+    # An earlier design folder is still replaced in place.
+    assert main(["grammar", "export", str(design), "-o", str(design.parent)]) == 0

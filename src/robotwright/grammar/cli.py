@@ -8,7 +8,45 @@ import sys
 import time
 from pathlib import Path
 
+from robotwright._atomic import check_output_path
 from robotwright.errors import GrammarError, Problem
+
+
+def _int_at_least(low: int):
+    """An argparse ``type`` for integers >= ``low`` (a usage error, exit 2, otherwise)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {value}")
+        return value
+
+    parse.__name__ = f"integer >= {low}"
+    return parse
+
+
+def _check_design_dir(out: Path) -> None:
+    """Refuse an output that would replace something that is not a design folder.
+
+    The design commands replace an earlier design folder in place; a file, or a
+    non-empty folder without ``design.txt``, is the user's data and is never replaced.
+    """
+    check_output_path(out, folder=True)
+    if out.exists() and not out.is_dir():
+        raise GrammarError([Problem(str(out), "is a file; expected a folder for the design")])
+    if out.is_dir() and any(out.iterdir()) and not (out / "design.txt").is_file():
+        raise GrammarError(
+            [
+                Problem(
+                    str(out),
+                    "folder is not empty and holds no design.txt: not replacing it; "
+                    "give a new or empty folder",
+                )
+            ]
+        )
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,7 +70,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     q = gsub.add_parser("count", help="exact number of designs up to a size")
     common(q)
-    q.add_argument("--max-links", type=int, required=True, help="largest number of links")
+    q.add_argument(
+        "--max-links", type=_int_at_least(0), required=True, help="largest number of links"
+    )
     q.add_argument(
         "--enumerate", action="store_true", help="also enumerate them and report the rate"
     )
@@ -41,8 +81,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     q = gsub.add_parser("sample", help="draw designs uniformly and write their files")
     common(q)
     q.add_argument("--seed", type=int, default=0)
-    q.add_argument("-n", type=int, default=1, help="number of designs")
-    q.add_argument("--max-links", type=int, default=4)
+    q.add_argument("-n", type=_int_at_least(1), default=1, help="number of designs")
+    q.add_argument("--max-links", type=_int_at_least(0), default=4)
     q.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     q.add_argument("--no-picture", action="store_true", help="skip the PNG pictures")
     q.set_defaults(func=_sample)
@@ -56,13 +96,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable",
     )
-    q.add_argument("--budget", type=int, default=100, help="designs to evaluate")
+    q.add_argument("--budget", type=_int_at_least(1), default=100, help="designs to evaluate")
     q.add_argument("--method", default="beam", choices=["beam", "mcts", "random"])
-    q.add_argument("--beam-width", type=int, default=4)
-    q.add_argument("--max-links", type=int, default=4)
+    q.add_argument("--beam-width", type=_int_at_least(1), default=4)
+    q.add_argument("--max-links", type=_int_at_least(0), default=4)
     q.add_argument("--seed", type=int, default=0)
     q.add_argument(
-        "--workers", type=int, default=None, help="worker processes (default: CPU count)"
+        "--workers",
+        type=_int_at_least(1),
+        default=None,
+        help="worker processes (default: CPU count)",
     )
     q.add_argument(
         "-o", "--out", type=Path, default=None, help="write the best design's files here"
@@ -143,6 +186,9 @@ def _sample(args: argparse.Namespace) -> int:
     g = _grammar(args)
     rng = random.Random(args.seed)
     counter = Counter(g)
+    check_output_path(args.out, folder=True)
+    if args.out.exists() and not args.out.is_dir():
+        raise GrammarError([Problem(str(args.out), "is a file; expected a folder for the designs")])
     args.out.mkdir(parents=True, exist_ok=True)
     for k in range(args.n):
         d = sample(g, args.max_links, rng, counter)
@@ -178,6 +224,8 @@ def _search(args: argparse.Namespace) -> int:
     from robotwright.grammar.search import beam_search, mcts_search, random_search
 
     g = _grammar(args)
+    if args.out:
+        _check_design_dir(args.out)
     try:
         constraints = [make_constraint(c) for c in (args.constraint or ["no-self-collision"])]
     except ValueError as exc:
@@ -265,6 +313,7 @@ def _export(args: argparse.Namespace) -> int:
     from robotwright.grammar.export import export_design
 
     g = _grammar(args)
+    _check_design_dir(args.out)
     d = _read_design(args.design)
     export_design(g, d, args.out, overwrite=True)
     print(f"{args.out}: {d.hash()}")
