@@ -32,3 +32,32 @@ def test_cli_converts_mjcf_and_hrdf(tmp_path, capsys):
     assert "arm.xml ->" in capsys.readouterr().out
     assert main(["things", str(tmp_path / "missing.xml"), str(tmp_path / "x.xml")]) == 2
     assert not (tmp_path / "x.xml").exists()
+
+
+def test_cli_bad_inputs_and_outputs_are_clear_errors(tmp_path, capsys):
+    src = tmp_path / "arm.xml"
+    src.write_text(_ARM)
+    urdf = tmp_path / "robot.xml"
+    urdf.write_text('<robot name="r"><link name="a"/></robot>')
+    plain = tmp_path / "plain.txt"
+    plain.write_text("keep")
+
+    # A URDF given as MJCF: MuJoCo would compile it into an empty world.
+    assert main(["things", str(urdf), str(tmp_path / "o.xml")]) == 2
+    assert "root element <robot>: expected <mujoco> (MJCF)" in capsys.readouterr().err
+    # Output under a file, output with an unknown extension, output folder already there.
+    assert main(["things", str(src), str(plain / "o.xml")]) == 2
+    assert "plain.txt is a file, not a folder" in capsys.readouterr().err
+    assert main(["things", str(src), str(tmp_path / "o.txt")]) == 2
+    assert "o.txt: expected a .xml file (MJCF) or a folder name" in capsys.readouterr().err
+    (tmp_path / "hrdf").mkdir()
+    (tmp_path / "hrdf" / "x").write_text("x")
+    assert main(["things", str(src), str(tmp_path / "hrdf")]) == 2
+    assert "hrdf exists (pass overwrite=True" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "arm.xml",
+        "hrdf",
+        "plain.txt",
+        "robot.xml",
+    ]
+    assert [p.name for p in (tmp_path / "hrdf").iterdir()] == ["x"]

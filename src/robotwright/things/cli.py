@@ -23,17 +23,25 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from robotwright._atomic import check_output_path
+    from robotwright.errors import OutputPathError
     from robotwright.hrdf import HRDF
     from robotwright.things import World, hrdf_to_world, things_to_hrdf
 
     source, output = Path(args.source), Path(args.output)
+    to_xml = output.suffix.lower() == ".xml"
+    if not to_xml and output.suffix and not output.is_dir():
+        raise OutputPathError(
+            f"{output}: expected a .xml file (MJCF) or a folder name without extension (HRDF)"
+        )
+    check_output_path(output, folder=not to_xml)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if source.is_dir():
             world = hrdf_to_world(HRDF.from_dir(source), strict=args.strict)
         else:
             world = World.from_xml_path(source, strict=args.strict)
-        if output.suffix.lower() == ".xml":
+        if to_xml:
             written = world.export(output)
         else:
             written = things_to_hrdf(world, strict=args.strict).save(output)

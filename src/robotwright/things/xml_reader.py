@@ -689,11 +689,17 @@ def _indent(node: ET.Element) -> str:
     return "  " + ET.tostring(node, encoding="unicode").strip()
 
 
-def _check_safe(text: str, source: str) -> None:
+def _check_safe(text: str | bytes, source: str) -> None:
     try:
-        SafeET.fromstring(text)
+        root = SafeET.fromstring(text)
     except Exception as exc:  # defusedxml raises several types; all mean "do not read"
         raise ThingXMLError(f"{source}: not readable as safe XML: {exc}") from None
+    # MuJoCo also compiles a URDF (<robot>) here, silently dropping what it cannot map.
+    if root.tag != "mujoco":
+        raise ThingXMLError(
+            f"{source}: root element <{root.tag}>: expected <mujoco> (MJCF); "
+            "convert a URDF first with 'robotwright convert'"
+        )
 
 
 def world_from_string(
@@ -715,7 +721,7 @@ def world_from_path(path: str | os.PathLike[str], strict: bool = False) -> World
     path = Path(path)
     if not path.is_file():
         raise ThingXMLError(f"{path}: no such MJCF file")
-    _check_safe(path.read_text(encoding="utf-8"), str(path))
+    _check_safe(path.read_bytes(), str(path))
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as exc:
