@@ -46,3 +46,19 @@ def test_every_subcommand_has_help() -> None:
 def test_help_exits_zero(cmd: str) -> None:
     out = run(cmd, "--help")
     assert out.returncode == 0 and "usage:" in out.stdout
+
+
+@pytest.mark.parametrize("command", ["validate", "info", "export"])
+def test_file_or_plain_folder_given_as_robot_is_named(tmp_path, capsys, command) -> None:
+    from robotwright.cli import main
+
+    (tmp_path / "robot.urdf").write_text("<robot name='r'/>", encoding="utf-8")
+    (tmp_path / "empty").mkdir()
+    extra = ["-o", str(tmp_path / "o.xml")] if command == "export" else []
+    assert main([command, str(tmp_path / "robot.urdf"), *extra]) == 2
+    err = capsys.readouterr().err
+    assert "robot.urdf: is a file; expected an HRDF folder (with meta.yaml)" in err
+    assert "robotwright convert" in err
+    assert main([command, str(tmp_path / "empty"), *extra]) == 2
+    assert "empty: not an HRDF folder: it has no meta.yaml" in capsys.readouterr().err
+    assert not (tmp_path / "o.xml").exists()

@@ -50,4 +50,22 @@ def resolve_robot(name_or_path: str | Path) -> Path:
     path = Path(name_or_path)
     if (path / "meta.yaml").is_file():
         return path
-    return find_robot(str(name_or_path))
+    try:
+        return find_robot(str(name_or_path))
+    except RobotNotFoundError:
+        # Something is there, so the user meant a path: say what is wrong with it
+        # rather than that no robot has this name.
+        if path.is_dir():
+            raise RobotNotFoundError(
+                f"{path}: not an HRDF folder: it has no meta.yaml (and no robot has this name)"
+            ) from None
+        if path.exists():
+            raise RobotNotFoundError(
+                f"{path}: is a file; expected an HRDF folder (with meta.yaml) or a robot name"
+                + (
+                    " (convert a URDF/MJCF first with 'robotwright convert')"
+                    if path.suffix.lower() in (".urdf", ".xml")
+                    else ""
+                )
+            ) from None
+        raise
