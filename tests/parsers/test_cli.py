@@ -88,3 +88,32 @@ def test_convert_urdf_only_option_on_mjcf_source_is_named(probe: Path, tmp_path:
     err = capsys.readouterr().err
     assert "bound_mass (--bound-mass) do not apply to a MJCF source" in err
     assert "Traceback" not in err and not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "expected"),
+    [
+        ("missing.urdf", None, "missing.urdf: file not found: expected a .urdf or .xml file"),
+        ("model.txt", "x", "model.txt: expected a .urdf or .xml (MJCF) file"),
+        ("empty.xml", "", "empty.xml: not well-formed XML: no element found"),
+        ("cut.urdf", "<robot name='r'><link name='a'>", "cut.urdf: not well-formed XML"),
+        (
+            "bomb.xml",
+            '<!DOCTYPE m [<!ENTITY a "aa"><!ENTITY b "&a;&a;">]><mujoco model="&b;"/>',
+            "bomb.xml: unsafe XML refused (EntitiesForbidden)",
+        ),
+    ],
+)
+def test_roundtrip_bad_input_is_exit_2_on_stderr(tmp_path, capsys, name, content, expected):
+    path = tmp_path / name
+    if content is not None:
+        path.write_text(content, encoding="utf-8")
+    assert main(["roundtrip", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert expected in captured.err and "Traceback" not in captured.err
+    assert captured.out == ""  # no half table
+
+
+def test_roundtrip_needs_at_least_one_configuration(probe: Path, capsys) -> None:
+    assert main(["roundtrip", str(probe), "--configs", "0"]) == 2
+    assert "configs: expected at least 1 configuration, got 0" in capsys.readouterr().err

@@ -24,6 +24,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
@@ -574,11 +575,33 @@ def roundtrip(
 
     ``reference``: ``"auto"`` (MuJoCo's import; yourdfpy for a URDF MuJoCo refuses),
     ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``options`` go to the parser. Staged
-    meshes live in a temporary folder removed at the end (unless ``work_dir`` is given)."""
+    meshes live in a temporary folder removed at the end (unless ``work_dir`` is given).
+
+    Raises:
+        ConversionError: the input itself is unusable (no such file, not a .urdf/.xml
+            file, not well-formed or unsafe XML, ``configs`` < 1); later failures
+            (parser, reference, compile) are reported in the table instead.
+    """
+    _check_input(Path(source), configs)
     if "work_dir" in options:
         return _roundtrip(Path(source), configs, urdf, reference, options)
     with tempfile.TemporaryDirectory(prefix="robotwright-rt-") as tmp:
         return _roundtrip(Path(source), configs, urdf, reference, {**options, "work_dir": tmp})
+
+
+def _check_input(path: Path, configs: int) -> None:
+    from robotwright.parsers.xmlsafe import parse_xml
+
+    if configs < 1:
+        raise ConversionError(
+            [Problem(str(path), f"configs: expected at least 1 configuration, got {configs}")]
+        )
+    if path.suffix.lower() not in (".urdf", ".xml", ".mjcf"):
+        raise ConversionError([Problem(str(path), "expected a .urdf or .xml (MJCF) file")])
+    if not path.is_file():
+        what = "is a folder" if path.is_dir() else "file not found"
+        raise ConversionError([Problem(str(path), f"{what}: expected a .urdf or .xml file")])
+    parse_xml(path)  # not well-formed or unsafe XML: an input error, named with its line
 
 
 def _roundtrip(
