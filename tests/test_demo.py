@@ -50,3 +50,16 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
     assert (out / "lidar" / "scan.png").stat().st_size > 20_000
     rt = (out / "robots" / "roundtrip_mini_humanoid_urdf.txt").read_text()
     assert "result:    PASS" in rt and "FAIL" not in rt
+
+
+def test_demo_output_that_is_a_file_is_a_clear_error(tmp_path: Path, capsys) -> None:
+    from robotwright.cli import main
+
+    plain = tmp_path / "plain.txt"
+    plain.write_text("keep", encoding="utf-8")
+    assert main(["demo", "-o", str(plain)]) == 2
+    assert "plain.txt: is a file; expected a folder for the demo output" in capsys.readouterr().err
+    assert main(["demo", "-o", str(plain / "sub")]) == 2
+    assert "plain.txt is a file, not a folder" in capsys.readouterr().err
+    assert plain.read_text(encoding="utf-8") == "keep"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain.txt"]

@@ -240,6 +240,13 @@ def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from robotwright._atomic import check_output_path
+    from robotwright.errors import OutputPathError
+
+    # Checked before the first step, so a wrong -o fails at once and writes nothing.
+    check_output_path(args.out, folder=True)
+    if args.out.exists() and not args.out.is_dir():
+        raise OutputPathError(f"{args.out}: is a file; expected a folder for the demo output")
     run_demo(args.out)
     print(f"demo written to {args.out.resolve()} (summary.json, conversion_notes.txt)")
     return 0
