@@ -65,11 +65,26 @@ def test_export_prints_conversion_notes_as_warnings(tmp_path, capsys):
 
 @pytest.mark.parametrize("command", ["export", "compose"])
 def test_output_that_is_a_folder_or_under_a_file_is_a_clear_error(tmp_path, capsys, command):
-    (tmp_path / "taken").mkdir()
+    (tmp_path / "taken.xml").mkdir()
     (tmp_path / "plain.txt").write_text("keep", encoding="utf-8")
-    assert main([command, "arm6", "-o", str(tmp_path / "taken")]) == 2
-    assert "taken: is a folder; expected the path of a file" in capsys.readouterr().err
+    assert main([command, "arm6", "-o", str(tmp_path / "taken.xml")]) == 2
+    assert "taken.xml: is a folder; expected the path of a file" in capsys.readouterr().err
     assert main([command, "arm6", "-o", str(tmp_path / "plain.txt" / "out.xml")]) == 2
     assert "plain.txt is a file, not a folder" in capsys.readouterr().err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain.txt", "taken"]
-    assert not any((tmp_path / "taken").iterdir())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain.txt", "taken.xml"]
+    assert not any((tmp_path / "taken.xml").iterdir())
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["export", "arm6", "-o", "OUT/a.txt"], "expected a file name ending in .xml or .mjcf"),
+        (["export", "arm6", "--format", "urdf", "-o", "OUT/a.sdf"], "ending in .urdf or .xml"),
+        (["compose", "arm6", "-o", "OUT/scene"], "got '(none)'"),
+    ],
+)
+def test_wrong_output_extension_is_refused(tmp_path, capsys, argv, expected):
+    argv = [a.replace("OUT", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    assert expected in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

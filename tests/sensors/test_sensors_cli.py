@@ -153,3 +153,13 @@ def test_cli_refuses_xml_entities_and_bad_view_radius(tmp_path, capsys):
     assert rc == 2
     assert "--view-radius: expected a positive distance" in capsys.readouterr().err
     assert not (tmp_path / "s.npz").exists() and not (tmp_path / "s.png").exists()
+
+
+def test_cli_wrong_output_extensions_are_refused(tmp_path, capsys):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(CLUTTER_XML, encoding="utf-8")
+    assert main(["lidar", str(scene), "--sensor", "lidar", "-o", str(tmp_path / "s.txt")]) == 2
+    assert "-o " in (err := capsys.readouterr().err) and "ending in .npz" in err
+    assert main(["lidar", str(scene), "--sensor", "lidar", "--png", str(tmp_path / "s.npz")]) == 2
+    assert "--png" in (err := capsys.readouterr().err) and "ending in .png" in err
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.xml"]

@@ -49,6 +49,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_compose)
 
 
+#: File name endings accepted per output format (URDF is often saved as .xml too).
+_EXTENSIONS = {"mjcf": (".xml", ".mjcf"), "urdf": (".urdf", ".xml")}
+
+
+def _check_extension(output: str, fmt: str) -> None:
+    suffix = Path(output).suffix.lower()
+    if suffix not in _EXTENSIONS[fmt]:
+        raise GeneratorError(
+            f"{output}: expected a file name ending in {' or '.join(_EXTENSIONS[fmt])} "
+            f"for --format {fmt}, got '{suffix or '(none)'}'"
+        )
+
+
 def _print_warnings(caught: list[warnings.WarningMessage]) -> None:
     for w in caught:
         print(f"warning: {w.message}", file=sys.stderr)
@@ -63,6 +76,7 @@ def _export(args: argparse.Namespace) -> int:
 
 
 def _export_quiet(args: argparse.Namespace) -> int:
+    _check_extension(args.output, args.format)
     hrdf = load_robot(args.robot)
     out = Path(args.output)
     if args.format == "mjcf":
@@ -110,6 +124,7 @@ def _compose(args: argparse.Namespace) -> int:
 
 
 def _compose_quiet(args: argparse.Namespace) -> int:
+    _check_extension(args.output, args.format)
     robots: list[tuple[str, object]] = []
     placements: dict[str, Placement] = {}
     used: dict[str, int] = {}

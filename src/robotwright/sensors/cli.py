@@ -73,8 +73,10 @@ def run(args: argparse.Namespace) -> int:
             f"--view-radius: expected a positive distance [m], got {args.view_radius}"
         )
     # Both outputs are checked before the scan, so a bad --png leaves no .npz behind.
-    for out in (args.output, args.png):
+    for out, ext, flag in ((args.output, ".npz", "-o"), (args.png, ".png", "--png")):
         if out is not None:
+            if out.suffix.lower() != ext:
+                raise SensorError(f"{flag} {out}: expected a file name ending in {ext}")
             check_output_path(out)
             if not out.parent.is_dir():
                 raise SensorError(f"{out}: folder {out.parent} does not exist")
