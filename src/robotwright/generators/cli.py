@@ -6,6 +6,7 @@ import argparse
 import re
 import sys
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 from robotwright.errors import GeneratorError
@@ -32,7 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--copy-meshes", action="store_true", help="copy meshes next to the output file")
     p.add_argument("--strict", action="store_true", help="fail instead of warning on losses")
     p.add_argument("-o", "--output", required=True, help="output file")
-    p.set_defaults(func=_export)
+    p.set_defaults(func=_printing_warnings(_export_quiet))
 
     p = sub.add_parser(
         "compose",
@@ -46,7 +47,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")
     p.add_argument("--copy-meshes", action="store_true", help="copy meshes next to the output file")
     p.add_argument("-o", "--output", required=True, help="output scene file")
-    p.set_defaults(func=_compose)
+    p.set_defaults(func=_printing_warnings(_compose_quiet))
 
 
 #: File name endings accepted per output format (URDF is often saved as .xml too).
@@ -62,17 +63,20 @@ def _check_extension(output: str, fmt: str) -> None:
         )
 
 
-def _print_warnings(caught: list[warnings.WarningMessage]) -> None:
-    for w in caught:
-        print(f"warning: {w.message}", file=sys.stderr)
+def _printing_warnings(
+    run: Callable[[argparse.Namespace], int],
+) -> Callable[[argparse.Namespace], int]:
+    """``run`` with the conversion warnings it raises printed to stderr, once each."""
 
+    def wrapped(args: argparse.Namespace) -> int:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            code = run(args)
+        for w in caught:
+            print(f"warning: {w.message}", file=sys.stderr)
+        return code
 
-def _export(args: argparse.Namespace) -> int:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        code = _export_quiet(args)
-    _print_warnings(caught)
-    return code
+    return wrapped
 
 
 def _export_quiet(args: argparse.Namespace) -> int:
@@ -113,14 +117,6 @@ def parse_robot_spec(spec: str) -> tuple[str | None, str, Placement | None]:
     if not spec:
         raise GeneratorError(f"robot spec '{spec}': empty robot name")
     return key, spec, placement
-
-
-def _compose(args: argparse.Namespace) -> int:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        code = _compose_quiet(args)
-    _print_warnings(caught)
-    return code
 
 
 def _compose_quiet(args: argparse.Namespace) -> int:

@@ -93,9 +93,7 @@ class URDFGeneratorComposite(URDFGeneratorBase):
             gen = self.generators[key]
             hrdf = gen.loaded_hrdf
             losses: list[Problem] = []
-            writer = _RobotWriter(
-                self, hrdf, key, add_mujoco_tag, relative_mesh_path, losses, robot_gen=gen
-            )
+            writer = _RobotWriter(self, hrdf, key, relative_mesh_path, losses, robot_gen=gen)
             p = self.placements.get(key)
             if p is not None and p.parent is not None:
                 parent_link = prefixed(p.parent, p.frame or "")

@@ -131,7 +131,7 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
             ET.SubElement(mj, "compiler", self.mujoco_compiler_attrs())
         if world_link:
             ET.SubElement(root, "link", {"name": WORLD_LINK})
-        writer = _RobotWriter(self, hrdf, prefix, add_mujoco_tag, relative_mesh_path, losses)
+        writer = _RobotWriter(self, hrdf, prefix, relative_mesh_path, losses)
         writer.write(root)
         self.dummy_links = dict(writer.dummy_links)
         self.frame_links = {k: writer.p(v) for k, v in writer.frame_links.items()}
@@ -146,7 +146,6 @@ class _RobotWriter:
         gen: URDFHumanoidGenerator | URDFGeneratorBase,
         hrdf: HRDF,
         prefix: str | None,
-        for_mujoco: bool,
         relative: bool,
         losses: list[Problem],
         robot_gen: URDFHumanoidGenerator | None = None,
@@ -155,7 +154,7 @@ class _RobotWriter:
         owner = robot_gen if robot_gen is not None else gen
         assert isinstance(owner, URDFHumanoidGenerator)
         self.mesh_path = owner.mesh_abspath
-        self.for_mujoco, self.relative, self.losses = for_mujoco, relative, losses
+        self.relative, self.losses = relative, losses
         self.materials: dict[tuple[float, ...], str] = {}
         self.mesh_refs: dict[str, str] = {}
         # Names already used per kind; generated names avoid them (see _fresh).

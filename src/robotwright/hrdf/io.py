@@ -79,7 +79,6 @@ _KNOWN_FILES = frozenset(
 
 # libyaml's loader is ~20x faster than the pure-Python one; both are "safe" loaders.
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-_YAML_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
 
 class HRDFWarning(UserWarning):
