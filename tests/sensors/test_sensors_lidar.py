@@ -15,7 +15,8 @@ from robotwright.sensors import GridPatternCfg, LidarCfg, LidarSensor, LivoxPatt
 AXES = [(1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0), (0, 0, -1), (0, 0, 1)]
 # +x sphere surface at 2.5, +y box face at 2.5, -x capsule at 2.8, -y cube mesh at 2.5,
 # floor 1 below, nothing above.
-EXPECTED = [2.5, 2.5, 2.8, 2.5, 1.0, math.inf]
+MISS = 100.0  # a miss reads max_distance by default (finite observations)
+EXPECTED = [2.5, 2.5, 2.8, 2.5, 1.0, MISS]
 EXPECTED_GEOMS = ["ball", "crate_geom", "pillar_geom", "cube", "floor", None]
 
 
@@ -27,7 +28,7 @@ def test_primitive_and_mesh_distances_are_exact(analytic_model, threads):
     dist = sensor.get_distances()
     assert dist.shape == (1, 6)
     np.testing.assert_allclose(dist[0, :5], EXPECTED[:5], atol=1e-6, rtol=0)
-    assert dist[0, 5] == math.inf  # miss
+    assert dist[0, 5] == MISS  # miss
     pts = sensor.get_pointcloud()
     np.testing.assert_allclose(pts[0, 0], [2.5, 0, 0], atol=1e-6)
     np.testing.assert_allclose(pts[0, 4], [0, 0, -1], atol=1e-6)
@@ -94,7 +95,8 @@ def test_mesh_prim_paths_select_geoms(analytic_model):
     sensor.update()
     d = sensor.get_distances()[0]
     np.testing.assert_allclose(d[:2], [2.5, 2.5], atol=1e-6)
-    assert np.isinf(d[2:]).all()  # capsule, mesh, floor not selected
+    assert (d[2:] == MISS).all()  # capsule, mesh, floor not selected
+    assert not sensor.get_hit_mask()[0, 2:].any()
     with pytest.raises(SensorError, match="'sofa\\*' matches no geom or body"):
         LidarSensor(
             LidarCfg(prim_path="lidar_site", mesh_prim_paths=["sofa*"]), analytic_model, data
@@ -180,7 +182,8 @@ def test_offset_pose(analytic_model):
     np.testing.assert_allclose(s.data.pos_w[0], [0, 0, 1], atol=1e-12)
     np.testing.assert_allclose(s.data.quat_w[0], [c, 0, 0, c], atol=1e-12)
     d = s.get_distances()[0]
-    assert np.isinf(d[0])  # the box top is at z=0.5, the ray at z=1 passes over it
+    # The box top is at z=0.5, the ray at z=1 passes over it.
+    assert d[0] == MISS and not s.get_hit_mask()[0, 0]
     np.testing.assert_allclose(d[1], 2.0, atol=1e-9)
     np.testing.assert_allclose(s.get_pointcloud(frame="sensor")[0, 1], [0, 0, -2.0], atol=1e-9)
 
@@ -204,8 +207,8 @@ def test_noise_and_dropout_are_seeded_and_keep_misses(analytic_model):
     np.testing.assert_array_equal(a.get_distances(), b.get_distances())
     d, hit = a.get_distances()[0], a.get_hit_mask()[0]
     up = np.arange(dirs.shape[0]) % 6 == 5
-    assert not hit[up].any() and np.isinf(d[up]).all()  # misses stay misses, noise or not
-    assert np.isinf(d[~hit]).all() and np.isfinite(d[hit]).all()
+    assert not hit[up].any() and (d[up] == MISS).all()  # misses stay misses, noise or not
+    assert (d[~hit] == MISS).all() and (d[hit] < 3.0).all()
     expected = np.tile(EXPECTED, 2000)
     err = d[hit] - expected[hit]
     assert abs(err.mean()) < 0.01 * 5 / math.sqrt(err.size)

@@ -39,7 +39,7 @@ def test_labels_from_names_default_mapping(clutter_model):
     # Unnamed geoms classified through their body path.
     body = mujoco.mj_name2id(clutter_model, mujoco.mjtObj.mjOBJ_BODY, "tomato_soup_can_1")
     g = int(np.flatnonzero(clutter_model.geom_bodyid == body)[0])
-    assert sensor.geom_path(g) == f"/world/tomato_soup_can_1/geom{g}"
+    assert sensor.geom_path(g) == f"/world/tomato_soup_can_1/geom{g}_cylinder"
     assert sensor.mesh_id_to_semantic_class[g] == 2
     # The robot's own geoms are not hittable, so not in the map.
     assert geom_id(clutter_model, "base") not in sensor.mesh_id_to_semantic_class

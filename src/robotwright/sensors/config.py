@@ -40,7 +40,10 @@ class LidarCfg:
     """Configuration of a :class:`~robotwright.sensors.LidarSensor` on a MuJoCo model.
 
     Attributes:
-        prim_path: name of the MuJoCo body or site that carries the sensor.
+        prim_path: name of the MuJoCo body or site that carries the sensor. Isaac Lab
+            style paths are accepted: ``"{ENV_REGEX_NS}/Robot/base"`` finds a body or
+            site named ``Robot/base``, else ``base`` (each MuJoCo world is one
+            environment, so the namespace is implied), case-insensitively if need be.
         pattern_cfg: the scan pattern (sensor frame: +x forward, +z up).
         offset_pos: sensor position in the carrier's frame [m].
         offset_rot: sensor orientation in the carrier's frame, quaternion (w, x, y, z).
@@ -49,9 +52,11 @@ class LidarCfg:
             pitches or rolls); ``"world"`` rays keep their pattern directions in the
             world frame. The origin always follows the sensor.
         mesh_prim_paths: which geoms rays may hit: shell-style patterns (``fnmatch``,
-            case-sensitive) matched against geom names, body names and geom paths
+            case-insensitive) matched against geom names, body names and geom paths
             (``/world/.../body/geom``); a body pattern selects all geoms of the bodies it
-            matches. Empty (default): every geom of the model.
+            matches. ``{ENV_REGEX_NS}`` at the start stands for any prefix, so the
+            seed's ``"{ENV_REGEX_NS}/cracker_box_0/_03_cracker_box"`` and
+            ``"/World/ground"`` work as written. Empty (default): every geom.
         exclude_robot: drop the geoms of the robot carrying the sensor (every body
             under the same root body as the carrier) from the hittable set.
         min_distance: hits closer than this are misses [m].
@@ -59,12 +64,17 @@ class LidarCfg:
         range_noise_std: standard deviation of Gaussian range noise added to hits [m].
         dropout_prob: probability that a ray returns nothing (becomes a miss).
         seed: seed of the noise and dropout generator (``None``: fresh entropy).
-        miss_distance: distance reported for misses (default ``inf``); points of misses
-            are NaN and ``data.hit_mask`` is False for them whatever this value.
+        miss_distance: distance reported for misses; ``None`` (default) means
+            ``max_distance``, so observations never hold ``inf``. Points of misses are
+            NaN and ``data.hit_mask`` is False for them whatever this value.
         engine: ``"mujoco"`` (``mj_multiRay`` on CPU threads, the reference) or
             ``"warp"`` (mujoco-warp batched rays with a BVH; needs ``robotwright[warp]``).
         device: warp device (``"cpu"``, ``"cuda"``, ``"cuda:0"``); ``None`` picks CUDA
             when present, else CPU. Ignored by the ``"mujoco"`` engine.
+        output: what ``data`` and the getters hold: ``"numpy"`` (host copies, float64),
+            ``"torch"`` (zero-copy tensors on the sensor's device, float32 / int32 /
+            bool) or ``"warp"`` (the device arrays themselves). Torch and warp outputs
+            need ``engine="warp"`` and are overwritten in place by every update.
         num_threads: CPU threads of the ``"mujoco"`` engine; ``None``: one per core.
     """
 
@@ -80,10 +90,11 @@ class LidarCfg:
     range_noise_std: float = 0.0
     dropout_prob: float = 0.0
     seed: int | None = 0
-    miss_distance: float = math.inf
+    miss_distance: float | None = None
     engine: Literal["mujoco", "warp"] = "mujoco"
     device: str | None = None
     num_threads: int | None = None
+    output: Literal["numpy", "torch", "warp"] = "numpy"
 
     def __post_init__(self) -> None:
         name = type(self).__name__
@@ -130,8 +141,23 @@ class LidarCfg:
             raise SensorError(
                 f"{name}.dropout_prob: expected a probability in [0, 1], got {self.dropout_prob}"
             )
+        if self.miss_distance is None:
+            self.miss_distance = float(self.max_distance)
+        elif not isinstance(self.miss_distance, (int, float)) or math.isnan(self.miss_distance):
+            raise SensorError(
+                f"{name}.miss_distance: expected a number [m] or None, got {self.miss_distance!r}"
+            )
         if self.engine not in ("mujoco", "warp"):
             raise SensorError(f"{name}.engine: expected 'mujoco' or 'warp', got {self.engine!r}")
+        if self.output not in ("numpy", "torch", "warp"):
+            raise SensorError(
+                f"{name}.output: expected 'numpy', 'torch' or 'warp', got {self.output!r}"
+            )
+        if self.output != "numpy" and self.engine != "warp":
+            raise SensorError(
+                f"{name}.output={self.output!r} needs engine='warp' (device buffers); "
+                "the mujoco engine returns numpy"
+            )
         if self.num_threads is not None and (
             not isinstance(self.num_threads, int) or self.num_threads < 1
         ):

@@ -3,12 +3,17 @@
 Frames: ray origins, directions and hit points are in the world frame unless stated;
 distances in metres along unit ray directions; quaternions (w, x, y, z).
 
-What a miss returns: ``distance = cfg.miss_distance`` (``inf`` by default), the point is
-``(nan, nan, nan)``, ``data.hit_mask`` is False (and, for the semantic sensor, label 0
-and mesh id -1). A ray is a miss when it hits nothing hittable, when its hit is nearer
+What a miss returns: ``distance = cfg.miss_distance`` (``max_distance`` by default, so
+observations stay finite), the point is ``(nan, nan, nan)``, ``data.hit_mask`` is False
+(and, for the semantic sensor, label 0 and mesh id -1). A ray is a miss when it hits nothing hittable, when its hit is nearer
 than ``min_distance`` or further than ``max_distance``, or when dropout removes it.
 Noise is added to hits only and the noisy range is clipped to
-``[min_distance, max_distance]``, so a hit never turns into a miss value by noise.
+``[min_distance, max_distance]``, so a hit never turns into a miss by noise.
+
+Two pipelines: ``engine="mujoco"`` works on the host in numpy (float64, the reference);
+``engine="warp"`` keeps every step of a frame on the warp device
+(:class:`~robotwright.sensors.device.WarpLidarPipeline`) and hands out its buffers as
+numpy copies, zero-copy torch tensors or warp arrays (``cfg.output``).
 """
 
 from __future__ import annotations
@@ -17,24 +22,34 @@ import difflib
 import fnmatch
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
 
 from robotwright.errors import SensorError
 from robotwright.sensors.config import LidarCfg
-from robotwright.sensors.raycast import MujocoRayEngine, WarpRayEngine, make_ray_model
+from robotwright.sensors.device import RangeModel, WarpLidarPipeline
+from robotwright.sensors.raycast import MujocoRayEngine, make_ray_model
 
 if TYPE_CHECKING:  # the warp extra is optional
     from mujoco_warp import Data as WarpData
 
-__all__ = ["LidarSensor", "LidarSensorData", "geom_paths"]
+__all__ = ["LidarSensor", "LidarSensorData", "geom_paths", "prim_path_candidates"]
+
+#: Environment namespaces of Isaac Lab style paths; each MuJoCo world is one environment,
+#: so they are dropped from ``prim_path`` and stand for "any prefix" in ``mesh_prim_paths``.
+_ENV_NAMESPACES = ("{ENV_REGEX_NS}", "/World/envs/env_.*", "/World/envs/env_*")
 
 
 @dataclass
 class LidarSensorData:
-    """Buffers of the last :meth:`LidarSensor.update` (numpy, one row per environment).
+    """Buffers of the last :meth:`LidarSensor.update`, one row per environment.
+
+    With ``cfg.output="numpy"`` every field is a numpy array (float64). With ``"torch"``
+    or ``"warp"`` (warp engine) every field is a zero-copy view of the device buffers
+    (float32, labels int32, mask bool): the same objects after every update, overwritten
+    in place, like mjlab's sensor data.
 
     Attributes:
         pos_w: ``(E, 3)`` sensor position, world frame [m].
@@ -90,7 +105,12 @@ class LidarSensorData:
         return self._cache["points"]
 
     def _invalidate(self) -> None:
-        self._cache.clear()
+        if not self._cache.get("device_views", False):
+            self._cache.clear()
+
+    def _set_device_views(self, origins: Any, directions: Any, points: Any) -> None:
+        """Device outputs: world rays and points are buffers too, not host computations."""
+        self._cache.update(origins=origins, dirs=directions, points=points, device_views=True)
 
 
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, idx: int, fallback: str) -> str:
@@ -105,10 +125,20 @@ def _body_chain(model: mujoco.MjModel, body: int) -> list[int]:
     return chain[::-1]
 
 
+def _geom_name(model: mujoco.MjModel, g: int) -> str:
+    """A geom's name; an unnamed one is ``geom<id>_<type>`` (e.g. ``geom0_plane``)."""
+    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g)
+    if name:
+        return name
+    kind = mujoco.mjtGeom(int(model.geom_type[g])).name.removeprefix("mjGEOM_").lower()
+    return f"geom{g}_{kind}"
+
+
 def geom_paths(model: mujoco.MjModel, with_mesh: bool = True) -> list[str]:
     """Path of every geom: ``/world/<body>/.../<geom>`` (``+ /<mesh>`` for mesh geoms).
 
-    Unnamed bodies and geoms appear as ``body<id>`` / ``geom<id>``.
+    Unnamed bodies appear as ``body<id>``; unnamed geoms as ``geom<id>_<type>``, so an
+    unnamed ``<geom type="plane">`` is classified as terrain by the default mapping.
     """
     paths = []
     for g in range(model.ngeom):
@@ -117,7 +147,7 @@ def geom_paths(model: mujoco.MjModel, with_mesh: bool = True) -> list[str]:
             _name(model, mujoco.mjtObj.mjOBJ_BODY, b, "body")
             for b in _body_chain(model, int(model.geom_bodyid[g]))
         ]
-        parts.append(_name(model, mujoco.mjtObj.mjOBJ_GEOM, g, "geom"))
+        parts.append(_geom_name(model, g))
         if (
             with_mesh
             and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH
@@ -126,6 +156,36 @@ def geom_paths(model: mujoco.MjModel, with_mesh: bool = True) -> list[str]:
             parts.append(_name(model, mujoco.mjtObj.mjOBJ_MESH, int(model.geom_dataid[g]), "mesh"))
         paths.append("/".join(parts))
     return paths
+
+
+def prim_path_candidates(prim_path: str) -> list[str]:
+    """Names a (possibly Isaac Lab style) ``prim_path`` may stand for, most specific first.
+
+    ``"{ENV_REGEX_NS}/Robot/base"`` gives ``["Robot/base", "base"]``: the environment
+    namespace is dropped (each MuJoCo world is one environment), then the path itself is
+    tried (mjlab names bodies ``<entity>/<body>``), then ever shorter tails of it.
+    """
+    path = prim_path
+    for ns in _ENV_NAMESPACES:
+        if path.startswith(ns):
+            path = path[len(ns) :]
+            break
+    if path.lower().startswith("/world/"):
+        path = path[len("/world/") :]
+    parts = [p for p in path.split("/") if p]
+    if not parts:
+        return [prim_path]
+    out = [prim_path] if prim_path != "/".join(parts) else []
+    out += ["/".join(parts[k:]) for k in range(len(parts))]
+    return out
+
+
+def _mesh_pattern(pattern: str) -> str:
+    """A ``mesh_prim_paths`` entry as a lower-case ``fnmatch`` pattern over geom paths."""
+    for ns in _ENV_NAMESPACES:
+        if pattern.startswith(ns):
+            return ("/world*" + pattern[len(ns) :]).lower()
+    return pattern.lower()
 
 
 def _is_warp_data(data: object) -> bool:
@@ -148,9 +208,9 @@ class LidarSensor:
         model: the compiled model (shared by every environment).
         data: one ``MjData`` or a list of them, one per environment, or a
             ``mujoco_warp.Data`` holding every environment on the warp device (with
-            ``engine="warp"``; then geom poses never leave the device). :meth:`update`
-            reads the poses they hold (as left by ``mj_step``/``mj_forward`` or
-            ``mujoco_warp.step``/``kinematics``); it never writes to them.
+            ``engine="warp"``; then it is read in place and nothing leaves the device).
+            :meth:`update` reads the poses they hold (as left by ``mj_step``/
+            ``mj_forward`` or ``mujoco_warp.step``/``kinematics``); it never writes them.
 
     Example:
         >>> sensor = LidarSensor(LidarCfg(prim_path="lidar_site"), model, data)
@@ -168,6 +228,8 @@ class LidarSensor:
     ) -> None:
         if not isinstance(cfg, LidarCfg):
             raise SensorError(f"cfg: expected a LidarCfg, got {type(cfg).__name__}")
+        if not isinstance(model, mujoco.MjModel):
+            raise SensorError(f"model: expected a mujoco.MjModel, got {type(model).__name__}")
         self.cfg = cfg
         self.model = model
         # A mujoco_warp.Data (all worlds on the warp device) or host MjData, one per env.
@@ -178,11 +240,6 @@ class LidarSensor:
             if cfg.engine != "warp":
                 raise SensorError(
                     "data is a mujoco_warp.Data: set engine='warp' (the mujoco engine needs MjData)"
-                )
-            if tuple(data.geom_xpos.shape) != (self._num_envs, model.ngeom):
-                raise SensorError(
-                    f"data: expected a mujoco_warp.Data of this model ({model.ngeom} geoms), "
-                    f"got geom_xpos of shape {tuple(data.geom_xpos.shape)}"
                 )
         else:
             self._datas = [data] if isinstance(data, mujoco.MjData) else list(data)
@@ -206,22 +263,41 @@ class LidarSensor:
         self._geom_paths = geom_paths(model)
         self.hittable_geom_mask = self._select_geoms()
         self._ray_model = make_ray_model(model, self.hittable_geom_mask)
-        if cfg.engine == "warp":
-            self._engine: MujocoRayEngine | WarpRayEngine = WarpRayEngine(
-                self._ray_model, self.num_envs, cfg.device
-            )
-        else:
-            self._engine = MujocoRayEngine(self._ray_model, cfg.num_threads)
+        self._table = cfg.pattern_cfg.ray_table()
+        self._single_origin = self._table.single_origin
+        self.num_rays = int(self._table.rays_per_frame)
         self._offset_mat = _quat_to_mat(cfg.offset_rot)
         self._offset_pos = np.asarray(cfg.offset_pos, dtype=np.float64)
-        self._rng = np.random.default_rng(cfg.seed)
         self._frame = -1
-        self._pattern_cache: tuple[np.ndarray, np.ndarray] | None = None
-        origins, _ = self._pattern(0)
-        self._single_origin = bool(np.all(origins == 0.0))
-        self.num_rays = int(origins.shape[0])
-        if self.num_rays == 0:
-            raise SensorError(f"{type(cfg.pattern_cfg).__name__}: empty pattern (0 rays)")
+        self._label_lut: np.ndarray | None = None
+        self._initialize_warp_meshes()
+        self._pipeline: WarpLidarPipeline | None = None
+        self._engine: MujocoRayEngine | None = None
+        if cfg.engine == "warp":
+            self._pipeline = WarpLidarPipeline(
+                self._ray_model,
+                self.num_envs,
+                cfg.device,
+                self._table,
+                (self._carrier_kind, self._carrier_id),
+                self._offset_pos,
+                self._offset_mat,
+                cfg.ray_alignment,
+                RangeModel(
+                    min_distance=float(cfg.min_distance),
+                    max_distance=float(cfg.max_distance),
+                    noise_std=float(cfg.range_noise_std),
+                    dropout_prob=float(cfg.dropout_prob),
+                    miss_distance=float(cfg.miss_distance),
+                    seed=cfg.seed,
+                ),
+                self._label_lut,
+            )
+            if self._warp_data is not None:
+                self._pipeline.check_data(self._warp_data)
+        else:
+            self._engine = MujocoRayEngine(self._ray_model, cfg.num_threads)
+            self._rng = np.random.default_rng(cfg.seed)
         self._raw_geom_ids = np.full((self.num_envs, self.num_rays), -1, dtype=np.int32)
         self._data = self._make_data()
 
@@ -242,18 +318,29 @@ class LidarSensor:
 
     @property
     def engine_name(self) -> str:
-        return self._engine.name
+        return self.cfg.engine
+
+    @property
+    def device(self) -> str:
+        """Where the sensor computes: ``"cpu"`` for the mujoco engine, else the warp device."""
+        return "cpu" if self._pipeline is None else str(self._pipeline.device)
 
     def _resolve_carrier(self, name: str) -> tuple[str, int, int]:
         m = self.model
-        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
-        if body >= 0:
-            return "body", body, body
-        site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
-        if site >= 0:
-            return "site", site, int(m.site_bodyid[site])
+        for candidate in prim_path_candidates(name):
+            body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, candidate)
+            if body >= 0:
+                return "body", body, body
+            site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, candidate)
+            if site >= 0:
+                return "site", site, int(m.site_bodyid[site])
         names = [_name(m, mujoco.mjtObj.mjOBJ_BODY, i, "") for i in range(m.nbody)]
         names += [_name(m, mujoco.mjtObj.mjOBJ_SITE, i, "") for i in range(m.nsite)]
+        # Case-insensitive, as Isaac Lab users write "Robot/base" for a body "base".
+        lowered = {n.lower(): n for n in names if n}
+        for candidate in prim_path_candidates(name):
+            if candidate.lower() in lowered:
+                return self._resolve_carrier(lowered[candidate.lower()])
         close = difflib.get_close_matches(name, [n for n in names if n], n=3)
         hint = f"; did you mean {', '.join(map(repr, close))}?" if close else ""
         raise SensorError(
@@ -273,11 +360,12 @@ class LidarSensor:
         if cfg.mesh_prim_paths:
             selected = np.zeros(m.ngeom, dtype=bool)
             # Candidate names of a geom: its own name and path, and every ancestor body's
-            # name and path, so a body pattern selects that body's whole subtree.
+            # name and path, so a body pattern selects that body's whole subtree. Matched
+            # case-insensitively, like classification ("/World/ground" finds "ground").
             candidates = []
             for g in range(m.ngeom):
                 chain = _body_chain(m, int(m.geom_bodyid[g]))
-                names = [_name(m, mujoco.mjtObj.mjOBJ_GEOM, g, "geom"), self._geom_paths[g]]
+                names = [_geom_name(m, g), self._geom_paths[g]]
                 prefix = "/world"
                 names.append(prefix)
                 for b in chain:
@@ -286,12 +374,13 @@ class LidarSensor:
                     names += [bname, prefix]
                 if not chain:
                     names.append("world")
-                candidates.append(names)
+                candidates.append([n.lower() for n in names])
             for pattern in cfg.mesh_prim_paths:
+                key = _mesh_pattern(pattern)
                 hits = [
                     g
                     for g in range(m.ngeom)
-                    if any(fnmatch.fnmatchcase(c, pattern) for c in candidates[g])
+                    if any(fnmatch.fnmatchcase(c, key) for c in candidates[g])
                 ]
                 if not hits:
                     raise SensorError(
@@ -310,10 +399,13 @@ class LidarSensor:
             )
         return selected
 
+    def _initialize_warp_meshes(self) -> None:
+        """Seed hook run before the engine is built; the semantic sensor classifies geoms here."""
+
     def _make_data(self) -> LidarSensorData:
         e, n = self.num_envs, self.num_rays
-        origins, dirs = self._pattern(0)
-        return LidarSensorData(
+        origins, dirs = self._table.window(0)
+        data = LidarSensorData(
             pos_w=np.zeros((e, 3)),
             quat_w=np.tile([1.0, 0.0, 0.0, 0.0], (e, 1)),
             distances=np.full((e, n), self.cfg.miss_distance),
@@ -322,28 +414,44 @@ class LidarSensor:
             pattern_origins=origins,
             pattern_directions=dirs,
         )
+        if self.cfg.output != "numpy":
+            p = self._pipeline
+            assert p is not None  # LidarCfg refuses device outputs without the warp engine
+            view = self._device_view
+            data.pos_w, data.quat_w = view(p.pos_w), view(p.quat_w)
+            data.distances, data.hit_mask = view(p.distances), view(p.hit_mask)
+            data.ray_rot_w = view(p.ray_rot)
+            data.pattern_origins, data.pattern_directions = self._device_window(0)
+            data._set_device_views(view(p.ray_origins), view(p.ray_directions), view(p.points))
+        return data
 
-    def _pattern(self, frame: int) -> tuple[np.ndarray, np.ndarray]:
-        pattern = self.cfg.pattern_cfg
-        if pattern.repetitive:
-            if self._pattern_cache is None:
-                self._pattern_cache = pattern.rays(0)
-            return self._pattern_cache
-        return pattern.rays(frame)
+    def _device_view(self, array: Any) -> Any:
+        """A warp array as the configured output: itself, or a zero-copy torch tensor."""
+        if self.cfg.output == "warp":
+            return array
+        import warp as wp
+
+        return wp.to_torch(array)
+
+    def _device_window(self, frame: int) -> tuple[Any, Any]:
+        """The pattern rows of ``frame`` as views of the device table."""
+        p = self._pipeline
+        assert p is not None
+        start = (frame % self._table.num_frames) * self.num_rays
+        o, d = self._device_view(p.table_o), self._device_view(p.table_d)
+        return o[start : start + self.num_rays], d[start : start + self.num_rays]
 
     # ------------------------------------------------------------------ update
     def sensor_poses(self) -> tuple[np.ndarray, np.ndarray]:
-        """Sensor positions ``(E, 3)`` [m] and rotation matrices ``(E, 3, 3)``, world frame."""
-        if self._warp_data is not None:
-            # Only the carrier's pose comes back from the device.
-            wd, i = self._warp_data, self._carrier_id
-            if self._carrier_kind == "body":
-                p = wd.xpos.numpy()[:, i].astype(np.float64)
-                r = wd.xmat.numpy()[:, i].astype(np.float64).reshape(-1, 3, 3)
-            else:
-                p = wd.site_xpos.numpy()[:, i].astype(np.float64)
-                r = wd.site_xmat.numpy()[:, i].astype(np.float64).reshape(-1, 3, 3)
-            return p + r @ self._offset_pos, r @ self._offset_mat
+        """Sensor positions ``(E, 3)`` [m] and rotation matrices ``(E, 3, 3)``, world frame.
+
+        With the warp engine these are the poses of the last update, copied to the host.
+        """
+        if self._pipeline is not None:
+            return (
+                self._pipeline.pos_w.numpy().astype(np.float64),
+                self._pipeline.sensor_mat.numpy().astype(np.float64),
+            )
         pos = np.empty((self.num_envs, 3))
         mat = np.empty((self.num_envs, 3, 3))
         for e, d in enumerate(self._datas):
@@ -368,17 +476,46 @@ class LidarSensor:
         return rot
 
     def update(self) -> None:
-        """Cast one frame of rays for every environment from the poses in its ``MjData``."""
+        """Cast one frame of rays for every environment from the poses its data holds."""
         self._update_buffers_impl(None)
 
     def _update_buffers_impl(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
         """Seed hook: cast and fill the buffers (every environment; ``env_ids`` kept for the API)."""
         self._frame += 1
-        origins_s, dirs_s = self._pattern(self._frame)
+        if self._pipeline is not None:
+            self._update_device()
+        else:
+            self._update_host()
+
+    def _update_device(self) -> None:
+        """Warp engine: kernels only; numpy output then copies the results to the host."""
+        p = self._pipeline
+        assert p is not None
+        p.update(self._warp_data if self._warp_data is not None else self._datas)
+        d = self._data
+        if self.cfg.output != "numpy":
+            d.frame = self._frame
+            d.pattern_origins, d.pattern_directions = self._device_window(self._frame)
+            return
+        d._invalidate()
+        d.frame = self._frame
+        d.pos_w = p.pos_w.numpy().astype(np.float64)
+        d.quat_w = p.quat_w.numpy().astype(np.float64)
+        d.ray_rot_w = p.ray_rot.numpy().astype(np.float64)
+        d.pattern_origins, d.pattern_directions = self._table.window(self._frame)
+        # .numpy() of a CPU-device array is a view of it: copy, numpy outputs are the host's.
+        d.distances = p.distances.numpy().astype(np.float64)
+        d.hit_mask = p.hit_mask.numpy().copy()
+        self._raw_geom_ids = p.geom_ids.numpy().copy()
+
+    def _update_host(self) -> None:
+        """Mujoco engine: threaded ``mj_multiRay`` and the range model in numpy (float64)."""
+        assert self._engine is not None
+        origins_s, dirs_s = self._table.window(self._frame)
         pos, mat = self.sensor_poses()
         rot = self._ray_rotation(mat)
         raw_dist, geom_ids = self._engine.cast(
-            self._warp_data if self._warp_data is not None else self._datas,
+            self._datas,
             origins_s,
             dirs_s,
             rot,
@@ -418,45 +555,79 @@ class LidarSensor:
         self._raw_geom_ids = geom_ids
 
     # ------------------------------------------------------------------ getters
-    def _rows(self, env_ids: Sequence[int] | np.ndarray | None) -> slice | np.ndarray:
+    def _rows(self, env_ids: Sequence[int] | np.ndarray | None) -> Any:
         if env_ids is None:
             return slice(None)
-        ids = np.asarray(env_ids, dtype=int).reshape(-1)
-        if ids.size and (ids.min() < -self.num_envs or ids.max() >= self.num_envs):
-            raise SensorError(
-                f"env_ids: expected indices in [0, {self.num_envs}), got {ids.tolist()}"
-            )
+        if self.cfg.output == "torch":
+            import torch
+
+            ids = torch.as_tensor(env_ids, dtype=torch.long).reshape(-1)
+            lo, hi = (int(ids.min()), int(ids.max())) if ids.numel() else (0, 0)
+            listed = ids.tolist()
+        else:
+            ids = np.asarray(env_ids, dtype=int).reshape(-1)
+            lo, hi = (int(ids.min()), int(ids.max())) if ids.size else (0, 0)
+            listed = ids.tolist()
+        if lo < -self.num_envs or hi >= self.num_envs:
+            raise SensorError(f"env_ids: expected indices in [0, {self.num_envs}), got {listed}")
+        if self.cfg.output == "torch":
+            return ids.to(self._data.distances.device)
         return ids
 
-    def get_distances(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
-        """Ranges ``(num_envs, num_rays)`` [m]; misses are ``cfg.miss_distance`` (inf)."""
-        return self._data.distances[self._rows(env_ids)].copy()
+    def _take(self, array: Any, env_ids: Sequence[int] | np.ndarray | None) -> Any:
+        """Rows of an output: a copy for numpy; for torch/warp the live buffer itself when
+        ``env_ids`` is None (valid until the next update), else the selected rows."""
+        if self.cfg.output == "numpy":
+            return array[self._rows(env_ids)].copy()
+        if env_ids is None:
+            return array
+        if self.cfg.output == "warp":
+            raise SensorError(
+                "env_ids: warp outputs are whole buffers; use output='torch' to index"
+            )
+        return array[self._rows(env_ids)]
+
+    def get_distances(self, env_ids: Sequence[int] | np.ndarray | None = None) -> Any:
+        """Ranges ``(num_envs, num_rays)`` [m]; misses hold ``cfg.miss_distance``."""
+        return self._take(self._data.distances, env_ids)
 
     def get_pointcloud(
         self, env_ids: Sequence[int] | np.ndarray | None = None, frame: str = "world"
-    ) -> np.ndarray:
+    ) -> Any:
         """Hit points ``(num_envs, num_rays, 3)`` [m], NaN for misses.
 
         Args:
             frame: ``"world"`` or ``"sensor"`` (the sensor's own frame, offset included).
         """
-        rows = self._rows(env_ids)
-        pts = self._data.hit_points_w[rows]
-        if frame == "world":
-            return pts.copy()
-        if frame != "sensor":
+        if frame not in ("world", "sensor"):
             raise SensorError(f"frame: expected 'world' or 'sensor', got {frame!r}")
+        pts = self._take(self._data.hit_points_w, env_ids)
+        if frame == "world":
+            return pts
+        if self.cfg.output == "warp":
+            raise SensorError("frame='sensor' needs output='numpy' or 'torch'")
         # The sensor pose at scan time (not the current one): p_s = R^T (p_w - pos).
+        rows = self._rows(env_ids)
+        pos = self._data.pos_w[rows]
+        if self.cfg.output == "torch":
+            assert self._pipeline is not None
+            import warp as wp
+
+            mat = wp.to_torch(self._pipeline.sensor_mat)[rows]
+            import torch
+
+            return torch.einsum("eji,enj->eni", mat, pts - pos[:, None, :])
         quat = self._data.quat_w[rows]
         mat = np.stack([_quat_to_mat(q) for q in quat]) if len(quat) else np.zeros((0, 3, 3))
-        return np.einsum("eji,enj->eni", mat, pts - self._data.pos_w[rows][:, None, :])
+        return np.einsum("eji,enj->eni", mat, pts - pos[:, None, :])
 
-    def get_hit_mask(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
+    def get_hit_mask(self, env_ids: Sequence[int] | np.ndarray | None = None) -> Any:
         """``(num_envs, num_rays)`` bool, True where a ray returned a point."""
-        return self._data.hit_mask[self._rows(env_ids)].copy()
+        return self._take(self._data.hit_mask, env_ids)
 
     def __repr__(self) -> str:
         return (
             f"{type(self).__name__}(prim_path={self.cfg.prim_path!r}, num_envs={self.num_envs}, "
-            f"num_rays={self.num_rays}, engine={self.engine_name!r}, max_distance={self.max_distance})"
+            f"num_rays={self.num_rays}, engine={self.engine_name!r}, device={self.device!r}, "
+            f"output={self.cfg.output!r}, max_distance={self.max_distance})"
         )

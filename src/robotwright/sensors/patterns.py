@@ -9,6 +9,11 @@ Every pattern config answers :meth:`PatternCfg.rays`, which returns ray origins
 Repetitive patterns return the same rays for every frame; the Livox-style pattern moves
 along its scan curve from one frame to the next so successive frames cover new
 directions.
+
+Sensors do not call :meth:`PatternCfg.rays` per frame: they compute the pattern's
+:class:`RayTable` once (``table_frames`` frames back to back) and cast a window of it
+each frame, so a frame costs no pattern arithmetic on the host and the table can live
+on the GPU. ``rays(f)`` equals ``ray_table().window(f)`` for every frame.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from robotwright.errors import SensorError
 
 __all__ = [
     "PatternCfg",
+    "RayTable",
     "LivoxPatternCfg",
     "SpinningLidarPatternCfg",
     "GridPatternCfg",
@@ -43,6 +49,40 @@ def spherical_to_directions(azimuth: np.ndarray, elevation: np.ndarray) -> np.nd
     return np.stack([cos_el * np.cos(az), cos_el * np.sin(az), np.sin(el)], axis=-1)
 
 
+@dataclass(frozen=True)
+class RayTable:
+    """Every ray a pattern casts over ``num_frames`` frames, frame after frame.
+
+    Frame ``f`` casts rows ``[k * N, (k + 1) * N)`` with ``k = f % num_frames`` and
+    ``N = rays_per_frame``: the window advances by one frame each update and wraps
+    after ``num_frames`` frames (1 for repetitive patterns).
+
+    Attributes:
+        origins: ``(num_frames * N, 3)`` ray origins in the sensor frame [m].
+        directions: ``(num_frames * N, 3)`` unit ray directions in the sensor frame.
+        rays_per_frame: ``N``.
+    """
+
+    origins: np.ndarray
+    directions: np.ndarray
+    rays_per_frame: int
+
+    @property
+    def num_frames(self) -> int:
+        return self.directions.shape[0] // self.rays_per_frame
+
+    @property
+    def single_origin(self) -> bool:
+        """Every ray starts at the sensor origin."""
+        return not self.origins.any()
+
+    def window(self, frame: int) -> tuple[np.ndarray, np.ndarray]:
+        """Origins and directions ``(N, 3)`` of frame ``frame`` (views into the table)."""
+        start = (int(frame) % self.num_frames) * self.rays_per_frame
+        stop = start + self.rays_per_frame
+        return self.origins[start:stop], self.directions[start:stop]
+
+
 @dataclass(kw_only=True)
 class PatternCfg:
     """Base class of scan patterns."""
@@ -59,6 +99,15 @@ class PatternCfg:
         """Ray origins ``(N, 3)`` [m] and unit directions ``(N, 3)`` in the sensor frame."""
         dirs = self._directions(frame)
         return np.zeros_like(dirs), dirs
+
+    def ray_table(self) -> RayTable:
+        """The rays of every distinct frame, computed once (see :class:`RayTable`)."""
+        origins, dirs = self.rays(0)
+        return RayTable(
+            np.ascontiguousarray(origins, dtype=np.float64),
+            np.ascontiguousarray(dirs, dtype=np.float64),
+            int(dirs.shape[0]),
+        )
 
     def _directions(self, frame: int) -> np.ndarray:
         raise NotImplementedError
@@ -121,6 +170,9 @@ class LivoxPatternCfg(PatternCfg):
         elevation_sweep_hz: elevation triangle-wave rate [Hz]; its ratio to
             ``rotation_hz`` is irrational by default so the pattern never repeats.
         prism_rpm: rotation rates of the two prisms of the Avia-like rosette [rev/min].
+        table_frames: frames in the precomputed ray table; the scan repeats after this
+            many frames (default 20: 2 s of a 10 Hz Mid-360, 400 000 directions, twice
+            the rays the real sensor needs to cover its field of view).
     """
 
     repetitive: ClassVar[bool] = False
@@ -135,6 +187,7 @@ class LivoxPatternCfg(PatternCfg):
     rotation_hz: float = 10.0
     elevation_sweep_hz: float = 10.0 * (1.0 + math.sqrt(5.0)) / 2.0 * 37.0
     prism_rpm: tuple[float, float] = (7294.0, -4664.0)
+    table_frames: int = 20
 
     def __post_init__(self) -> None:
         name = type(self).__name__
@@ -148,6 +201,7 @@ class LivoxPatternCfg(PatternCfg):
                 setattr(self, key, value)
         _check_count("num_rays", self.num_rays, name)
         _check_count("num_lines", self.num_lines, name)
+        _check_count("table_frames", self.table_frames, name)
         for key in ("points_per_second", "horizontal_fov", "rotation_hz", "elevation_sweep_hz"):
             _check_positive(key, getattr(self, key), name)
         if self.horizontal_fov > 2.0 * math.pi + 1e-12:
@@ -165,8 +219,16 @@ class LivoxPatternCfg(PatternCfg):
             )
 
     def _directions(self, frame: int) -> np.ndarray:
-        first = int(frame) * int(self.num_rays)
-        idx = np.arange(first, first + self.num_rays, dtype=np.int64)
+        first = (int(frame) % self.table_frames) * int(self.num_rays)
+        return self._fire(first, int(self.num_rays))
+
+    def ray_table(self) -> RayTable:
+        dirs = self._fire(0, self.table_frames * int(self.num_rays))
+        return RayTable(np.zeros_like(dirs), dirs, int(self.num_rays))
+
+    def _fire(self, first: int, count: int) -> np.ndarray:
+        """Directions of the rays fired ``first .. first + count - 1`` (sensor frame)."""
+        idx = np.arange(first, first + count, dtype=np.int64)
         t = idx / self.points_per_second
         lo, hi = self.vertical_fov_min, self.vertical_fov_max
         if self.sensor_type == "mid360":

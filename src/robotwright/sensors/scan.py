@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -46,7 +48,7 @@ def scan_to_files(
     """Scan one environment with a :class:`SemanticLidarSensor` and save the result.
 
     ``data`` must hold current poses (call ``mj_forward`` first). The ``.npz`` holds
-    ``distances`` (N,) [m] (inf = miss), ``points`` (N, 3) world frame [m] (NaN = miss),
+    ``distances`` (N,) [m] (inf = miss), ``hit_mask`` (N,) bool, ``points`` (N, 3) world frame [m] (NaN = miss),
     ``labels`` (N,) class ids, ``mesh_ids`` (N,) hit geom ids (-1 = miss),
     ``directions`` (N, 3), ``sensor_pos`` (3,), ``sensor_quat`` (4, w x y z),
     ``class_names`` and ``geom_paths`` (strings). ``view_radius`` [m] crops the picture
@@ -68,6 +70,7 @@ def scan_to_files(
         exclude_robot=exclude_robot,
         return_mesh_ids=True,
         engine=engine,  # type: ignore[arg-type]
+        miss_distance=math.inf,  # a scan file marks misses unmistakably
     )
     lidar = SemanticLidarSensor(cfg, model, data)
     lidar.update()
@@ -83,6 +86,7 @@ def scan_to_files(
         save_npz(
             npz_path,
             distances=dist,
+            hit_mask=lidar.get_hit_mask()[0],
             points=points,
             labels=labels,
             mesh_ids=mesh_ids,

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -28,6 +28,8 @@ __all__ = ["SemanticLidarData", "SemanticLidarSensor"]
 class SemanticLidarData(LidarSensorData):
     """:class:`LidarSensorData` plus semantic fields (seed 004).
 
+    Fields follow ``cfg.output`` like the parent's (numpy, or zero-copy torch/warp views).
+
     Attributes:
         semantic_labels: ``(E, N)`` int32 class id per ray: 1..K in mapping order,
             0 for a miss or a hit on a geom no keyword matches. ``None`` when
@@ -36,8 +38,8 @@ class SemanticLidarData(LidarSensorData):
             ``None`` unless ``return_mesh_ids`` is True.
     """
 
-    semantic_labels: np.ndarray | None = None
-    mesh_ids: np.ndarray | None = None
+    semantic_labels: Any = None
+    mesh_ids: Any = None
 
 
 class SemanticLidarSensor(LidarSensor):
@@ -73,9 +75,8 @@ class SemanticLidarSensor(LidarSensor):
             (cls_id, [k.lower() for k in keywords])
             for cls_id, keywords in enumerate(self.semantic_class_mapping.values(), start=1)
         ]
-        super().__init__(cfg, model, data)
         self.mesh_id_to_semantic_class: dict[int, int] = {}
-        self._initialize_warp_meshes()
+        super().__init__(cfg, model, data)  # classifies geoms in _initialize_warp_meshes
 
     @property
     def return_semantic_labels(self) -> bool:
@@ -92,13 +93,20 @@ class SemanticLidarSensor(LidarSensor):
     def _make_data(self) -> SemanticLidarData:
         base = super()._make_data()
         shape = (self.num_envs, self.num_rays)
-        return SemanticLidarData(
+        if self.cfg.output != "numpy":
+            assert self._pipeline is not None
+            labels = self._device_view(self._pipeline.labels)
+            ids = self._device_view(self._pipeline.geom_ids)
+        else:
+            labels = np.zeros(shape, dtype=np.int32)
+            ids = np.full(shape, -1, dtype=np.int32)
+        data = SemanticLidarData(
             **{f.name: getattr(base, f.name) for f in fields(base) if f.init},
-            semantic_labels=np.zeros(shape, dtype=np.int32)
-            if self.cfg.return_semantic_labels
-            else None,
-            mesh_ids=np.full(shape, -1, dtype=np.int32) if self.cfg.return_mesh_ids else None,
+            semantic_labels=labels if self.cfg.return_semantic_labels else None,
+            mesh_ids=ids if self.cfg.return_mesh_ids else None,
         )
+        data._cache.update(base._cache)
+        return data
 
     def _classify_mesh_path(self, mesh_prim_path: str) -> int:
         """Class id of a path: first class (mapping order) with a keyword in it; 0 if none.
@@ -115,7 +123,7 @@ class SemanticLidarSensor(LidarSensor):
         """Classify every hittable geom once (seed name; the "meshes" here are MuJoCo geoms).
 
         Builds ``mesh_id_to_semantic_class`` and a lookup table indexed by geom id whose
-        last entry (index -1, a miss) is class 0.
+        last entry (index -1, a miss) is class 0; the warp engine keeps it on the device.
         """
         self.geom_semantic_class = np.zeros(self.model.ngeom, dtype=np.int32)
         for g in np.flatnonzero(self.hittable_geom_mask):
@@ -131,7 +139,12 @@ class SemanticLidarSensor(LidarSensor):
         self._compute_semantic_labels(env_ids)
 
     def _compute_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
-        """Fill labels (and mesh ids) of ``env_ids`` (all when None) from the hit geom ids."""
+        """Fill labels (and mesh ids) of ``env_ids`` (all when None) from the hit geom ids.
+
+        Device outputs were labelled by the ``finish_rays`` kernel already: nothing to do.
+        """
+        if self.cfg.output != "numpy":
+            return
         rows = self._rows(env_ids)
         ids = self._raw_geom_ids[rows]
         if self._data.semantic_labels is not None:
@@ -142,19 +155,19 @@ class SemanticLidarSensor(LidarSensor):
         if self._data.mesh_ids is not None:
             self._data.mesh_ids[rows] = ids
 
-    def get_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
+    def get_semantic_labels(self, env_ids: Sequence[int] | np.ndarray | None = None) -> Any:
         """Class id per ray ``(num_envs, num_rays)`` int32 (0 = miss/unknown)."""
         if self._data.semantic_labels is None:
             raise SensorError(
                 "semantic labels are off: set SemanticLidarCfg.return_semantic_labels=True"
             )
-        return self._data.semantic_labels[self._rows(env_ids)].copy()
+        return self._take(self._data.semantic_labels, env_ids)
 
-    def get_mesh_ids(self, env_ids: Sequence[int] | np.ndarray | None = None) -> np.ndarray:
+    def get_mesh_ids(self, env_ids: Sequence[int] | np.ndarray | None = None) -> Any:
         """Hit geom id per ray ``(num_envs, num_rays)`` int32 (-1 = miss)."""
         if self._data.mesh_ids is None:
             raise SensorError("mesh ids are off: set SemanticLidarCfg.return_mesh_ids=True")
-        return self._data.mesh_ids[self._rows(env_ids)].copy()
+        return self._take(self._data.mesh_ids, env_ids)
 
     def geom_path(self, geom_id: int) -> str:
         """The classification path of a geom (``/world/<bodies>/<geom>[/<mesh>]``)."""
