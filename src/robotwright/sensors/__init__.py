@@ -16,12 +16,18 @@ from robotwright.sensors.patterns import (
     LivoxPatternCfg,
     PatternCfg,
     PinholeCameraPatternCfg,
+    RayTable,
     SpinningLidarPatternCfg,
     pattern_from_name,
 )
 from robotwright.sensors.raycast import warp_available
 from robotwright.sensors.scan import scan_to_files
-from robotwright.sensors.semantic import SemanticLidarData, SemanticLidarSensor
+from robotwright.sensors.semantic import (
+    SemanticLidarData,
+    SemanticLidarSensor,
+    classify_path,
+    geom_class_table,
+)
 
 __all__ = [
     "DEFAULT_SEMANTIC_CLASS_MAPPING",
@@ -38,6 +44,9 @@ __all__ = [
     "SemanticLidarData",
     "SemanticLidarSensor",
     "SpinningLidarPatternCfg",
+    "RayTable",
+    "classify_path",
+    "geom_class_table",
     "geom_paths",
     "pattern_from_name",
     "scan_to_files",

@@ -21,7 +21,29 @@ from robotwright.sensors.lidar import LidarSensor, LidarSensorData
 if TYPE_CHECKING:  # the warp extra is optional
     from mujoco_warp import Data as WarpData
 
-__all__ = ["SemanticLidarData", "SemanticLidarSensor"]
+__all__ = ["SemanticLidarData", "SemanticLidarSensor", "classify_path", "geom_class_table"]
+
+
+def classify_path(path: str, mapping: dict[str, list[str]]) -> int:
+    """Class id of a path: the first class (mapping order, ids from 1) one of whose
+    keywords occurs in it, case-insensitively; 0 when none does (seed 004's rule)."""
+    lowered = path.lower()
+    for cls_id, keywords in enumerate(mapping.values(), start=1):
+        if any(k.lower() in lowered for k in keywords):
+            return cls_id
+    return 0
+
+
+def geom_class_table(
+    paths: Sequence[str], mapping: dict[str, list[str]], hittable: np.ndarray | None = None
+) -> np.ndarray:
+    """``(ngeom + 1,)`` int32 class id per geom path, 0 for geoms not ``hittable``; the
+    extra last entry answers geom id -1 (a miss) with class 0."""
+    table = np.zeros(len(paths) + 1, dtype=np.int32)
+    for g, path in enumerate(paths):
+        if hittable is None or hittable[g]:
+            table[g] = classify_path(path, mapping)
+    return table
 
 
 @dataclass
@@ -71,10 +93,6 @@ class SemanticLidarSensor(LidarSensor):
             k: list(v) for k, v in cfg.semantic_class_mapping.items()
         }
         self.class_names: tuple[str, ...] = ("unknown", *self.semantic_class_mapping)
-        self._keywords = [
-            (cls_id, [k.lower() for k in keywords])
-            for cls_id, keywords in enumerate(self.semantic_class_mapping.values(), start=1)
-        ]
         self.mesh_id_to_semantic_class: dict[int, int] = {}
         super().__init__(cfg, model, data)  # classifies geoms in _initialize_warp_meshes
 
@@ -113,11 +131,7 @@ class SemanticLidarSensor(LidarSensor):
 
         Matching is case-insensitive substring search, as in the seed.
         """
-        path = mesh_prim_path.lower()
-        for cls_id, keywords in self._keywords:
-            if any(k in path for k in keywords):
-                return cls_id
-        return 0
+        return classify_path(mesh_prim_path, self.semantic_class_mapping)
 
     def _initialize_warp_meshes(self) -> None:
         """Classify every hittable geom once (seed name; the "meshes" here are MuJoCo geoms).
@@ -125,13 +139,13 @@ class SemanticLidarSensor(LidarSensor):
         Builds ``mesh_id_to_semantic_class`` and a lookup table indexed by geom id whose
         last entry (index -1, a miss) is class 0; the warp engine keeps it on the device.
         """
-        self.geom_semantic_class = np.zeros(self.model.ngeom, dtype=np.int32)
-        for g in np.flatnonzero(self.hittable_geom_mask):
-            cls_id = self._classify_mesh_path(self._geom_paths[g])
-            self.geom_semantic_class[g] = cls_id
-            self.mesh_id_to_semantic_class[int(g)] = cls_id
-        # Indexed by geom id; the extra last entry answers id -1 (a miss) with class 0.
-        self._label_lut = np.concatenate([self.geom_semantic_class, [0]]).astype(np.int32)
+        self._label_lut = geom_class_table(
+            self._geom_paths, self.semantic_class_mapping, self.hittable_geom_mask
+        )
+        self.geom_semantic_class = self._label_lut[:-1]
+        self.mesh_id_to_semantic_class.update(
+            {int(g): int(self._label_lut[g]) for g in np.flatnonzero(self.hittable_geom_mask)}
+        )
 
     def _update_buffers_impl(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
         """Cast (parent), then turn hit geom ids into labels, as in the seed."""
