@@ -96,11 +96,17 @@ def write_text_atomic(path: Path, text: str) -> None:
 
 
 def copy_file_atomic(src: Path, dst: Path) -> None:
-    """Copy ``src`` to ``dst``, creating its folder; see :func:`atomic_path`."""
+    """Copy ``src`` to ``dst``, creating its folder; see :func:`atomic_path`.
+
+    Only a regular file is copied: a FIFO or a device as ``src`` raises
+    :class:`~robotwright.errors.InputFileError` before anything is read or written.
+    """
+    from robotwright._inputs import copy_regular_file
+
     check_output_path(dst)
     dst.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(dst) as tmp:
-        shutil.copyfile(src, tmp)
+        copy_regular_file(src, tmp)
 
 
 @contextmanager

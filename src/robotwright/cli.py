@@ -12,6 +12,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from robotwright._paths import trusted_asset_roots
 from robotwright.errors import RobotwrightError
 
 # Modules that expose ``register(subparsers: argparse._SubParsersAction) -> None``.
@@ -25,6 +26,18 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.things.cli",
 )
 
+#: Commands that read robots from files: they take ``--asset-root DIR`` (see
+#: :mod:`robotwright._paths`).
+_ASSET_COMMANDS: tuple[str, ...] = (
+    "validate",
+    "info",
+    "export",
+    "compose",
+    "convert",
+    "roundtrip",
+    "things",
+)
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
@@ -34,6 +47,16 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for module_name in _COMMAND_MODULES:
         importlib.import_module(module_name).register(sub)
+    for name in _ASSET_COMMANDS:
+        sub.choices[name].add_argument(
+            "--asset-root",
+            action="append",
+            dest="asset_roots",
+            metavar="DIR",
+            default=[],
+            help="trust folder DIR: mesh/asset paths of the input may point into it "
+            "(by default they must stay inside the robot's own folder); repeatable",
+        )
     return parser
 
 
@@ -41,7 +64,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with trusted_asset_roots(getattr(args, "asset_roots", None) or []):
+            return int(args.func(args) or 0)
     except RobotwrightError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -83,5 +83,28 @@ class OutputExistsError(OutputPathError, FileExistsError):
     """The output exists and replacing it was not allowed."""
 
 
+class UnsafePathError(RobotwrightError, ValueError):
+    """A file path read from an input (a mesh, texture or include path) leaves the folder
+    it must stay in: ``..``, an absolute path or a symbolic link pointing elsewhere
+    (see :mod:`robotwright._paths`). Folders can be trusted explicitly (``asset_roots``,
+    ``--asset-root``)."""
+
+
+class InputFileError(RobotwrightError, ValueError):
+    """An input file cannot be read as what it must be: not a regular file (a FIFO, a
+    device, a folder), larger than its size limit, not UTF-8 text, or nested deeper than
+    the limit (see :mod:`robotwright._inputs`).
+
+    Attributes:
+        path: the file, as given.
+        reason: what is wrong with it (the message without the path).
+    """
+
+    def __init__(self, path: object, reason: str) -> None:
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")
+
+
 class ConversionWarning(UserWarning):
     """An element was dropped or approximated during a conversion (named in the message)."""

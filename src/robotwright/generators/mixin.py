@@ -66,7 +66,12 @@ class HRDFMixin:
 
     def mesh_abspath(self, mesh: MeshGeom) -> str:
         """Absolute, normalised path of a mesh geom's file (as ``HRDF.mesh_path``; cached
-        per load, kept as a string because generation uses it for every mesh row)."""
+        per load, kept as a string because generation uses it for every mesh row).
+
+        Raises:
+            robotwright.errors.UnsafePathError: the file leads out of the robot folder
+                (see :meth:`HRDF.mesh_source`).
+        """
         key = (mesh.file, mesh.name)
         path = self._mesh_abs.get(key)
         if path is None:
@@ -79,6 +84,9 @@ class HRDFMixin:
             if hrdf.root_dir is not None and not os.path.isabs(rel):
                 rel = os.path.join(hrdf.root_dir, rel)
             path = os.path.abspath(rel)
+            # What the output references and what export(copy_meshes=True) copies: it
+            # must stay inside the robot folder or a trusted one.
+            hrdf.mesh_source(mesh)
             self._mesh_abs[key] = path
         return path
 

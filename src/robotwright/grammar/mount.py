@@ -117,7 +117,7 @@ def mount_on(
         dataclasses.replace(
             m,
             body=rn.format(m.body),
-            file=str(limb.mesh_path(m).resolve()) if limb.root_dir else m.file,
+            file=str(limb.mesh_source(m)) if limb.root_dir else m.file,
         )
         for m in limb.meshes
     ]
@@ -165,6 +165,13 @@ def mount_on(
         meta=meta,
         mjcf_extra=robot.mjcf_extra,
         root_dir=robot.root_dir,
+        # The limb's meshes keep their absolute paths in its folder: trusted here.
+        asset_roots=tuple(
+            dict.fromkeys(
+                [*robot.asset_roots, *limb.asset_roots]
+                + ([limb.root_dir.resolve()] if limb.root_dir and limb.meshes else [])
+            )
+        ),
     )
 
 

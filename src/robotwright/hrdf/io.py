@@ -11,8 +11,8 @@ import csv
 import io
 import math
 import os
-import shutil
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import repeat
 from pathlib import Path
@@ -21,7 +21,22 @@ from typing import Any
 import yaml
 
 from robotwright._atomic import atomic_dir
-from robotwright.errors import HRDFError, OutputExistsError, Problem
+from robotwright._inputs import (
+    MAX_TABLE_BYTES,
+    MAX_XML_BYTES,
+    MAX_YAML_BYTES,
+    copy_regular_file,
+    load_yaml,
+    read_text,
+)
+from robotwright._paths import resolve_inside, trusted_roots
+from robotwright.errors import (
+    HRDFError,
+    InputFileError,
+    OutputExistsError,
+    Problem,
+    UnsafePathError,
+)
 from robotwright.hrdf.model import (
     FORMAT_VERSION,
     HRDF,
@@ -77,10 +92,6 @@ _KNOWN_FILES = frozenset(
 )
 
 
-# libyaml's loader is ~20x faster than the pure-Python one; both are "safe" loaders.
-_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-
-
 class HRDFWarning(UserWarning):
     """Something in an HRDF folder was not understood and is ignored (named in the message)."""
 
@@ -128,14 +139,30 @@ def _flat_columns(lines: list[str], width: int) -> list[list[str]] | None:
     return [flat[j::width] for j in range(width)]
 
 
+def _folder_text(path: Path, limit: int, problems: list[Problem]) -> str | None:
+    """The text of a file of the robot folder (``path.parent``), or ``None`` after
+    reporting why it cannot be read: a symbolic link leading out of the folder, not a
+    regular file (FIFO, device), over ``limit`` bytes, not UTF-8 (see
+    :mod:`robotwright._inputs`)."""
+    try:
+        if os.path.islink(path):
+            resolve_inside(path.name, base=path.parent, root=path.parent, trusted=())
+        return read_text(path, limit)
+    except UnsafePathError as exc:
+        problems.append(Problem(path.name, f"the file is a link out of the robot folder: {exc}"))
+    except InputFileError as exc:
+        problems.append(Problem(path.name, f"cannot read file: it {exc.reason}"))
+    except OSError as exc:
+        problems.append(Problem(path.name, f"cannot read file: {exc.strerror or exc}"))
+    return None
+
+
 def _read_table(
     path: Path, schema: list[Column], problems: list[Problem], *, hurodes_format: bool
 ) -> _Table | None:
     fname = path.name
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        problems.append(Problem(fname, f"cannot read file: {exc}"))
+    text = _folder_text(path, MAX_TABLE_BYTES, problems)
+    if text is None:
         return None
     lines = _split_plain(text)
     columns: list[list[str]] | None = None
@@ -344,10 +371,18 @@ def _records(cls: type, fields: list[str], rows: list[tuple[Any, ...] | None]) -
 
 def _load_yaml(path: Path, problems: list[Problem]) -> Any:
     try:
-        return yaml.load(path.read_text(encoding="utf-8"), Loader=_YAML_LOADER)
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        if os.path.islink(path):
+            resolve_inside(path.name, base=path.parent, root=path.parent, trusted=())
+        return load_yaml(path, MAX_YAML_BYTES)
+    except UnsafePathError as exc:
+        problems.append(Problem(path.name, f"the file is a link out of the robot folder: {exc}"))
+    except InputFileError as exc:
+        problems.append(Problem(path.name, f"cannot read file: it {exc.reason}"))
+    except OSError as exc:
+        problems.append(Problem(path.name, f"cannot read file: {exc.strerror or exc}"))
+    except yaml.YAMLError as exc:
         problems.append(Problem(path.name, f"cannot parse YAML: {exc}"))
-        return None
+    return None
 
 
 def _float_list(value: Any, size: int, key: str, problems: list[Problem]) -> tuple | None:
@@ -490,11 +525,14 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
     return meta, parent_ids, ext
 
 
-def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
+def collect_hrdf_dir(
+    path: str | Path, *, asset_roots: Iterable[str | os.PathLike[str]] | None = None
+) -> tuple[HRDF | None, list[Problem]]:
     """Read an HRDF folder, returning the model (``None`` if unreadable) and all problems.
 
     The model is returned even when some rows had problems (those rows are left out), so
     that semantic checks can still run; callers raise when any problem is an error.
+    ``asset_roots``: folders outside the robot folder that mesh paths may point into.
     """
     from robotwright.hrdf.validate import check_model
 
@@ -506,9 +544,12 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
     except (FileNotFoundError, NotADirectoryError):
         return None, [Problem(str(root), "not a folder: expected an HRDF folder")]
     meta_path = root / "meta.yaml"
-    if "meta.yaml" not in present or not meta_path.is_file():
+    if "meta.yaml" not in present:
         return None, [Problem(str(meta_path), "meta.yaml is missing")]
-    meta, parent_ids, ext = _parse_meta(_load_yaml(meta_path, problems), problems)
+    raw_meta = _load_yaml(meta_path, problems)
+    if problems:  # not a readable YAML file (a folder, a FIFO, a link out, ...)
+        return None, problems
+    meta, parent_ids, ext = _parse_meta(raw_meta, problems)
     hurodes_format = meta.format_version is None
     if meta.format_version is not None and meta.format_version != FORMAT_VERSION:
         problems.append(
@@ -606,7 +647,7 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
     meta.joint_mapping = joint_mapping
     mjcf_extra = None
     if EXTRA_MJCF_FILE in present:
-        mjcf_extra = (root / EXTRA_MJCF_FILE).read_text(encoding="utf-8")
+        mjcf_extra = _folder_text(root / EXTRA_MJCF_FILE, MAX_XML_BYTES, problems)
 
     resolved = root.resolve()
     hrdf = HRDF(
@@ -623,6 +664,7 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
         meta=meta,
         mjcf_extra=mjcf_extra,
         root_dir=resolved,
+        asset_roots=trusted_roots(asset_roots),
     )
     if any(b is None for b in hrdf.bodies):
         return None, problems
@@ -630,9 +672,14 @@ def collect_hrdf_dir(path: str | Path) -> tuple[HRDF | None, list[Problem]]:
     return hrdf, problems
 
 
-def read_hrdf_dir(path: str | Path) -> HRDF:
-    """Load an HRDF folder; raise :class:`HRDFError` listing all errors, warn for the rest."""
-    hrdf, problems = collect_hrdf_dir(path)
+def read_hrdf_dir(
+    path: str | Path, *, asset_roots: Iterable[str | os.PathLike[str]] | None = None
+) -> HRDF:
+    """Load an HRDF folder; raise :class:`HRDFError` listing all errors, warn for the rest.
+
+    ``asset_roots``: folders outside the robot folder that mesh paths may point into.
+    """
+    hrdf, problems = collect_hrdf_dir(path, asset_roots=asset_roots)
     errors = [p for p in problems if p.severity == "error"]
     if errors or hrdf is None:
         raise HRDFError(errors or problems, summary=f"invalid HRDF folder {path}")
@@ -748,24 +795,30 @@ def meta_dict(hrdf: HRDF) -> dict[str, Any]:
     return out
 
 
-def _with_folder_mesh_paths(hrdf: HRDF) -> HRDF:
-    """A view of ``hrdf`` whose mesh ``file`` entries are paths inside the folder.
+def _with_folder_mesh_paths(hrdf: HRDF, sources: list[Path]) -> HRDF:
+    """A view of ``hrdf`` whose mesh paths all lie inside the folder being written.
 
-    Meshes given by absolute paths (robots built in memory) are stored under ``meshes/``
-    with their file name; the default ``meshes/<name>.<type>`` path is kept implicit.
+    A relative path without ``..`` is kept (the default ``meshes/<name>.<type>`` stays
+    implicit). Any other (the absolute path of a robot built in memory, a path into a
+    trusted folder outside the robot) becomes ``meshes/<file name>``, numbered when two
+    different files would share a name.
     """
     from dataclasses import replace
 
+    ext = hrdf.meta.mesh_file_type
+    rels = [m.file if m.file is not None else f"meshes/{m.name}.{ext}" for m in hrdf.meshes]
+    inside = [not Path(r).is_absolute() and ".." not in Path(r).parts for r in rels]
+    taken = {r: src for r, src, ok in zip(rels, sources, inside, strict=True) if ok}
     meshes = []
-    for mesh in hrdf.meshes:
-        src = hrdf.mesh_path(mesh)
-        file = mesh.file
-        if file is not None and Path(file).is_absolute():
-            file = f"meshes/{src.name}"
-            if file == f"meshes/{mesh.name}.{hrdf.meta.mesh_file_type}":
-                file = None
+    for mesh, rel, src, ok in zip(hrdf.meshes, rels, sources, inside, strict=True):
+        if not ok:
+            name = Path(rel)
+            rel, k = f"meshes/{name.name}", 1
+            while taken.setdefault(rel, src) != src:
+                rel, k = f"meshes/{name.stem}_{k}{name.suffix}", k + 1
+        file = None if rel == f"meshes/{mesh.name}.{ext}" else rel
         meshes.append(replace(mesh, file=file))
-    return replace(hrdf, meshes=meshes, root_dir=hrdf.root_dir)
+    return replace(hrdf, meshes=meshes)
 
 
 def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> Path:
@@ -783,8 +836,9 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
     if problems:
         raise HRDFError(problems, summary=f"cannot save robot '{hrdf.name}'")
     target = Path(path)
-    sources = [hrdf.mesh_path(m) for m in hrdf.meshes]
-    hrdf = _with_folder_mesh_paths(hrdf)
+    # The copier checks again: every source inside the robot folder or a trusted one.
+    sources = [hrdf.mesh_source(m) for m in hrdf.meshes]
+    hrdf = _with_folder_mesh_paths(hrdf, sources)
 
     def fill(tmp: Path) -> None:
         meta_text = yaml.safe_dump(meta_dict(hrdf), default_flow_style=False, allow_unicode=True)
@@ -804,8 +858,13 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
                 continue
             copied.add(rel)
             dest = tmp / rel
+            if not dest.resolve().is_relative_to(tmp.resolve()):
+                raise HRDFError(
+                    [Problem("mesh.csv", f"mesh path '{rel}' would be written outside {path}")],
+                    summary=f"cannot save robot '{hrdf.name}'",
+                )
             dest.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(source, dest)
+            copy_regular_file(source, dest)
         if hrdf.meta.joint_mapping is not None:
             (tmp / JOINT_MAPPING_FILE).write_text(
                 yaml.safe_dump(

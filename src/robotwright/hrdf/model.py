@@ -17,6 +17,8 @@ See ``docs/hrdf.md`` for the folder format (files, columns, defaults).
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -357,6 +359,9 @@ class HRDF:
 
     ``root_dir`` is the folder the robot was loaded from (mesh files are resolved against
     it), or ``None`` for a robot built in memory whose meshes are given by absolute paths.
+    Mesh paths of a robot with a folder must resolve inside it (no ``..``, absolute path
+    or symbolic link leading out), or inside one of ``asset_roots``: folders the caller
+    trusts explicitly (see :mod:`robotwright._paths`).
     """
 
     name: str
@@ -370,18 +375,26 @@ class HRDF:
     meta: Meta = field(default_factory=Meta)
     mjcf_extra: str | None = None
     root_dir: Path | None = None
+    asset_roots: tuple[Path, ...] = field(default=(), compare=False, repr=False)
 
     # -- loading and saving -------------------------------------------------------------
     @classmethod
-    def from_dir(cls, path: str | Path) -> HRDF:
+    def from_dir(
+        cls, path: str | Path, *, asset_roots: Iterable[str | os.PathLike[str]] | None = None
+    ) -> HRDF:
         """Load an HRDF folder from anywhere on disk (hurodes 0.1.9 or robotwright format).
+
+        Args:
+            path: the folder.
+            asset_roots: folders outside ``path`` that mesh paths may point into
+                (trusted explicitly; by default mesh paths must stay inside ``path``).
 
         Raises:
             robotwright.errors.HRDFError: listing every problem found.
         """
         from robotwright.hrdf.io import read_hrdf_dir
 
-        return read_hrdf_dir(path)
+        return read_hrdf_dir(path, asset_roots=asset_roots)
 
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write this robot as an HRDF folder (atomically: all or nothing).
@@ -465,6 +478,39 @@ class HRDF:
         if path.is_absolute() or self.root_dir is None:
             return path
         return self.root_dir / path
+
+    def mesh_source(self, mesh: MeshGeom) -> Path:
+        """The resolved path of a mesh geom's file, the one to read or copy.
+
+        For a robot with a folder (``root_dir``) the path must resolve inside it or
+        inside a trusted folder (``asset_roots``, or a
+        :func:`robotwright._paths.trusted_asset_roots` block); a robot built in memory
+        names its own files.
+
+        Raises:
+            robotwright.errors.UnsafePathError: the path leads out of the robot folder
+                (the message names the path, where it resolves to and the mesh).
+        """
+        from robotwright._paths import resolve_inside, trusted_roots
+        from robotwright.errors import UnsafePathError
+
+        if self.root_dir is None:
+            return self.mesh_path(mesh).resolve()
+        rel = (
+            mesh.file if mesh.file is not None else f"meshes/{mesh.name}.{self.meta.mesh_file_type}"
+        )
+        try:
+            return resolve_inside(
+                rel,
+                base=self.root_dir,
+                root=self.root_dir,
+                trusted=self.asset_roots + trusted_roots(),
+            )
+        except UnsafePathError as exc:
+            column = "file" if mesh.file is not None else "name"
+            raise UnsafePathError(
+                f"mesh.csv: mesh '{mesh.name}' (column '{column}'): {exc}"
+            ) from None
 
     def summary(self) -> dict[str, Any]:
         """Counts and totals for display."""

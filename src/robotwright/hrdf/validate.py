@@ -18,7 +18,7 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-from robotwright.errors import Problem
+from robotwright.errors import Problem, UnsafePathError
 from robotwright.hrdf.model import (
     ACTUATOR_TYPES,
     HRDF,
@@ -340,15 +340,6 @@ def _check_actuators(hrdf: HRDF) -> list[Problem]:
     return out
 
 
-def _inside(root: Path, rel: str) -> bool:
-    base = root.resolve()
-    try:
-        (base / rel).resolve().relative_to(base)
-    except ValueError:
-        return False
-    return True
-
-
 def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
     # Plain strings: this runs for every mesh row on every load.
     if mesh.file is None and hrdf.root_dir is not None:
@@ -357,21 +348,16 @@ def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
 
 
 def _listing(folder: str, listings: dict[str, set[str]]) -> set[str]:
-    """Names of the files in ``folder``, listed once per check (meshes share a folder)."""
+    """Names of the regular files in ``folder`` that are not symbolic links, listed once
+    per check (meshes share a folder)."""
     names = listings.get(folder)
     if names is None:
         try:
-            names = {e.name for e in os.scandir(folder) if e.is_file()}
+            names = {e.name for e in os.scandir(folder) if e.is_file(follow_symlinks=False)}
         except OSError:
             names = set()
         listings[folder] = names
     return names
-
-
-def _is_file(path: str, listings: dict[str, set[str]]) -> bool:
-    """Existence check through one directory listing per folder."""
-    folder, _, name = path.rpartition(os.sep)
-    return name in _listing(folder, listings)
 
 
 def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Problem]:
@@ -439,9 +425,14 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
         out.append(Problem("simple_geom.csv", f"duplicate geom name '{name}'", column="name"))
     unit = (1.0, 1.0, 1.0)
     ext = hrdf.meta.mesh_file_type
-    default_dir = None  # the folder of meshes/<name>.<ext> paths, when _mesh_file uses it
-    if hrdf.root_dir is not None and os.sep not in str(ext):
-        default_dir = f"{hrdf.root_dir}{os.sep}meshes"
+    root = hrdf.root_dir
+    # The folder of meshes/<name>.<ext> paths, when it is a plain folder of the robot (not
+    # a link): its plain files need no containment check, only a listing.
+    default_dir = None
+    if root is not None and os.sep not in str(ext):
+        candidate = f"{root}{os.sep}meshes"
+        if not os.path.islink(candidate) and Path(root).resolve() == Path(root):
+            default_dir = candidate
     for i, m in enumerate(hrdf.meshes):
         if not m.name:
             out.append(Problem("mesh.csv", "empty mesh name", row=i, column="name"))
@@ -450,33 +441,47 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             out.append(
                 Problem("mesh.csv", f"scale {m.scale}: expected > 0", row=i, column="scale0")
             )
-        relative = m.file is not None and not Path(m.file).is_absolute()
-        if relative and hrdf.root_dir is not None and not _inside(hrdf.root_dir, m.file):
-            out.append(
-                Problem(
-                    "mesh.csv",
-                    f"mesh file '{m.file}' escapes the robot folder",
-                    row=i,
-                    column="file",
-                )
-            )
+        # A plain file listed in the robot's own meshes/ folder is inside and exists.
+        if (
+            _QUICK_PASS
+            and default_dir is not None
+            and m.file is None
+            and os.sep not in m.name
+            and f"{m.name}.{ext}" in _listing(default_dir, listings)
+        ):
             continue
-        if check_files:
-            # What _mesh_file and _is_file do, without building the path of every row.
-            if (
-                _QUICK_PASS
-                and default_dir is not None
-                and m.file is None
-                and os.sep not in m.name
-                and f"{m.name}.{ext}" in _listing(default_dir, listings)
-            ):
-                continue
-            path = _mesh_file(hrdf, m)
-            if not _is_file(path, listings):
+        column = "file" if m.file is not None else "name"
+        if root is not None:
+            try:
+                source = hrdf.mesh_source(m)
+            except UnsafePathError as exc:
                 out.append(
-                    Problem("mesh.csv", f"mesh file '{path}' does not exist", row=i, column="name")
+                    Problem(
+                        "mesh.csv",
+                        f"mesh file escapes the robot folder: {_reason(exc)}",
+                        row=i,
+                        column=column,
+                    )
                 )
+                continue
+            if check_files and not os.path.isfile(source):
+                out.append(_missing(source, i, column))
+        elif check_files:
+            path = _mesh_file(hrdf, m)
+            if not os.path.isfile(path):
+                out.append(_missing(path, i, column))
     return out
+
+
+def _reason(exc: UnsafePathError) -> str:
+    """The message of a :meth:`HRDF.mesh_source` error without its 'mesh.csv: ...' head."""
+    text = str(exc)
+    return text.split("): ", 1)[1] if text.startswith("mesh.csv: ") else text
+
+
+def _missing(path: str | Path, row: int, column: str) -> Problem:
+    why = "is not a regular file" if os.path.exists(path) else "does not exist"
+    return Problem("mesh.csv", f"mesh file '{path}' {why}", row=row, column=column)
 
 
 def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:

@@ -151,7 +151,7 @@ def _hrdf_tree(robot: H.HRDF) -> tuple[Body, list[Problem]]:
     for m in robot.meshes:
         geom = Mesh(
             m.geom_name,
-            file=str(robot.mesh_path(m).resolve()),
+            file=str(robot.mesh_source(m)),
             scale=m.scale,
             mesh=m.name,
             **_geom_kw(m),
