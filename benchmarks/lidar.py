@@ -1,25 +1,29 @@
-"""LiDAR throughput: robotwright's engines vs raw ``mj_multiRay`` vs mujoco-lidar, same scenes.
+"""LiDAR throughput: robotwright vs mjlab's RayCastSensor vs mujoco-lidar vs raw ``mj_multiRay``.
 
 Scenes (built here with MjSpec): a ground plane, 20 primitives (sphere, box, capsule,
 cylinder, ellipsoid) and one 5120-triangle mesh, plus a robot carrying the sensor; the
 "hfield" variant replaces the plane with a 256x256 heightfield. One frame = 20 000 rays
-(Mid-360-like pattern) per environment, for 1 and 16 environments (each environment has
-its own robot pose).
+(Mid-360-like pattern) per environment, for 1, 16, 256 (and on CUDA 4096) environments,
+each environment with its own robot pose.
 
-Contenders, timed per frame on the same poses and directions:
-  raw mj_multiRay       one mj_multiRay call per environment, one thread, no labels
-  robotwright mujoco/1t SemanticLidarSensor.update() (labels on), engine "mujoco", 1 thread,
-                        with the raw call's fixed directions, and with the Mid-360
-                        pattern regenerated every frame
-  robotwright mujoco/Nt the same on every core
-  robotwright warp      engine "warp" (mujoco-warp BVH; CPU device here, CUDA when present)
-  mujoco-lidar cpu/warp MjLidarWrapper backends, when the package is installed (no labels)
+Contenders, timed per frame on the same poses and the same ray directions:
+  raw mj_multiRay        one mj_multiRay call per environment, one thread, no labels
+  robotwright mujoco     SemanticLidarSensor.update() (labels on), engine "mujoco", host
+                         numpy: 1 thread with the raw call's fixed directions, 1 thread
+                         and every core with the Mid-360 window advancing each frame
+  robotwright warp       engine "warp", output "torch", reading a mujoco_warp.Data in
+                         place: the RL training path (labels on, nothing leaves the device)
+  mjlab RayCastSensor    mjlab's own ray cast (prepare -> refit BVH + rays -> finalize),
+                         same directions, no labels (when mjlab is installed: the
+                         MuJoCo 3.11 environment of .ci/run)
+  mujoco-lidar warp/cpu  MjLidarWrapper backends (no labels; `pip install -e .[bench]`)
 
 Contenders run interleaved (one frame each, in turn) so load from other processes hits
 them alike, for at least --repeats rounds and --min-seconds of raw frames; prints median
-frame times, the ratio to raw mj_multiRay and the
-fraction of rays that hit something within 40 m (a check that all do the same work).
-Run: python benchmarks/lidar.py [--repeats 7] [--envs 1 16] [--scenes plane hfield]
+frame times, rays per second, the ratio to raw mj_multiRay and the fraction of rays that
+hit something within 40 m (a check that all do the same work). Slow CPU contenders are
+left out above 16 environments (raw mj_multiRay stays as the reference).
+Run: python benchmarks/lidar.py [--device cpu|cuda] [--envs 1 16 256] [--scenes plane hfield]
 """
 
 from __future__ import annotations
@@ -43,6 +47,10 @@ from robotwright.sensors import (
     SemanticLidarSensor,
     warp_available,
 )
+
+#: Above this many environments the host-side contenders (threads, mujoco-lidar cpu)
+#: take seconds per frame and are left out; raw mj_multiRay stays as the reference.
+MAX_HOST_ENVS = 16
 
 NUM_RAYS = 20_000
 
@@ -112,8 +120,137 @@ def make_envs(model: mujoco.MjModel, n: int) -> list[mujoco.MjData]:
     return datas
 
 
+def device_contenders(
+    model: mujoco.MjModel,
+    datas: list[mujoco.MjData],
+    device: str,
+    pattern: LivoxPatternCfg,
+    dirs_s: np.ndarray,
+    robot: int,
+) -> list[tuple[str, object]]:
+    """Contenders that run on a warp device and read a mujoco_warp.Data in place."""
+    import mujoco_warp as mjw
+    import warp as wp
+
+    wp.config.quiet = True
+    out = []
+    n = len(datas)
+    with wp.ScopedDevice(device):
+        mw = mjw.put_model(model)
+        dw = mjw.put_data(model, datas[0], nworld=n)
+        dw.qpos.assign(np.stack([d.qpos for d in datas]).astype(np.float32))
+        mjw.kinematics(mw, dw)
+    cfg = SemanticLidarCfg(
+        prim_path="lidar",
+        max_distance=40.0,
+        pattern_cfg=pattern,
+        engine="warp",
+        device=device,
+        output="torch",
+    )
+    sensor = SemanticLidarSensor(cfg, model, dw)
+
+    def ours() -> float:
+        sensor.update()
+        wp.synchronize_device(device)
+        return float(sensor.data.hit_mask.float().mean())
+
+    out.append((f"robotwright warp ({device}), labels, torch out", ours))
+    mjlab = mjlab_contender(model, mw, dw, device, dirs_s)
+    if mjlab is not None:
+        out.append((f"mjlab RayCastSensor ({device}, no labels)", mjlab))
+    try:
+        from mujoco_lidar import MjLidarWrapper
+    except ImportError:
+        print("  (mujoco-lidar not installed: skipped; pip install -e '.[bench]')")
+        return out
+    site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "lidar")
+    theta = np.arctan2(dirs_s[:, 1], dirs_s[:, 0])
+    phi = np.arcsin(np.clip(dirs_s[:, 2], -1, 1))
+    args = {"bodyexclude": robot, "device": device}
+    wrp = MjLidarWrapper(model, "lidar", backend="warp", cutoff_dist=40.0, args=args)
+    # mujoco-lidar takes host arrays of poses (its API), so they are made once here.
+    xpos = np.stack([d.geom_xpos for d in datas])
+    xmat = np.stack([d.geom_xmat for d in datas])
+    spos = np.stack([d.site_xpos[site] for d in datas])
+    srot = np.stack([d.site_xmat[site].reshape(3, 3) for d in datas])
+
+    def ml_warp() -> float:
+        dist, _ = wrp.trace_rays_batch(xpos, xmat, spos, srot, theta, phi)
+        return float(((dist > 0) & (dist < 40.0)).mean())
+
+    out.append((f"mujoco-lidar warp ({device}, no labels)", ml_warp))
+    return out
+
+
+def mujoco_lidar_cpu(
+    model: mujoco.MjModel, datas: list[mujoco.MjData], dirs_s: np.ndarray, robot: int
+) -> list[tuple[str, object]]:
+    try:
+        from mujoco_lidar import MjLidarWrapper
+    except ImportError:
+        return []
+    theta = np.arctan2(dirs_s[:, 1], dirs_s[:, 0])
+    phi = np.arcsin(np.clip(dirs_s[:, 2], -1, 1))
+    # Same hittable set as the others: everything but the robot body.
+    cpu = MjLidarWrapper(
+        model, "lidar", backend="cpu", cutoff_dist=40.0, args={"bodyexclude": robot}
+    )
+
+    def ml_cpu() -> float:
+        return float(np.mean([cpu.trace_rays(d, theta, phi) >= 0 for d in datas]))
+
+    return [("mujoco-lidar cpu (no labels)", ml_cpu)]
+
+
+def mjlab_contender(model, mw, dw, device: str, dirs_s: np.ndarray):
+    """mjlab's RayCastSensor on the same model, data and directions (None without mjlab)."""
+    try:
+        import torch
+        from mjlab.sensor.builtin_sensor import ObjRef
+        from mjlab.sensor.raycast_sensor import RayCastSensorCfg
+        from mjlab.sensor.sensor_context import SensorContext
+        from mjlab.sim.sim_data import WarpBridge
+    except ImportError:
+        print("  (mjlab not installed: skipped; it runs in the MuJoCo 3.11 environment)")
+        return None
+    import mujoco_warp as mjw
+    import warp as wp
+
+    class SameRays:
+        """An mjlab pattern that casts our frame-0 Mid-360 directions."""
+
+        def generate_rays(self, mj_model, dev):
+            d = torch.as_tensor(dirs_s, dtype=torch.float32, device=dev)
+            return torch.zeros_like(d), d
+
+    cfg = RayCastSensorCfg(
+        name="bench",
+        frame=ObjRef(type="site", name="lidar"),
+        pattern=SameRays(),  # type: ignore[arg-type]
+        max_distance=40.0,
+        include_geom_groups=None,
+    )
+    sensor = cfg.build()
+    # As mjlab's Simulation does: the sensor sees the warp model/data through torch bridges.
+    mb, db = WarpBridge(mw, nworld=dw.nworld), WarpBridge(dw)
+    sensor.initialize(model, mb, db, device)
+    ctx = SensorContext(model, mb, db, [], [sensor], device)
+
+    def run() -> float:
+        ctx.prepare()
+        with wp.ScopedDevice(device):
+            mjw.refit_bvh(mw, dw, ctx.render_context)
+            sensor.raycast_kernel(rc=ctx.render_context)
+        ctx.finalize()
+        wp.synchronize_device(device)
+        return float((sensor.data.distances >= 0).float().mean())
+
+    return run
+
+
 def bench_scene(
-    kind: str, num_envs: int, repeats: int, min_seconds: float
+    kind: str, num_envs: int, repeats: int, min_seconds: float, device: str
 ) -> list[tuple[str, float, float]]:
     """(label, median seconds per frame, fraction of rays that hit) for every contender."""
     model = build_scene(kind)
@@ -149,7 +286,7 @@ def bench_scene(
     contenders = [("raw mj_multiRay (1 thread, no labels)", raw)]
     common = dict(prim_path="lidar", max_distance=40.0, return_mesh_ids=True)
     # The same 20k directions every frame, as the raw call uses (read from a file of
-    # angles), and the Mid-360 pattern regenerated every frame (non-repetitive).
+    # angles), and the Mid-360 pattern advancing every frame (non-repetitive).
     angles = np.stack(
         [np.arctan2(dirs_s[:, 1], dirs_s[:, 0]), np.arcsin(np.clip(dirs_s[:, 2], -1, 1))], 1
     )
@@ -160,14 +297,16 @@ def bench_scene(
     engines = [
         ("mujoco, 1 thread, fixed rays", dict(engine="mujoco", num_threads=1, pattern_cfg=fixed)),
         ("mujoco, 1 thread", dict(engine="mujoco", num_threads=1, pattern_cfg=pattern)),
-        (f"mujoco, {ncpu} threads", dict(engine="mujoco", num_threads=ncpu, pattern_cfg=pattern)),
     ]
-    if warp_available():
-        engines.append(("warp", dict(engine="warp", pattern_cfg=pattern)))
+    if num_envs <= MAX_HOST_ENVS:
+        engines.append(
+            (
+                f"mujoco, {ncpu} threads",
+                dict(engine="mujoco", num_threads=ncpu, pattern_cfg=pattern),
+            )
+        )
     for label, extra in engines:
         sensor = SemanticLidarSensor(SemanticLidarCfg(**common, **extra), model, datas)
-        if extra["engine"] == "warp":
-            label = f"warp ({sensor._engine.device})"
 
         def ours(sensor: SemanticLidarSensor = sensor) -> float:
             sensor.update()
@@ -175,36 +314,10 @@ def bench_scene(
             return float(sensor.data.hit_mask.mean())
 
         contenders.append((f"robotwright {label}, labels", ours))
-    try:
-        from mujoco_lidar import MjLidarWrapper
-    except ImportError:
-        print("  (mujoco-lidar not installed: skipped)")
-    else:
-        theta = np.arctan2(dirs_s[:, 1], dirs_s[:, 0])
-        phi = np.arcsin(np.clip(dirs_s[:, 2], -1, 1))
-        # Same hittable set as the others: everything but the robot body.
-        cpu = MjLidarWrapper(
-            model, "lidar", backend="cpu", cutoff_dist=40.0, args={"bodyexclude": robot}
-        )
-
-        def ml_cpu() -> float:
-            hits = [cpu.trace_rays(d, theta, phi) >= 0 for d in datas]
-            return float(np.mean(hits))
-
-        contenders.append(("mujoco-lidar cpu (no labels)", ml_cpu))
-        if warp_available():
-            args = {"bodyexclude": robot, "device": "cpu"}
-            wrp = MjLidarWrapper(model, "lidar", backend="warp", cutoff_dist=40.0, args=args)
-            xpos = np.stack([d.geom_xpos for d in datas])
-            xmat = np.stack([d.geom_xmat for d in datas])
-            spos = np.stack([d.site_xpos[site] for d in datas])
-            srot = np.stack([d.site_xmat[site].reshape(3, 3) for d in datas])
-
-            def ml_warp() -> float:
-                dist, _ = wrp.trace_rays_batch(xpos, xmat, spos, srot, theta, phi)
-                return float(((dist > 0) & (dist < 40.0)).mean())
-
-            contenders.append(("mujoco-lidar warp (cpu, no labels)", ml_warp))
+    if warp_available():
+        contenders += device_contenders(model, datas, device, pattern, dirs_s, robot)
+    if num_envs <= MAX_HOST_ENVS:
+        contenders += mujoco_lidar_cpu(model, datas, dirs_s, robot)
     hits = {}
     for label, fn in contenders:  # warm-up: JIT compile, caches
         fn()
@@ -230,7 +343,8 @@ def main() -> None:
     )
     ap.add_argument("--repeats", type=int, default=7, help="minimum rounds per case")
     ap.add_argument("--min-seconds", type=float, default=1.0, help="minimum raw time per case")
-    ap.add_argument("--envs", type=int, nargs="+", default=[1, 16])
+    ap.add_argument("--envs", type=int, nargs="+", default=[1, 16, 256])
+    ap.add_argument("--device", default="cpu", help="warp device of the device contenders")
     ap.add_argument("--scenes", nargs="+", default=["plane", "hfield"], choices=["plane", "hfield"])
     args = ap.parse_args()
     print(f"mujoco {mujoco.__version__}, {os.cpu_count()} CPU cores, {NUM_RAYS} rays/frame/env")
@@ -238,7 +352,7 @@ def main() -> None:
     for kind in args.scenes:
         for n in args.envs:
             print(f"\nscene={kind} envs={n}  (median frame time)")
-            results = bench_scene(kind, n, args.repeats, args.min_seconds)
+            results = bench_scene(kind, n, args.repeats, args.min_seconds, args.device)
             base = results[0][1]
             for label, t, hit in results:
                 mrays = n * NUM_RAYS / t / 1e6

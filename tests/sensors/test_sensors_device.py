@@ -223,3 +223,26 @@ def test_unnamed_plane_is_terrain():
     s.update()
     assert s.geom_path(0) == "/world/geom0_plane"
     assert s.get_semantic_labels()[0, 0] == 1 and math.isclose(s.get_distances()[0, 0], 1.0)
+
+
+def test_cpu_blocks_give_the_same_frame_as_one_launch(clutter_model):
+    """Rays split over threads on warp's CPU device: same distances, labels, noise."""
+    host = random_envs(clutter_model, 2, seed=8)
+    kw = dict(
+        pattern_cfg=LivoxPatternCfg(num_rays=3001),
+        output="torch",
+        range_noise_std=0.02,
+        dropout_prob=0.1,
+        seed=5,
+    )
+    one = SemanticLidarSensor(_cfg(num_threads=1, **kw), clutter_model, host)
+    three = SemanticLidarSensor(_cfg(num_threads=3, **kw), clutter_model, host)
+    assert len(one._pipeline._blocks) == 1 and len(three._pipeline._blocks) == 3
+    for _ in range(2):
+        one.update()
+        three.update()
+        assert torch.equal(one.get_distances(), three.get_distances())
+        assert torch.equal(one.get_semantic_labels(), three.get_semantic_labels())
+        assert torch.equal(one.get_hit_mask(), three.get_hit_mask())
+        assert torch.equal(one.data.ray_directions_w, three.data.ray_directions_w)
+    assert 0.0 < one.get_hit_mask().float().mean() < 1.0

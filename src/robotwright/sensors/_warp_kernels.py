@@ -74,14 +74,18 @@ def world_rays(
     table_o: wp.array(dtype=wp.vec3),
     table_d: wp.array(dtype=wp.vec3),
     window: wp.array(dtype=wp.int32),
+    ray_offset: wp.int32,
     pos_w: wp.array(dtype=wp.vec3),
     ray_rot: wp.array(dtype=wp.mat33),
     pnt: wp.array2d(dtype=wp.vec3),
     vec: wp.array2d(dtype=wp.vec3),
 ):
-    """World rays of every environment: the frame's window of the table, rotated and moved."""
+    """World rays of every environment: the frame's window of the table, rotated and moved.
+
+    ``pnt``/``vec`` may be a column slice of the frame's rays starting at ``ray_offset``.
+    """
     e, i = wp.tid()
-    k = window[0] + i
+    k = window[0] + ray_offset + i
     r = ray_rot[e]
     pnt[e, i] = pos_w[e] + r @ table_o[k]
     vec[e, i] = r @ table_d[k]
@@ -273,6 +277,7 @@ def finish_rays(
     env_seed: wp.array(dtype=wp.int32),
     frame: wp.array(dtype=wp.int32),
     label_lut: wp.array(dtype=wp.int32),
+    ray_offset: wp.int32,
     distances: wp.array2d(dtype=wp.float32),
     hit_mask: wp.array2d(dtype=wp.bool),
     geom_ids: wp.array2d(dtype=wp.int32),
@@ -284,7 +289,8 @@ def finish_rays(
     A ray is a miss when it hits nothing, hits nearer than ``min_distance`` or further
     than ``max_distance``, or is dropped; noise is added to hits only and clipped to
     ``[min_distance, max_distance]``. Misses: distance ``miss_distance``, mask False,
-    geom id -1, label 0 (``label_lut[-1]``), point NaN.
+    geom id -1, label 0, point NaN. The arrays may be a column slice of the frame's rays
+    starting at ``ray_offset`` (the random stream of a ray depends on its index only).
     """
     e, i = wp.tid()
     g = raw_geom[e, i]
@@ -301,7 +307,7 @@ def finish_rays(
     if hit:
         hit = d >= min_distance and d <= max_distance
     if hit and (noise_std > 0.0 or dropout_prob > 0.0):
-        state = wp.rand_init(_mix_seed(env_seed[e], frame[0]), i)
+        state = wp.rand_init(_mix_seed(env_seed[e], frame[0]), ray_offset + i)
         if noise_std > 0.0:
             d = wp.clamp(d + noise_std * wp.randn(state), min_distance, max_distance)
         if dropout_prob > 0.0 and wp.randf(state) < dropout_prob:

@@ -75,7 +75,8 @@ class LidarCfg:
             ``"torch"`` (zero-copy tensors on the sensor's device, float32 / int32 /
             bool) or ``"warp"`` (the device arrays themselves). Torch and warp outputs
             need ``engine="warp"`` and are overwritten in place by every update.
-        num_threads: CPU threads of the ``"mujoco"`` engine; ``None``: one per core.
+        num_threads: CPU threads of the ``"mujoco"`` engine, and of the ``"warp"`` engine
+            on warp's CPU device (rays split in blocks); ``None``: one per core.
     """
 
     prim_path: str

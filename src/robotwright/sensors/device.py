@@ -11,7 +11,9 @@ the simulation's arrays in place; given host ``MjData`` it uploads their geom po
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -81,6 +83,9 @@ class WarpLidarPipeline:
         label_lut: ``(ngeom + 1,)`` class id per geom, last entry for a miss; ``None``:
             every label is 0.
         refine: recompute curved-primitive hits in float64 (default True).
+        num_threads: on warp's CPU device, which runs a kernel on one core, the rays are
+            split into this many column blocks cast by parallel launches (warp releases
+            the GIL while a CPU kernel runs); ``None``: one per core. CUDA: one launch.
 
     Attributes (device arrays, shapes ``E`` = envs, ``N`` = rays per frame):
         distances ``(E, N)`` float32, hit_mask ``(E, N)`` bool, geom_ids and labels
@@ -102,6 +107,7 @@ class WarpLidarPipeline:
         range_model: RangeModel,
         label_lut: np.ndarray | None,
         refine: bool = True,
+        num_threads: int | None = None,
     ) -> None:
         wp, mjw = import_warp()
         self._wp, self._mjw = wp, mjw
@@ -169,6 +175,18 @@ class WarpLidarPipeline:
             self.points = wp.full((e, n), wp.vec3(np.nan, np.nan, np.nan), dtype=wp.vec3)
             self._carrier_pos = wp.zeros((e, 1), dtype=wp.vec3)
             self._carrier_mat = wp.zeros((e, 1), dtype=wp.mat33)
+        threads = 1 if self.device.is_cuda else max(1, int(num_threads or os.cpu_count() or 1))
+        bounds = [n * k // threads for k in range(threads + 1)]
+        self._blocks = [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+        self._pool = ThreadPoolExecutor(len(self._blocks)) if len(self._blocks) > 1 else None
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=False)
+            self._pool = None
+
+    def __del__(self) -> None:  # pragma: no cover - best effort at interpreter teardown
+        self.close()
 
     # ------------------------------------------------------------------ inputs
     def check_data(self, data: Any) -> None:
@@ -223,7 +241,6 @@ class WarpLidarPipeline:
                 cpos, cmat = dev.xpos, dev.xmat
             else:
                 cpos, cmat = dev.site_xpos, dev.site_xmat
-        rm = self.range_model
         with wp.ScopedDevice(self.device):
             wp.launch(
                 k.advance_frame,
@@ -237,34 +254,54 @@ class WarpLidarPipeline:
                 inputs=[cpos, cmat, idx, self._offset_pos, self._offset_mat, self._alignment],
                 outputs=[self.pos_w, self.quat_w, self.sensor_mat, self.ray_rot],
             )
+            mjw.refit_bvh(self._m, dev, self._rc)
+        blocks = [(a, b, dev) for a, b in self._blocks]
+        if self._pool is None:
+            for block in blocks:
+                self._cast_block(block)
+        else:
+            list(self._pool.map(self._cast_block, blocks))
+
+    def _cast_block(self, block: tuple[int, int, Any]) -> None:
+        """World rays, casting and finishing of the rays ``[a, b)`` of every environment."""
+        wp, mjw, k = self._wp, self._mjw, self._k
+        a, b, dev = block
+        e, rm = self.num_envs, self.range_model
+        whole = (a, b) == (0, self.num_rays)
+
+        def cols(array: Any) -> Any:
+            return array if whole else array[:, a:b]
+
+        pnt, vec = cols(self.ray_origins), cols(self.ray_directions)
+        raw_dist, raw_geom = cols(self._raw_dist), cols(self._raw_geom)
+        with wp.ScopedDevice(self.device):
             wp.launch(
                 k.world_rays,
-                dim=(e, n),
-                inputs=[self.table_o, self.table_d, self.window, self.pos_w, self.ray_rot],
-                outputs=[self.ray_origins, self.ray_directions],
+                dim=(e, b - a),
+                inputs=[self.table_o, self.table_d, self.window, a, self.pos_w, self.ray_rot],
+                outputs=[pnt, vec],
             )
-            mjw.refit_bvh(self._m, dev, self._rc)
             mjw.rays(
                 self._m,
                 dev,
-                self.ray_origins,
-                self.ray_directions,
+                pnt,
+                vec,
                 self._geomgroup,
                 True,
-                self._bodyexclude,
-                self._raw_dist,
-                self._raw_geom,
-                self._normal,
+                self._bodyexclude if whole else self._bodyexclude[: b - a],
+                raw_dist,
+                raw_geom,
+                cols(self._normal),
                 self._rc,
             )
             wp.launch(
                 k.finish_rays,
-                dim=(e, n),
+                dim=(e, b - a),
                 inputs=[
-                    self._raw_dist,
-                    self._raw_geom,
-                    self.ray_origins,
-                    self.ray_directions,
+                    raw_dist,
+                    raw_geom,
+                    pnt,
+                    vec,
                     dev.geom_xpos,
                     dev.geom_xmat,
                     self.geom_type,
@@ -278,6 +315,13 @@ class WarpLidarPipeline:
                     self.env_seed,
                     self.frame,
                     self.label_lut,
+                    a,
                 ],
-                outputs=[self.distances, self.hit_mask, self.geom_ids, self.labels, self.points],
+                outputs=[
+                    cols(self.distances),
+                    cols(self.hit_mask),
+                    cols(self.geom_ids),
+                    cols(self.labels),
+                    cols(self.points),
+                ],
             )

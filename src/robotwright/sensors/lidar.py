@@ -292,6 +292,7 @@ class LidarSensor:
                     seed=cfg.seed,
                 ),
                 self._label_lut,
+                num_threads=cfg.num_threads,
             )
             if self._warp_data is not None:
                 self._pipeline.check_data(self._warp_data)
