@@ -6,10 +6,30 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
+import numpy as np
+
 from robotwright.errors import SensorError
 from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
 
 __all__ = ["LidarCfg", "SemanticLidarCfg", "DEFAULT_SEMANTIC_CLASS_MAPPING"]
+
+#: Most CPU threads a sensor may start.
+MAX_THREADS = 256
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _floats(value: object, n: int) -> tuple[float, ...] | None:
+    """``value`` as ``n`` floats, or None when it is not a sequence of ``n`` numbers."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
+        return None
+    items = list(value)  # type: ignore[call-overload]
+    if len(items) != n or not all(_is_number(v) or isinstance(v, np.floating) for v in items):
+        return None
+    return tuple(float(v) for v in items)
+
 
 #: The seed's default mapping: class ids are 1..K in this order, 0 = miss/unknown.
 DEFAULT_SEMANTIC_CLASS_MAPPING: dict[str, list[str]] = {
@@ -107,16 +127,17 @@ class LidarCfg:
             raise SensorError(
                 f"{name}.pattern_cfg: expected a PatternCfg, got {type(self.pattern_cfg).__name__}"
             )
-        if self.pattern_cfg.num_rays < 1:
-            raise SensorError(f"{name}.pattern_cfg: empty pattern (0 rays)")
-        if len(self.offset_pos) != 3 or not all(math.isfinite(v) for v in self.offset_pos):
+        offset_pos = _floats(self.offset_pos, 3)
+        if offset_pos is None or not all(math.isfinite(v) for v in offset_pos):
             raise SensorError(
-                f"{name}.offset_pos: expected 3 finite numbers [m], got {self.offset_pos}"
+                f"{name}.offset_pos: expected 3 finite numbers [m], got {self.offset_pos!r}"
             )
-        norm = math.sqrt(sum(v * v for v in self.offset_rot)) if len(self.offset_rot) == 4 else 0.0
+        self.offset_pos = offset_pos  # type: ignore[assignment]
+        rot = _floats(self.offset_rot, 4)
+        norm = math.sqrt(sum(v * v for v in rot)) if rot is not None else 0.0
         if not norm > 1e-9 or not math.isfinite(norm):
             raise SensorError(
-                f"{name}.offset_rot: expected a non-zero quaternion (w, x, y, z), got {self.offset_rot}"
+                f"{name}.offset_rot: expected a non-zero quaternion (w, x, y, z), got {self.offset_rot!r}"
             )
         self.offset_rot = tuple(float(v) / norm for v in self.offset_rot)  # type: ignore[assignment]
         if self.ray_alignment not in ("base", "yaw", "world"):
@@ -130,7 +151,7 @@ class LidarCfg:
         self.mesh_prim_paths = list(self.mesh_prim_paths)
         for key in ("min_distance", "max_distance", "range_noise_std"):
             value = getattr(self, key)
-            if not isinstance(value, (int, float)) or math.isnan(value) or value < 0:
+            if not _is_number(value) or math.isnan(value) or value < 0:
                 raise SensorError(
                     f"{name}.{key}: expected a non-negative number [m], got {value!r}"
                 )
@@ -138,13 +159,13 @@ class LidarCfg:
             raise SensorError(
                 f"{name}: expected min_distance < max_distance < inf, got {self.min_distance}, {self.max_distance}"
             )
-        if not (0.0 <= self.dropout_prob <= 1.0):
+        if not _is_number(self.dropout_prob) or not (0.0 <= self.dropout_prob <= 1.0):
             raise SensorError(
-                f"{name}.dropout_prob: expected a probability in [0, 1], got {self.dropout_prob}"
+                f"{name}.dropout_prob: expected a probability in [0, 1], got {self.dropout_prob!r}"
             )
         if self.miss_distance is None:
             self.miss_distance = float(self.max_distance)
-        elif not isinstance(self.miss_distance, (int, float)) or math.isnan(self.miss_distance):
+        elif not _is_number(self.miss_distance) or math.isnan(self.miss_distance):
             raise SensorError(
                 f"{name}.miss_distance: expected a number [m] or None, got {self.miss_distance!r}"
             )
@@ -160,10 +181,23 @@ class LidarCfg:
                 "the mujoco engine returns numpy"
             )
         if self.num_threads is not None and (
-            not isinstance(self.num_threads, int) or self.num_threads < 1
+            not isinstance(self.num_threads, int)
+            or isinstance(self.num_threads, bool)
+            or not 1 <= self.num_threads <= MAX_THREADS
         ):
             raise SensorError(
-                f"{name}.num_threads: expected an integer >= 1 or None, got {self.num_threads!r}"
+                f"{name}.num_threads: expected an integer in [1, {MAX_THREADS}] or None, "
+                f"got {self.num_threads!r}"
+            )
+        if self.seed is not None and (
+            not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0
+        ):
+            raise SensorError(
+                f"{name}.seed: expected an integer >= 0 or None (fresh entropy), got {self.seed!r}"
+            )
+        if not isinstance(self.exclude_robot, bool):
+            raise SensorError(
+                f"{name}.exclude_robot: expected True or False, got {self.exclude_robot!r}"
             )
 
 

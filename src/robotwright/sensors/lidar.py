@@ -514,6 +514,12 @@ class LidarSensor:
         assert self._engine is not None
         origins_s, dirs_s = self._table.window(self._frame)
         pos, mat = self.sensor_poses()
+        bad = np.flatnonzero(~(np.isfinite(pos).all(axis=1) & np.isfinite(mat).all(axis=(1, 2))))
+        if bad.size:  # a diverged simulation: every ray would silently miss
+            raise SensorError(
+                f"environment {int(bad[0])}: the pose of {self.cfg.prim_path!r} is not finite "
+                "(NaN or inf in MjData: has the simulation diverged?)"
+            )
         rot = self._ray_rotation(mat)
         raw_dist, geom_ids = self._engine.cast(
             self._datas,

@@ -118,6 +118,21 @@ def _check_positive(name: str, value: float, cls: str) -> None:
         raise SensorError(f"{cls}.{name}: expected a positive finite number, got {value!r}")
 
 
+#: Most rays one frame may cast (a 4096-env batch of these is already 40 GB of rays), and
+#: most rows of a precomputed table: larger requests are refused before any allocation.
+MAX_RAYS_PER_FRAME = 10_000_000
+MAX_TABLE_RAYS = 20_000_000
+
+
+def _check_ray_count(count: float, cls: str, what: str = "rays per frame") -> None:
+    limit = MAX_RAYS_PER_FRAME if what == "rays per frame" else MAX_TABLE_RAYS
+    if count > limit:
+        raise SensorError(
+            f"{cls}: {count:.3g} {what} requested; at most {limit:,} are allowed "
+            "(check the resolution, size or field of view)"
+        )
+
+
 def _check_count(name: str, value: int, cls: str) -> None:
     if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
         raise SensorError(f"{cls}.{name}: expected an integer >= 1, got {value!r}")
@@ -202,6 +217,10 @@ class LivoxPatternCfg(PatternCfg):
         _check_count("num_rays", self.num_rays, name)
         _check_count("num_lines", self.num_lines, name)
         _check_count("table_frames", self.table_frames, name)
+        _check_ray_count(self.num_rays, name)
+        _check_ray_count(
+            self.num_rays * self.table_frames, name, "table rows (num_rays x table_frames)"
+        )
         for key in ("points_per_second", "horizontal_fov", "rotation_hz", "elevation_sweep_hz"):
             _check_positive(key, getattr(self, key), name)
         if self.horizontal_fov > 2.0 * math.pi + 1e-12:
@@ -213,9 +232,13 @@ class LivoxPatternCfg(PatternCfg):
             raise SensorError(
                 f"{name}: expected -pi/2 <= vertical_fov_min < vertical_fov_max <= pi/2, got {lo}, {hi}"
             )
-        if len(self.prism_rpm) != 2 or self.prism_rpm[0] == self.prism_rpm[1]:
+        if (
+            len(self.prism_rpm) != 2
+            or self.prism_rpm[0] == self.prism_rpm[1]
+            or not all(math.isfinite(r) for r in self.prism_rpm)
+        ):
             raise SensorError(
-                f"{name}.prism_rpm: expected two different rates, got {self.prism_rpm}"
+                f"{name}.prism_rpm: expected two different finite rates, got {self.prism_rpm}"
             )
 
     def _directions(self, frame: int) -> np.ndarray:
@@ -314,10 +337,18 @@ class SpinningLidarPatternCfg(PatternCfg):
             raise SensorError(
                 f"{name}.vertical_angles: empty pattern (expected at least one channel)"
             )
-        if any(abs(a) > math.pi / 2 for a in self.vertical_angles):
+        if not all(abs(a) <= math.pi / 2 for a in self.vertical_angles):  # NaN fails too
             raise SensorError(f"{name}.vertical_angles: expected angles in [-pi/2, pi/2] rad")
         _check_positive("horizontal_resolution", self.horizontal_resolution, name)
         _check_positive("horizontal_fov", self.horizontal_fov, name)
+        if not (
+            isinstance(self.horizontal_start, (int, float)) and math.isfinite(self.horizontal_start)
+        ):
+            raise SensorError(
+                f"{name}.horizontal_start: expected a finite angle [rad], got {self.horizontal_start!r}"
+            )
+        columns = self.horizontal_fov / self.horizontal_resolution + 1
+        _check_ray_count(columns * len(self.vertical_angles), name)
 
     @property
     def channels(self) -> int:
@@ -374,8 +405,11 @@ class GridPatternCfg(PatternCfg):
             raise SensorError(
                 f"{name}.size: expected two non-negative lengths [m], got {self.size}"
             )
+        _check_ray_count(
+            (self.size[0] / self.resolution + 1) * (self.size[1] / self.resolution + 1), name
+        )
         norm = float(np.linalg.norm(self.direction))
-        if len(self.direction) != 3 or not norm > 0:
+        if len(self.direction) != 3 or not norm > 0 or not math.isfinite(norm):
             raise SensorError(
                 f"{name}.direction: expected a non-zero 3-vector, got {self.direction}"
             )
@@ -415,6 +449,7 @@ class PinholeCameraPatternCfg(PatternCfg):
         name = type(self).__name__
         _check_count("width", self.width, name)
         _check_count("height", self.height, name)
+        _check_ray_count(self.width * self.height, name)
         _check_positive("horizontal_fov", self.horizontal_fov, name)
         if self.horizontal_fov >= math.pi:
             raise SensorError(
@@ -461,6 +496,7 @@ class FilePatternCfg(PatternCfg):
             )
         if angles.shape[0] == 0:
             raise SensorError(f"{path}: empty pattern (no rays)")
+        _check_ray_count(angles.shape[0], str(path))
         if self.degrees:
             angles = np.radians(angles)
         bad = np.flatnonzero(
