@@ -27,10 +27,17 @@ from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
+from typing import Any
 
 from robotwright.errors import UnsafePathError
 
-__all__ = ["resolve_inside", "trusted_asset_roots", "trusted_roots"]
+__all__ = [
+    "check_mjcf_includes",
+    "check_mjcf_spec",
+    "resolve_inside",
+    "trusted_asset_roots",
+    "trusted_roots",
+]
 
 PathLike = str | os.PathLike[str]
 
@@ -76,6 +83,7 @@ def resolve_inside(
     base: PathLike,
     root: PathLike,
     trusted: Sequence[Path] | None = None,
+    what: str = "the robot folder",
 ) -> Path:
     """The resolved path of ``file`` (a relative one is taken from folder ``base``),
     which must lie inside folder ``root`` or a trusted folder.
@@ -85,6 +93,7 @@ def resolve_inside(
         base: the folder a relative ``file`` is relative to.
         root: the folder the path must stay inside (the robot's folder).
         trusted: resolved folders also allowed; ``None``: :func:`trusted_roots`.
+        what: how messages name ``root``.
 
     Raises:
         UnsafePathError: the path leaves ``root`` (the message says where it resolves
@@ -110,6 +119,138 @@ def resolve_inside(
         else ""
     )
     raise UnsafePathError(
-        f"'{file}' resolves{how} to {resolved}: expected a path inside the robot folder "
-        f"{root_path} (a folder outside it can be trusted with asset_roots / --asset-root)"
+        f"'{file}' resolves{how} to {resolved}, outside {what} {root_path}; expected a path "
+        "inside it (a folder outside can be trusted with asset_roots / --asset-root)"
     )
+
+
+# ------------------------------------------------------------------------------- MJCF
+
+#: MJCF asset elements whose files MuJoCo reads at compile time, and the compiler folder
+#: their relative paths are taken from (``assetdir`` sets both).
+_SPEC_ASSETS = (("meshes", "mesh", "meshdir"), ("hfields", "hfield", "meshdir"))
+_SPEC_ASSETS += (("skins", "skin", "meshdir"), ("textures", "texture", "texturedir"))
+#: How deep ``<include>`` may nest (MuJoCo refuses include cycles itself, later).
+MAX_INCLUDE_DEPTH = 20
+
+
+def _element(tag: str, name: str | None, attr: str, value: str) -> str:
+    named = f' name="{name}"' if name else ""
+    return f'<{tag}{named} {attr}="{value}">'
+
+
+def _compiler_dirs(tree: Any) -> list[str]:
+    out = []
+    for el in tree.iter("compiler"):
+        out += [el.get(a) for a in ("meshdir", "texturedir", "assetdir") if el.get(a)]
+    return out
+
+
+def check_mjcf_includes(
+    tree: Any,
+    *,
+    source: str,
+    model_dir: PathLike,
+    root: PathLike,
+    trusted: Sequence[Path] | None = None,
+) -> None:
+    """Check what MuJoCo's XML parser itself opens, before it runs: ``<include file>``
+    (each included file is read safely, without entities, and checked the same way) and
+    the files of other elements read while parsing (``<flexcomp file>``, ``<model
+    file>``), the latter taken both from ``model_dir`` and from every compiler folder.
+
+    Args:
+        tree: the root element of the (already safely parsed) main file.
+        source: the main file, for messages.
+        model_dir: the folder of the main file (MuJoCo resolves includes from it).
+        root: the folder every path must stay inside (besides trusted ones).
+
+    Raises:
+        UnsafePathError: naming the file and element; also for an included file that is
+            not well-formed or unsafe XML, and for includes nested too deep.
+    """
+    import defusedxml
+    import defusedxml.ElementTree as SafeET
+
+    pending = [(tree, source, 0)]
+    dirs = [""]
+    while pending:
+        node, where, depth = pending.pop()
+        dirs += _compiler_dirs(node)
+        for el in node.iter():
+            if not isinstance(el.tag, str):
+                continue
+            if el.tag == "include":
+                value = el.get("file") or ""
+                elem = _element("include", None, "file", value)
+                try:
+                    path = resolve_inside(value, base=model_dir, root=root, trusted=trusted)
+                except UnsafePathError as exc:
+                    raise UnsafePathError(exc.reason, file=where, element=elem) from None
+                if depth + 1 > MAX_INCLUDE_DEPTH:
+                    raise UnsafePathError(
+                        f"includes nest deeper than {MAX_INCLUDE_DEPTH} levels",
+                        file=where,
+                        element=elem,
+                    )
+                try:
+                    child = SafeET.parse(str(path)).getroot()
+                except (defusedxml.DefusedXmlException, SafeET.ParseError, OSError) as exc:
+                    raise UnsafePathError(
+                        f"the included file cannot be read as safe XML: {exc}",
+                        file=where,
+                        element=elem,
+                    ) from None
+                pending.append((child, str(path), depth + 1))
+                continue
+            if el.tag in ("mesh", "hfield", "skin", "texture"):
+                continue  # read at compile time: see check_mjcf_spec
+            for attr, value in el.attrib.items():
+                if attr.startswith("file") and value:
+                    for folder in dirs:
+                        try:
+                            resolve_inside(
+                                Path(folder) / value, base=model_dir, root=root, trusted=trusted
+                            )
+                        except UnsafePathError as exc:
+                            elem = _element(el.tag, el.get("name"), attr, value)
+                            raise UnsafePathError(exc.reason, file=where, element=elem) from None
+
+
+def check_mjcf_spec(
+    spec: Any,
+    *,
+    source: str,
+    model_dir: PathLike,
+    root: PathLike,
+    trusted: Sequence[Path] | None = None,
+) -> None:
+    """Check every file a ``mujoco.MjSpec`` reads when compiled (mesh, height field, skin
+    and texture files, cube faces included) as MuJoCo resolves them: an absolute file as
+    is, else under ``meshdir``/``texturedir`` (itself absolute, or under ``model_dir``);
+    with ``strippath`` the file name only.
+
+    Raises:
+        UnsafePathError: naming ``source`` and the element.
+    """
+    compiler = getattr(spec, "compiler", None)
+    strip = bool(getattr(spec, "strippath", False))
+    for group, tag, dir_attr in _SPEC_ASSETS:
+        folder = getattr(compiler, dir_attr, None)
+        if folder is None:
+            folder = getattr(spec, dir_attr, "")
+        for item in getattr(spec, group, []):
+            files = [("file", item.file)]
+            if tag == "texture":
+                files += [(f"cubefiles[{k}]", f) for k, f in enumerate(item.cubefiles)]
+            for attr, value in files:
+                if not value:
+                    continue
+                file = os.path.basename(value) if strip else value
+                try:
+                    resolve_inside(
+                        Path(folder or "") / file, base=model_dir, root=root, trusted=trusted
+                    )
+                except UnsafePathError as exc:
+                    elem = _element(tag, item.name, attr, value)
+                    raise UnsafePathError(exc.reason, file=source, element=elem) from None

@@ -87,7 +87,22 @@ class UnsafePathError(RobotwrightError, ValueError):
     """A file path read from an input (a mesh, texture or include path) leaves the folder
     it must stay in: ``..``, an absolute path or a symbolic link pointing elsewhere
     (see :mod:`robotwright._paths`). Folders can be trusted explicitly (``asset_roots``,
-    ``--asset-root``)."""
+    ``--asset-root``).
+
+    Attributes:
+        file: the input file the path was read from, when known.
+        element: the element holding it (e.g. ``<mesh name="leg" file="../x.stl">``).
+        reason: the message without file and element.
+    """
+
+    def __init__(
+        self, message: str, *, file: str | None = None, element: str | None = None
+    ) -> None:
+        self.file = file
+        self.element = element
+        self.reason = message
+        where = ": ".join(x for x in (file, element) if x)
+        super().__init__(f"{where}: {message}" if where else message)
 
 
 class InputFileError(RobotwrightError, ValueError):

@@ -509,7 +509,7 @@ class HRDF:
         except UnsafePathError as exc:
             column = "file" if mesh.file is not None else "name"
             raise UnsafePathError(
-                f"mesh.csv: mesh '{mesh.name}' (column '{column}'): {exc}"
+                exc.reason, file="mesh.csv", element=f"mesh '{mesh.name}' (column '{column}')"
             ) from None
 
     def summary(self) -> dict[str, Any]:

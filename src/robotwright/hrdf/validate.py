@@ -458,7 +458,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
                 out.append(
                     Problem(
                         "mesh.csv",
-                        f"mesh file escapes the robot folder: {_reason(exc)}",
+                        f"mesh file escapes the robot folder: {exc.reason}",
                         row=i,
                         column=column,
                     )
@@ -471,12 +471,6 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             if not os.path.isfile(path):
                 out.append(_missing(path, i, column))
     return out
-
-
-def _reason(exc: UnsafePathError) -> str:
-    """The message of a :meth:`HRDF.mesh_source` error without its 'mesh.csv: ...' head."""
-    text = str(exc)
-    return text.split("): ", 1)[1] if text.startswith("mesh.csv: ") else text
 
 
 def _missing(path: str | Path, row: int, column: str) -> Problem:

@@ -22,7 +22,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from robotwright.errors import ConversionError, Problem
+from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
+from robotwright.errors import ConversionError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
     HRDF,
     Actuator,
@@ -82,12 +83,16 @@ class MJCFOptions:
             object's triangles unchanged (each such mesh is reported; the robot then
             differs from the source as MuJoCo compiles it). Without it the loss is
             reported.
+        asset_roots: folders outside the MJCF's folder that its files (meshes,
+            textures, includes) may point into. By default every file must lie inside
+            the MJCF's folder (see :mod:`robotwright._paths`).
     """
 
     root_body: str | None = None
     work_dir: Path | None = None
     massless_frames: str = "keep"
     join_obj_objects: bool = False
+    asset_roots: tuple[str | os.PathLike, ...] = ()
 
     def __post_init__(self) -> None:
         if self.massless_frames not in ("keep", "site"):
@@ -806,17 +811,28 @@ def parse_mjcf(
     """Parse an MJCF file into an HRDF (see the module docstring and :class:`MJCFOptions`).
 
     Raises:
-        ConversionError: unsafe XML, a model MuJoCo cannot compile (MuJoCo's message),
-            a world with several robots and no ``root_body``, or, with ``strict=True``,
-            any warning.
+        ConversionError: unsafe XML, a file path leaving the MJCF's folder (an include,
+            mesh or texture: ``..``, an absolute path or ``meshdir``, a symbolic link; see
+            ``asset_roots``), a model MuJoCo cannot compile (MuJoCo's message), a world
+            with several robots and no ``root_body``, or, with ``strict=True``, any
+            warning.
     """
     path = Path(path)
     opt = options or MJCFOptions()
     rep = Reporter(str(path))
-    parse_xml(path)  # refuse entity tricks before MuJoCo's own (expanding) XML reader
+    # Refuse entity tricks before MuJoCo's own (expanding) XML reader, and any file the
+    # model would make MuJoCo read (include, mesh, texture) outside the MJCF's folder.
+    tree = parse_xml(path)
+    where = {"source": str(path), "model_dir": path.resolve().parent}
     try:
+        trusted = trusted_roots(opt.asset_roots)
+        check_mjcf_includes(tree, **where, root=path.resolve().parent, trusted=trusted)
         spec = mujoco.MjSpec.from_file(str(path))
+        check_mjcf_spec(spec, **where, root=path.resolve().parent, trusted=trusted)
         model = spec.compile()
+    except UnsafePathError as exc:
+        problem = Problem(exc.file or str(path), exc.reason, element=exc.element)
+        raise ConversionError([problem]) from exc
     except ValueError as exc:
         raise ConversionError([Problem(str(path), f"MuJoCo cannot load it: {exc}")]) from exc
 

@@ -10,7 +10,11 @@
    ``NAME`` sub-folder, or an ancestor whose ``package.xml`` names ``NAME``.
 
 A resolved path must stay inside its package folder (``..`` may not climb out), and a
-relative or ``file://`` path must stay inside the robot folder (see :func:`robot_root`).
+relative or ``file://`` path must stay inside the robot folder (see :func:`robot_root`),
+symbolic links followed, unless it lies in a folder trusted explicitly (see
+:mod:`robotwright._paths`). A package found among the URDF's ancestors (step 4) must
+hold a ``package.xml`` or lie inside the robot folder, so that ``package://etc/passwd``
+cannot name ``/etc``.
 """
 
 from __future__ import annotations
@@ -21,6 +25,9 @@ from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
 from urllib.parse import unquote, urlparse
+
+from robotwright._paths import resolve_inside
+from robotwright.errors import UnsafePathError
 
 _NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 
@@ -74,10 +81,17 @@ def find_package(
     for entry in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
         if entry and (Path(entry) / "share" / name).is_dir():
             return Path(entry) / "share" / name
+    root = robot_root(urdf_path)
+
+    def is_package(folder: Path) -> bool:
+        # Any folder on the way up (/etc, /home) is not a package: it needs a package.xml
+        # or must lie inside the robot folder.
+        return folder.resolve().is_relative_to(root) or (folder / "package.xml").is_file()
+
     for ancestor in urdf_path.resolve().parents:
-        if ancestor.name == name:
+        if ancestor.name == name and is_package(ancestor):
             return ancestor
-        if (ancestor / name).is_dir():
+        if (ancestor / name).is_dir() and is_package(ancestor / name):
             return ancestor / name
         if _package_xml_name(str(ancestor)) == name:
             return ancestor
@@ -93,14 +107,6 @@ def robot_root(urdf_path: Path) -> Path:
         if (ancestor / "package.xml").is_file():
             return ancestor
     return resolved.parent.parent
-
-
-def _inside(path: Path, root: Path) -> bool:
-    try:
-        path.relative_to(root)
-    except ValueError:
-        return False
-    return True
 
 
 def resolve_uri(
@@ -123,18 +129,20 @@ def resolve_uri(
                 f"package '{name}' not found (package_map, ROS_PACKAGE_PATH, "
                 f"AMENT_PREFIX_PATH, ancestors of {urdf_path})"
             )
-        base = pkg.resolve()
-        path = (base / unquote(sub)).resolve()
-        if not _inside(path, base):
-            raise UnresolvedMesh(f"'{uri}' escapes package folder {base}")
+        try:
+            path = resolve_inside(
+                unquote(sub), base=pkg, root=pkg, what=f"the folder of package '{name}'"
+            )
+        except UnsafePathError as exc:
+            raise UnresolvedMesh(f"'{uri}': {exc}") from None
     else:
-        path = Path(unquote(urlparse(uri).path)) if uri.startswith("file://") else Path(uri)
-        if not path.is_absolute():
-            path = urdf_path.resolve().parent / path
-        path = path.resolve()
-        base = (root or robot_root(urdf_path)).resolve()
-        if not _inside(path, base):
-            raise UnresolvedMesh(f"'{uri}' resolves to {path}, outside the robot folder {base}")
+        raw = Path(unquote(urlparse(uri).path)) if uri.startswith("file://") else Path(uri)
+        try:
+            path = resolve_inside(
+                raw, base=urdf_path.resolve().parent, root=root or robot_root(urdf_path)
+            )
+        except UnsafePathError as exc:
+            raise UnresolvedMesh(str(exc) if str(raw) == uri else f"'{uri}': {exc}") from None
     if not path.is_file():
         raise UnresolvedMesh(f"'{uri}' resolves to {path}, which does not exist")
     return path

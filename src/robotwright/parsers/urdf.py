@@ -21,6 +21,7 @@ from typing import Literal
 
 import numpy as np
 
+from robotwright._paths import trusted_asset_roots
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import (
     HRDF,
@@ -72,6 +73,8 @@ class URDFOptions:
             lines), of which MuJoCo reads the first only, into one mesh holding every
             object's triangles unchanged (each such mesh is reported; without the option
             the loss is reported).
+        asset_roots: folders outside the robot folder that relative and ``file://``
+            mesh paths may point into (trusted explicitly; see :mod:`robotwright._paths`).
     """
 
     fixed_joints: FixedPolicy = "keep"
@@ -84,6 +87,7 @@ class URDFOptions:
     bound_inertia: float | None = None
     floating_base: bool = False
     join_obj_objects: bool = False
+    asset_roots: tuple[str | os.PathLike, ...] = ()
 
     def __post_init__(self) -> None:
         if self.fixed_joints not in FIXED_POLICIES:
@@ -588,11 +592,16 @@ def parse_urdf(
     """Parse a URDF file into an HRDF (see :class:`URDFOptions`).
 
     Raises:
-        ConversionError: malformed or unsafe XML, an invalid tree, unresolved meshes
-            (all listed in one error), or, with ``strict=True``, any warning.
+        ConversionError: malformed or unsafe XML, an invalid tree, unresolved meshes or
+            mesh paths leaving the robot folder (all listed in one error), or, with
+            ``strict=True``, any warning.
     """
-    path = Path(path)
     opt = options or URDFOptions()
+    with trusted_asset_roots(opt.asset_roots):
+        return _parse_urdf(Path(path), opt, strict)
+
+
+def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     rep = Reporter(str(path))
     root = parse_xml(path)
     if root.tag != "robot":

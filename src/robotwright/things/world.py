@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import os
-import shutil
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 import mujoco
 import numpy as np
 
-from robotwright._atomic import atomic_open
+from robotwright._atomic import atomic_open, copy_file_atomic
 from robotwright.errors import RobotwrightError
 from robotwright.things.attrs import Choice, Flag, Integer, Real, Vector
 from robotwright.things.base import BaseThing
@@ -239,7 +239,8 @@ class World(BaseThing):
         if copies:
             (out_dir / "assets").mkdir(exist_ok=True)
             for src, rel in copies.items():
-                shutil.copyfile(src, out_dir / "assets" / rel)
+                # Atomic, and regular files only (a FIFO or device is refused unread).
+                copy_file_atomic(Path(src), out_dir / "assets" / rel)
         with atomic_open(path, "w") as fh:
             fh.write(text)
         return path
@@ -247,20 +248,32 @@ class World(BaseThing):
     # ------------------------------------------------------------------ reading
     @classmethod
     def from_xml_string(
-        cls, xml: str, base_dir: str | os.PathLike[str] | None = None, strict: bool = False
+        cls,
+        xml: str,
+        base_dir: str | os.PathLike[str] | None = None,
+        strict: bool = False,
+        asset_roots: Iterable[str | os.PathLike[str]] | None = None,
     ) -> World:
         """Build Things from MJCF text; relative file paths resolve against ``base_dir``
-        (default: the working directory). See :mod:`robotwright.things.xml_reader`."""
+        (default: the working directory) and must stay inside it or inside one of
+        ``asset_roots``. See :mod:`robotwright.things.xml_reader`."""
         from robotwright.things.xml_reader import world_from_string
 
-        return world_from_string(xml, base_dir=base_dir, strict=strict)
+        return world_from_string(xml, base_dir=base_dir, strict=strict, asset_roots=asset_roots)
 
     @classmethod
-    def from_xml_path(cls, path: str | os.PathLike[str], strict: bool = False) -> World:
-        """Build Things from an MJCF file (``<include>`` and relative paths resolve from it)."""
+    def from_xml_path(
+        cls,
+        path: str | os.PathLike[str],
+        strict: bool = False,
+        asset_roots: Iterable[str | os.PathLike[str]] | None = None,
+    ) -> World:
+        """Build Things from an MJCF file (``<include>`` and relative paths resolve from
+        it); every file it names must lie inside its folder or inside one of
+        ``asset_roots`` (:class:`~robotwright.errors.UnsafePathError` otherwise)."""
         from robotwright.things.xml_reader import world_from_path
 
-        return world_from_path(path, strict=strict)
+        return world_from_path(path, strict=strict, asset_roots=asset_roots)
 
     # ------------------------------------------------------------------ simulation
     def _stale(self) -> bool:

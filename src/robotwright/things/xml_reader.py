@@ -25,6 +25,7 @@ import math
 import os
 import warnings
 import xml.etree.ElementTree as ET
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -32,8 +33,16 @@ import defusedxml.ElementTree as SafeET
 import mujoco
 import numpy as np
 
+from robotwright._inputs import MAX_XML_BYTES, read_bytes
+from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
 from robotwright._rotations import compose_pose
-from robotwright.errors import ConversionError, ConversionWarning, Problem, RobotwrightError
+from robotwright.errors import (
+    ConversionError,
+    ConversionWarning,
+    InputFileError,
+    Problem,
+    RobotwrightError,
+)
 from robotwright.things import actuators as A
 from robotwright.things import sensors as S
 from robotwright.things.assets import Material, Texture
@@ -689,7 +698,7 @@ def _indent(node: ET.Element) -> str:
     return "  " + ET.tostring(node, encoding="unicode").strip()
 
 
-def _check_safe(text: str | bytes, source: str) -> None:
+def _check_safe(text: str | bytes, source: str) -> ET.Element:
     try:
         root = SafeET.fromstring(text)
     except Exception as exc:  # defusedxml raises several types; all mean "do not read"
@@ -700,30 +709,57 @@ def _check_safe(text: str | bytes, source: str) -> None:
             f"{source}: root element <{root.tag}>: expected <mujoco> (MJCF); "
             "convert a URDF first with 'robotwright convert'"
         )
+    return root
 
 
 def world_from_string(
-    xml: str, base_dir: str | os.PathLike[str] | None = None, strict: bool = False
+    xml: str,
+    base_dir: str | os.PathLike[str] | None = None,
+    strict: bool = False,
+    asset_roots: Iterable[str | os.PathLike[str]] | None = None,
 ) -> World:
-    """Things from MJCF text; relative files resolve against ``base_dir`` (default: cwd)."""
-    _check_safe(xml, "<string>")
-    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    """Things from MJCF text; relative files resolve against ``base_dir`` (default: cwd)
+    and must lie inside it or inside one of ``asset_roots`` (``<include>`` files, which
+    MuJoCo takes from the working folder, too)."""
+    tree = _check_safe(xml, "<string>")
+    base = Path(base_dir).resolve() if base_dir is not None else Path.cwd()
+    trusted = trusted_roots(asset_roots)
+    check_mjcf_includes(tree, source="<string>", model_dir=Path.cwd(), root=base, trusted=trusted)
     try:
         spec = mujoco.MjSpec.from_string(xml)
     except ValueError as exc:
         raise ThingXMLError(f"<string>: MuJoCo rejected the MJCF: {exc}") from None
-    spec.modelfiledir = str(base.resolve())
-    return _read_world(spec, base.resolve(), "<string>", strict)
+    spec.modelfiledir = str(base)
+    check_mjcf_spec(spec, source="<string>", model_dir=base, root=base, trusted=trusted)
+    return _read_world(spec, base, "<string>", strict)
 
 
-def world_from_path(path: str | os.PathLike[str], strict: bool = False) -> World:
-    """Things from an MJCF file (includes and relative paths resolve from its folder)."""
+def world_from_path(
+    path: str | os.PathLike[str],
+    strict: bool = False,
+    asset_roots: Iterable[str | os.PathLike[str]] | None = None,
+) -> World:
+    """Things from an MJCF file (includes and relative paths resolve from its folder).
+
+    Every file the model names (includes, meshes, textures, height fields) must lie
+    inside the file's folder or inside one of ``asset_roots`` (see
+    :mod:`robotwright._paths`); :class:`~robotwright.errors.UnsafePathError` otherwise.
+    """
     path = Path(path)
     if not path.is_file():
         raise ThingXMLError(f"{path}: no such MJCF file")
-    _check_safe(path.read_bytes(), str(path))
+    try:
+        text = read_bytes(path, MAX_XML_BYTES)
+    except InputFileError as exc:
+        raise ThingXMLError(str(exc)) from None
+    tree = _check_safe(text, str(path))
+    folder = path.parent.resolve()
+    where = {"source": str(path), "model_dir": folder, "root": folder}
+    trusted = trusted_roots(asset_roots)
+    check_mjcf_includes(tree, **where, trusted=trusted)
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as exc:
         raise ThingXMLError(f"{path}: MuJoCo rejected the MJCF: {exc}") from None
-    return _read_world(spec, path.parent.resolve(), str(path), strict)
+    check_mjcf_spec(spec, **where, trusted=trusted)
+    return _read_world(spec, folder, str(path), strict)

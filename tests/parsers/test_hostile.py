@@ -1,0 +1,191 @@
+"""Hostile MJCF and URDF files (issue 11): file paths that leave the model's folder
+(``..``, absolute paths, ``meshdir``, symbolic links, includes, textures) are refused by
+the parsers, ``convert`` and ``things`` with an error naming the file and element, and
+nothing is written; trusted folders are an explicit opt-in."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import trimesh
+
+from robotwright.cli import main
+from robotwright.errors import ConversionError
+from robotwright.parsers import mjcf_to_hrdf, urdf_to_hrdf
+
+MODEL = """<mujoco model="m">
+  <compiler angle="radian"{compiler}/>
+  <asset>{assets}<mesh name="part" file="{file}"/></asset>
+  <worldbody>
+    <body name="base">
+      <joint name="j" type="hinge"/>
+      <geom type="mesh" mesh="part" mass="1"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def _stl(path: Path, size: float = 0.05) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    trimesh.creation.box(extents=(size, size, size)).export(str(path), file_type="stl")
+    return path
+
+
+@pytest.fixture
+def outside(tmp_path: Path) -> Path:
+    folder = tmp_path / "outside"
+    _stl(folder / "secret.stl", size=0.3)
+    return folder
+
+
+@pytest.fixture
+def robot(tmp_path: Path) -> Path:
+    folder = tmp_path / "robot"
+    _stl(folder / "part.stl")
+    return folder
+
+
+def _model(folder: Path, *, file: str = "part.stl", compiler: str = "", assets: str = "") -> Path:
+    path = folder / "model.xml"
+    path.write_text(MODEL.format(file=file, compiler=compiler, assets=assets))
+    return path
+
+
+def _refused_everywhere(model: Path, tmp_path: Path, capsys, element: str) -> str:
+    """The parser raises; convert (three targets) and things exit 2 and write nothing."""
+    with pytest.raises(ConversionError) as exc:
+        mjcf_to_hrdf(model)
+    message = str(exc.value)
+    assert str(model) in message and element in message, message
+    assert "outside the robot folder" in message
+    outs = tmp_path / "outs"
+    outs.mkdir()
+    for argv in (
+        ["convert", str(model), "-o", str(outs / "hrdf")],
+        ["convert", str(model), "-o", str(outs / "r.xml")],
+        ["convert", str(model), "-o", str(outs / "r.urdf")],
+        ["things", str(model), str(outs / "t.xml")],
+        ["things", str(model), str(outs / "t_hrdf")],
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert element in err and "outside the robot folder" in err, (argv, err)
+    assert list(outs.iterdir()) == []
+    return message
+
+
+def test_plain_model_converts(robot: Path, tmp_path: Path) -> None:
+    assert len(mjcf_to_hrdf(_model(robot)).meshes) == 1
+
+
+def test_dotdot_mesh_file_is_refused(robot, outside, tmp_path, capsys) -> None:
+    model = _model(robot, file="../outside/secret.stl")
+    _refused_everywhere(model, tmp_path, capsys, '<mesh name="part" file="../outside/secret.stl">')
+
+
+def test_absolute_mesh_file_is_refused(robot, outside, tmp_path, capsys) -> None:
+    secret = outside / "secret.stl"
+    model = _model(robot, file=str(secret))
+    text = _refused_everywhere(model, tmp_path, capsys, f'file="{secret}"')
+    assert f"resolves to {secret}" in text
+
+
+@pytest.mark.parametrize("meshdir", ["absolute", "../outside", "assetdir"])
+def test_meshdir_leading_out_is_refused(robot, outside, tmp_path, capsys, meshdir) -> None:
+    attr = {
+        "absolute": f' meshdir="{outside}"',
+        "../outside": ' meshdir="../outside"',
+        "assetdir": f' assetdir="{outside}"',
+    }[meshdir]
+    model = _model(robot, file="secret.stl", compiler=attr)
+    _refused_everywhere(model, tmp_path, capsys, '<mesh name="part" file="secret.stl">')
+
+
+def test_symlinked_mesh_is_refused(robot, outside, tmp_path, capsys) -> None:
+    (robot / "part.stl").unlink()
+    (robot / "part.stl").symlink_to(outside / "secret.stl")
+    text = _refused_everywhere(_model(robot), tmp_path, capsys, '<mesh name="part"')
+    assert "through a symbolic link" in text
+
+
+def test_texture_file_leading_out_is_refused(robot, outside, tmp_path, capsys) -> None:
+    (outside / "t.png").write_bytes(b"not read")
+    assets = '<texture name="t" type="2d" file="../outside/t.png"/>'
+    model = _model(robot, assets=assets)
+    _refused_everywhere(model, tmp_path, capsys, '<texture name="t" file="../outside/t.png">')
+
+
+def test_include_leading_out_is_refused(robot, outside, tmp_path, capsys) -> None:
+    (outside / "inc.xml").write_text("<mujoco><option timestep='0.01'/></mujoco>")
+    model = _model(robot)
+    model.write_text(
+        model.read_text().replace("<asset>", '<include file="../outside/inc.xml"/><asset>')
+    )
+    _refused_everywhere(model, tmp_path, capsys, '<include file="../outside/inc.xml">')
+
+
+def test_nested_include_is_checked_and_read_safely(robot, outside) -> None:
+    """An included file inside the folder may not include a file outside, nor hide
+    entities from the safe reader (MuJoCo's own reader would expand them)."""
+    (robot / "a.xml").write_text('<mujoco><include file="../outside/inc.xml"/></mujoco>')
+    (outside / "inc.xml").write_text("<mujoco/>")
+    model = _model(robot)
+    model.write_text(model.read_text().replace("<asset>", '<include file="a.xml"/><asset>'))
+    with pytest.raises(ConversionError, match=r"a\.xml: <include file=\"\.\./outside/inc\.xml\">"):
+        mjcf_to_hrdf(model)
+    (robot / "a.xml").write_text(
+        '<?xml version="1.0"?><!DOCTYPE m [<!ENTITY e "x">]><mujoco model="&e;"/>'
+    )
+    with pytest.raises(ConversionError, match="cannot be read as safe XML"):
+        mjcf_to_hrdf(model)
+
+
+def test_trusted_asset_root_is_an_explicit_opt_in(robot, outside, tmp_path, capsys) -> None:
+    model = _model(robot, file=str(outside / "secret.stl"))
+    hrdf = mjcf_to_hrdf(model, asset_roots=(outside,))
+    assert len(hrdf.meshes) == 1
+    out = tmp_path / "copy"
+    assert main(["convert", str(model), "-o", str(out), "--asset-root", str(outside)]) == 0
+    assert (out / "meshes" / "secret.stl").is_file()
+    assert main(["things", str(model), str(tmp_path / "t.xml"), "--asset-root", str(outside)]) == 0
+
+
+# ------------------------------------------------------------------------------- URDF
+
+URDF = """<robot name="r">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><mesh filename="{uri}"/></geometry></visual></link>
+</robot>
+"""
+
+
+def test_urdf_package_found_among_ancestors_must_be_a_package(tmp_path: Path) -> None:
+    """``package://outside/secret.stl`` used to name any folder called ``outside`` next to
+    an ancestor (``package://etc/passwd`` named ``/etc``)."""
+    _stl(tmp_path / "outside" / "secret.stl")
+    path = tmp_path / "robot" / "urdf" / "r.urdf"
+    path.parent.mkdir(parents=True)
+    path.write_text(URDF.format(uri="package://outside/secret.stl"))
+    with pytest.raises(ConversionError, match="package 'outside' not found") as exc:
+        urdf_to_hrdf(path)
+    assert '<link name="base">' in str(exc.value)
+    # A real ROS package (package.xml) beside the robot is still found.
+    (tmp_path / "outside" / "package.xml").write_text("<package><name>outside</name></package>")
+    assert len(urdf_to_hrdf(path).meshes) == 1
+
+
+def test_urdf_symlinked_mesh_is_refused(tmp_path: Path, capsys) -> None:
+    secret = _stl(tmp_path / "outside" / "secret.stl")
+    path = tmp_path / "robot" / "urdf" / "r.urdf"
+    (tmp_path / "robot" / "meshes").mkdir(parents=True)
+    (tmp_path / "robot" / "meshes" / "m.stl").symlink_to(secret)
+    path.parent.mkdir(parents=True)
+    path.write_text(URDF.format(uri="../meshes/m.stl"))
+    with pytest.raises(ConversionError, match="through a symbolic link") as exc:
+        urdf_to_hrdf(path)
+    assert "outside the robot folder" in str(exc.value)
+    assert main(["convert", str(path), "-o", str(tmp_path / "out.xml")]) == 2
+    assert not (tmp_path / "out.xml").exists()
+    assert len(urdf_to_hrdf(path, asset_roots=(tmp_path / "outside",)).meshes) == 1
