@@ -16,7 +16,7 @@ Contenders, timed per frame on the same poses and the same ray directions:
   mjlab RayCastSensor    mjlab's own ray cast (prepare -> refit BVH + rays -> finalize),
                          same directions, no labels (when mjlab is installed: the
                          MuJoCo 3.11 environment of .ci/run)
-  mujoco-lidar warp/cpu  MjLidarWrapper backends (no labels; `pip install -e .[bench]`)
+  mujoco-lidar warp/cpu  MjLidarWrapper backends (no labels; `pip install --no-deps mujoco-lidar==0.3.5`)
 
 Contenders run interleaved (one frame each, in turn) so load from other processes hits
 them alike, for at least --repeats rounds and --min-seconds of raw frames; prints median
@@ -162,7 +162,7 @@ def device_contenders(
     try:
         from mujoco_lidar import MjLidarWrapper
     except ImportError:
-        print("  (mujoco-lidar not installed: skipped; pip install -e '.[bench]')")
+        print("  (mujoco-lidar not installed: skipped; pip install --no-deps mujoco-lidar==0.3.5)")
         return out
     site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "lidar")
     theta = np.arctan2(dirs_s[:, 1], dirs_s[:, 0])
