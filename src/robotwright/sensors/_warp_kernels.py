@@ -100,21 +100,29 @@ def _nearest(best: wp.float64, t0: wp.float64, t: wp.float64) -> wp.float64:
 
 
 @wp.func
-def _quadric(
-    best: wp.float64, t0: wp.float64, a: wp.float64, b: wp.float64, c: wp.float64
-) -> wp.float64:
-    """Roots of ``a t^2 + 2 b t + c = 0`` offered to :func:`_nearest` (stable form)."""
+def _root(a: wp.float64, b: wp.float64, c: wp.float64, which: wp.int32) -> wp.float64:
+    """Root ``which`` (0 or 1) of ``a t^2 + 2 b t + c = 0`` in the stable form, or -1
+    (a point behind the origin, which :func:`_nearest` ignores) when there is none."""
     disc = b * b - a * c
     if disc < wp.float64(0.0) or a <= wp.float64(0.0):
-        return best
+        return wp.float64(-1.0)
     sq = wp.sqrt(disc)
     q = -b - sq
     if b < wp.float64(0.0):
         q = -b + sq
-    out = _nearest(best, t0, q / a)
+    if which == 0:
+        return q / a
     if q != wp.float64(0.0):
-        out = _nearest(out, t0, c / q)
-    return out
+        return c / q
+    return wp.float64(-1.0)
+
+
+@wp.func
+def _quadric(
+    best: wp.float64, t0: wp.float64, a: wp.float64, b: wp.float64, c: wp.float64
+) -> wp.float64:
+    """Both roots of ``a t^2 + 2 b t + c = 0`` offered to :func:`_nearest`."""
+    return _nearest(_nearest(best, t0, _root(a, b, c, 0)), t0, _root(a, b, c, 1))
 
 
 @wp.func
@@ -125,19 +133,9 @@ def _side(
     a = v[0] * v[0] + v[1] * v[1]
     b = p[0] * v[0] + p[1] * v[1]
     c = p[0] * p[0] + p[1] * p[1] - r * r
-    disc = b * b - a * c
-    if disc < wp.float64(0.0) or a <= wp.float64(0.0):
-        return best
-    sq = wp.sqrt(disc)
-    q = -b - sq
-    if b < wp.float64(0.0):
-        q = -b + sq
     out = best
-    t = q / a
-    if wp.abs(p[2] + t * v[2]) <= h:
-        out = _nearest(out, t0, t)
-    if q != wp.float64(0.0):
-        t = c / q
+    for which in range(2):
+        t = _root(a, b, c, which)
         if wp.abs(p[2] + t * v[2]) <= h:
             out = _nearest(out, t0, t)
     return out
@@ -158,19 +156,9 @@ def _cap_sphere(
     a = wp.dot(v, v)
     b = wp.dot(pc, v)
     c = wp.dot(pc, pc) - r * r
-    disc = b * b - a * c
-    if disc < wp.float64(0.0) or a <= wp.float64(0.0):
-        return best
-    sq = wp.sqrt(disc)
-    q = -b - sq
-    if b < wp.float64(0.0):
-        q = -b + sq
     out = best
-    t = q / a
-    if sign * (p[2] + t * v[2]) >= h:
-        out = _nearest(out, t0, t)
-    if q != wp.float64(0.0):
-        t = c / q
+    for which in range(2):
+        t = _root(a, b, c, which)
         if sign * (p[2] + t * v[2]) >= h:
             out = _nearest(out, t0, t)
     return out
