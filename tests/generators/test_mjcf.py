@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from robotwright.errors import ConversionError, ConversionWarning, GeneratorError
+from robotwright.errors import ConversionError, ConversionWarning, GeneratorError, HRDFError
 from robotwright.generators import DEFAULT_SCENE, MJCFHumanoidGenerator, SceneDefaults
 from robotwright.hrdf.model import ImuConfig, Meta
 
@@ -212,8 +212,11 @@ def test_name_clash_is_a_clear_error(synth):
 
 def test_bad_mjcf_extra_is_a_clear_error(synth):
     bad = dataclasses.replace(synth, mjcf_extra="<robot/>")
+    with pytest.raises(HRDFError, match=r"extra\.xml: root element <robot>: expected <mujoco>"):
+        MJCFHumanoidGenerator.from_hrdf(bad)
+    gen = MJCFHumanoidGenerator().load(bad, validate=False)
     with pytest.raises(GeneratorError, match="mjcf_extra: expected a <mujoco> element"):
-        MJCFHumanoidGenerator.from_hrdf(bad).export()
+        gen.export()
 
 
 def test_to_spec_and_to_model(synth):

@@ -18,7 +18,13 @@ import yaml
 from robotwright._inputs import MAX_TABLE_BYTES
 from robotwright._paths import trusted_asset_roots
 from robotwright.cli import main
-from robotwright.errors import HRDFError, Problem, UnsafePathError
+from robotwright.errors import (
+    ConversionWarning,
+    GeneratorError,
+    HRDFError,
+    Problem,
+    UnsafePathError,
+)
 from robotwright.generators import MJCFHumanoidGenerator
 from robotwright.hrdf import HRDF
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
@@ -268,3 +274,107 @@ def test_deeply_nested_meta_yaml_is_refused(robot) -> None:
     (robot / "meta.yaml").write_text(text)
     problems = validate_dir(robot)
     assert any(p.file == "meta.yaml" and "nests more than" in p.message for p in problems)
+
+
+# ------------------------------------------------------------------ XML injection
+
+INJECTED = 'gyro site="tool0"/><body name="INJECTED"><geom size="1"/></body><gyro site="tool0"'
+
+
+def _edit_sensor(folder: Path, column: str, value: str) -> None:
+    path = folder / "sensor.csv"
+    with path.open(newline="") as f:
+        rows = list(csv.reader(f))
+    rows[1][rows[0].index(column)] = value
+    with path.open("w", newline="") as f:
+        csv.writer(f, lineterminator="\n").writerows(rows)
+
+
+@pytest.mark.parametrize("column", ["type", "objtype"])
+def test_sensor_cells_written_as_xml_names_are_vocabulary(robot, tmp_path, capsys, column):
+    """sensor.csv 'type' becomes an element name and (for non-frame sensors) 'objtype'
+    an attribute name: markup in them used to reach the MJCF (<body name="INJECTED">
+    compiled)."""
+    if column == "objtype":
+        _edit_sensor(robot, "type", "gyro")
+    _edit_sensor(robot, column, INJECTED)
+    problems = _errors(robot)
+    assert any(
+        p.file == "sensor.csv" and p.row == 0 and p.column == column and "expected" in p.message
+        for p in problems
+    ), problems
+    out = tmp_path / "out.xml"
+    assert main(["export", str(robot), "-o", str(out)]) == 2
+    assert "sensor.csv: row 0: column" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_xml_writer_refuses_a_name_that_is_not_an_xml_name(robot) -> None:
+    """Second line of defence: a model that skipped validation still cannot inject."""
+    hrdf = HRDF.from_dir(robot)
+    bad = dataclasses.replace(hrdf.sensors[0], type=INJECTED)
+    gen = MJCFHumanoidGenerator().load(dataclasses.replace(hrdf, sensors=[bad]), validate=False)
+    with pytest.raises(GeneratorError, match="cannot write .* as an XML element or attribute"):
+        gen.export()
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ('<mujoco><asset><mesh name="x" file="/etc/passwd"/></asset></mujoco>', "<asset>"),
+        ('<mujoco><tendon><include file="/etc/passwd"/></tendon></mujoco>', "names a file"),
+        ("<mujoco><worldbody><body/></worldbody></mujoco>", "section not allowed"),
+        ('<!DOCTYPE m [<!ENTITY e "x">]><mujoco><tendon/></mujoco>', "not safe"),
+        ("<mujoco>" + "<tendon>" * 5000 + "</tendon>" * 5000 + "</mujoco>", "nested deeper"),
+    ],
+    ids=["asset", "include", "worldbody", "entity", "deep"],
+)
+def test_extra_xml_holds_only_its_sections(robot, tmp_path, capsys, extra, message) -> None:
+    (robot / "extra.xml").write_text(extra)
+    problems = _errors(robot)
+    assert any(p.file == "extra.xml" and message in str(p) for p in problems), problems
+    out = tmp_path / "out.xml"
+    assert main(["export", str(robot), "-o", str(out)]) == 2
+    capsys.readouterr()
+    assert not out.exists()
+
+
+# ------------------------------------------------------------------ deep trees
+
+
+def _chain(n: int) -> HRDF:
+    hrdf = HRDF.from_dir(BUNDLED_ROBOTS_DIR / "arm6")
+    body = hrdf.bodies[1]
+    bodies = [hrdf.bodies[0]] + [
+        dataclasses.replace(body, name=f"b{i}", parent=i - 1) for i in range(1, n)
+    ]
+    joint = hrdf.joints[0]
+    joints = [dataclasses.replace(joint, name=f"j{i}", body=f"b{i}") for i in range(1, n)]
+    return HRDF(name="chain", bodies=bodies, joints=joints, meta=hrdf.meta)
+
+
+def test_chain_of_10000_bodies_saves_loads_and_exports_urdf(tmp_path) -> None:
+    from robotwright.generators import URDFHumanoidGenerator
+
+    folder = _chain(10_000).save(tmp_path / "chain")
+    hrdf = HRDF.from_dir(folder)
+    assert len(hrdf.bodies) == 10_000
+    with pytest.warns(ConversionWarning, match="armature"):  # URDF has no armature
+        text = URDFHumanoidGenerator.from_hrdf(hrdf).export(tmp_path / "chain.urdf")
+    assert text.count("<link ") == 10_001  # and MuJoCo's "world"
+
+
+def test_chain_deeper_than_mujoco_reads_is_refused_for_mjcf(tmp_path, capsys) -> None:
+    folder = _chain(1_000).save(tmp_path / "chain")
+    for argv in (
+        ["export", str(folder), "-o", str(tmp_path / "c.xml")],
+        ["convert", str(folder), "-o", str(tmp_path / "c.xml")],
+        ["things", str(folder), str(tmp_path / "c.xml")],
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert "'b496'" in err and "nested 497 bodies deep" in err and "at most 496" in err
+    assert not (tmp_path / "c.xml").exists()
+    # 496 nested bodies are written, and MuJoCo reads them.
+    model = MJCFHumanoidGenerator.from_hrdf(_chain(496)).to_model()
+    assert model.nbody == 497

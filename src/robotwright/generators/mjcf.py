@@ -31,11 +31,13 @@ import os
 import warnings
 import xml.etree.ElementTree as ET
 
+from robotwright._inputs import MJCF_MAX_BODY_DEPTH
 from robotwright.errors import ConversionError, ConversionWarning, GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf_base import MJCFGeneratorBase, name_clashes, prefix_tree
 from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
 from robotwright.hrdf.model import HRDF, Actuator, Geom, Joint, SimpleGeom
+from robotwright.hrdf.validate import check_extra
 
 #: IMU quantity -> (MuJoCo sensor, how it names its object).
 IMU_SENSORS: dict[str, str] = {"quat": "framequat", "angvel": "gyro", "linacc": "accelerometer"}
@@ -110,6 +112,10 @@ def parse_mjcf_extra(hrdf: HRDF) -> ET.Element | None:
         raise GeneratorError(
             f"robot '{hrdf.name}': mjcf_extra: expected a <mujoco> element, got <{root.tag}>"
         )
+    # Only the sections HRDF carries, naming no file (checked at load too).
+    problems = check_extra(hrdf.mjcf_extra)
+    if problems:
+        raise GeneratorError(f"robot '{hrdf.name}': mjcf_extra: {problems[0]}")
     return root
 
 
@@ -246,11 +252,17 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         for i, b in enumerate(hrdf.bodies):
             children.setdefault(b.parent, []).append(i)
         worldbody = self.get_elem("worldbody")
-        stack: list[tuple[ET.Element, int]] = [
-            (worldbody, i) for i in reversed(children.get(-1, []))
+        stack: list[tuple[ET.Element, int, int]] = [
+            (worldbody, i, 1) for i in reversed(children.get(-1, []))
         ]
         while stack:
-            parent_el, idx = stack.pop()
+            parent_el, idx, depth = stack.pop()
+            if depth > MJCF_MAX_BODY_DEPTH:
+                raise GeneratorError(
+                    f"robot '{hrdf.name}': body '{hrdf.bodies[idx].name}' is nested "
+                    f"{depth} bodies deep; MuJoCo's MJCF reader accepts at most "
+                    f"{MJCF_MAX_BODY_DEPTH} (write URDF or HRDF, whose files are flat)"
+                )
             b = hrdf.bodies[idx]
             el = ET.SubElement(
                 parent_el,
@@ -272,7 +284,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             el.extend(geoms.get(b.name, ()))
             el.extend(sites.get(b.name, ()))
             for c in reversed(children.get(idx, [])):
-                stack.append((el, c))
+                stack.append((el, c, depth + 1))
 
     @staticmethod
     def _geom_elem(

@@ -13,6 +13,8 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterable
 from functools import lru_cache
 
+from robotwright.errors import GeneratorError
+
 XML_HEADER = '<?xml version="1.0" encoding="utf-8"?>\n'
 
 
@@ -89,16 +91,45 @@ def to_xml_string(root: ET.Element) -> str:
     return text
 
 
+#: An XML name as generators write them (ASCII; what element and attribute names may be).
+_XML_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.:-]*\Z")
+#: Element and attribute names already checked against :data:`_XML_NAME`.
+_CHECKED_NAMES: set[str] = set()
+
+
+def _check_names(el: ET.Element) -> None:
+    """Refuse an element or attribute name that is not an XML name: names come from code
+    and vocabularies, and one built from input data must never inject markup."""
+    for name in (el.tag, *el.attrib):
+        if name not in _CHECKED_NAMES:
+            if not isinstance(name, str) or _XML_NAME.match(name) is None:
+                raise GeneratorError(
+                    f"cannot write {name!r} as an XML element or attribute name "
+                    f"(in <{el.tag}>): expected letters, digits, '_', '-', '.', ':'"
+                )
+            _CHECKED_NAMES.add(name)
+
+
 def _serialize(root: ET.Element, *, escape: bool) -> tuple[str, list[str], int]:
-    """(document, the attribute text of each element, number of attributes)."""
+    """(document, the attribute text of each element, number of attributes).
+
+    Iterative (an explicit stack), so trees of any depth are written."""
     out: list[str] = [XML_HEADER]
     append = out.append
     attr_parts: list[str] = []
     n_attrs = 0
-
-    def write(el: ET.Element, indent: str) -> None:
-        nonlocal n_attrs
+    checked = _CHECKED_NAMES
+    # (element, indentation) to open, or (element, indentation) to close: closing
+    # entries carry None as element and the closing tag text instead.
+    stack: list[tuple[ET.Element | None, str]] = [(root, "")]
+    while stack:
+        el, indent = stack.pop()
+        if el is None:
+            append(indent)
+            continue
         attrib = el.attrib
+        if el.tag not in checked or not checked.issuperset(attrib):
+            _check_names(el)
         if escape:
             attrs = "".join([f' {k}="{_attr(v)}"' for k, v in attrib.items()])
         else:
@@ -108,18 +139,14 @@ def _serialize(root: ET.Element, *, escape: bool) -> tuple[str, list[str], int]:
         text = el.text if el.text is not None and el.text.strip() else None
         if len(el) == 0 and text is None:
             append(f"{indent}<{el.tag}{attrs} />\n")
-            return
+            continue
         if len(el) == 0:
             append(f"{indent}<{el.tag}{attrs}>{_text(text or '')}</{el.tag}>\n")
-            return
+            continue
         append(f"{indent}<{el.tag}{attrs}>\n")
         if text is not None:
             append(f"{indent}  {_text(text)}\n")
+        stack.append((None, f"{indent}</{el.tag}>\n"))
         child_indent = indent + "  "
-        for child in el:
-            if isinstance(child.tag, str):
-                write(child, child_indent)
-        append(f"{indent}</{el.tag}>\n")
-
-    write(root, "")
+        stack.extend((child, child_indent) for child in reversed(el) if isinstance(child.tag, str))
     return "".join(out), attr_parts, n_attrs

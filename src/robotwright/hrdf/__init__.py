@@ -3,8 +3,10 @@
 from robotwright.hrdf.model import (
     ACTUATOR_TYPES,
     FORMAT_VERSION,
+    FRAME_OBJTYPES,
     HRDF,
     JOINT_TYPES,
+    SENSOR_OBJTYPES,
     SIMPLE_GEOM_TYPES,
     Actuator,
     Body,
@@ -24,8 +26,10 @@ from robotwright.hrdf.model import (
 __all__ = [
     "ACTUATOR_TYPES",
     "FORMAT_VERSION",
+    "FRAME_OBJTYPES",
     "HRDF",
     "JOINT_TYPES",
+    "SENSOR_OBJTYPES",
     "SIMPLE_GEOM_TYPES",
     "Actuator",
     "Body",

@@ -36,6 +36,69 @@ ACTUATOR_TYPES: tuple[str, ...] = ("motor", "position", "velocity")
 SIMPLE_GEOM_TYPES: tuple[str, ...] = ("box", "sphere", "capsule", "cylinder", "ellipsoid")
 #: Site shapes (MuJoCo site types).
 SITE_TYPES: tuple[str, ...] = ("sphere", "capsule", "ellipsoid", "cylinder", "box")
+#: Object types a frame sensor (``framepos``, ...) may read, or measure relative to.
+FRAME_OBJTYPES: tuple[str, ...] = ("body", "xbody", "geom", "site", "camera")
+#: ``sensor.csv`` types: the MJCF sensor elements that read one named object, each with
+#: the object types it reads (written as the element's ``site=``/``joint=``/... attribute,
+#: or as ``objtype`` for frame sensors).
+SENSOR_OBJTYPES: dict[str, tuple[str, ...]] = {
+    **dict.fromkeys(
+        ("touch", "accelerometer", "velocimeter", "gyro", "force", "torque", "magnetometer"),
+        ("site",),
+    ),
+    "rangefinder": ("site",),
+    **dict.fromkeys(
+        (
+            "jointpos",
+            "jointvel",
+            "ballquat",
+            "ballangvel",
+            "jointlimitpos",
+            "jointlimitvel",
+            "jointlimitfrc",
+            "jointactuatorfrc",
+        ),
+        ("joint",),
+    ),  # fmt: skip
+    **dict.fromkeys(
+        (
+            "tendonpos",
+            "tendonvel",
+            "tendonactuatorfrc",
+            "tendonlimitpos",
+            "tendonlimitvel",
+            "tendonlimitfrc",
+        ),
+        ("tendon",),
+    ),  # fmt: skip
+    **dict.fromkeys(("actuatorpos", "actuatorvel", "actuatorfrc"), ("actuator",)),
+    **dict.fromkeys(("subtreecom", "subtreelinvel", "subtreeangmom"), ("body",)),
+    **dict.fromkeys(
+        (
+            "framepos",
+            "framequat",
+            "framexaxis",
+            "frameyaxis",
+            "framezaxis",
+            "framelinvel",
+            "frameangvel",
+            "framelinacc",
+            "frameangacc",
+        ),
+        FRAME_OBJTYPES,
+    ),  # fmt: skip
+}
+#: Top-level sections ``extra.xml`` (``HRDF.mjcf_extra``) may hold.
+EXTRA_SECTIONS: tuple[str, ...] = (
+    "tendon",
+    "equality",
+    "contact",
+    "actuator",
+    "sensor",
+    "keyframe",
+)
+#: Deepest element nesting in ``extra.xml`` (``<mujoco><tendon><spatial><site>`` is 4).
+EXTRA_MAX_DEPTH = 8
 #: The format version this package writes into ``meta.yaml``.
 FORMAT_VERSION = "robotwright-hrdf/1"
 
@@ -240,12 +303,13 @@ class Sensor:
 
     Attributes:
         name: unique sensor name.
-        type: MuJoCo sensor element name, e.g. ``accelerometer``, ``gyro``,
-            ``framequat``, ``jointpos``, ``touch``, ``force``, ``torque``.
-        objtype: type of the object it reads (``site``, ``body``, ``xbody``, ``joint``,
-            ``actuator``, ...), as in MJCF.
+        type: MuJoCo sensor element name, one of :data:`SENSOR_OBJTYPES` (e.g.
+            ``accelerometer``, ``gyro``, ``framequat``, ``jointpos``, ``touch``).
+        objtype: type of the object it reads, one of ``SENSOR_OBJTYPES[type]``
+            (``site``, ``body``, ``xbody``, ``joint``, ``actuator``, ...), as in MJCF.
         objname: name of that object.
-        reftype: reference frame object type for frame sensors, or ``None``.
+        reftype: reference frame object type for frame sensors (one of
+            :data:`FRAME_OBJTYPES`), or ``None``.
         refname: reference frame object name, or ``None``.
         noise: standard deviation of sensor noise (sensor units).
         cutoff: absolute-value cutoff (0 = none).

@@ -18,11 +18,18 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+import defusedxml
+import defusedxml.ElementTree as SafeET
+
 from robotwright.errors import Problem, UnsafePathError
 from robotwright.hrdf.model import (
     ACTUATOR_TYPES,
+    EXTRA_MAX_DEPTH,
+    EXTRA_SECTIONS,
+    FRAME_OBJTYPES,
     HRDF,
     JOINT_TYPES,
+    SENSOR_OBJTYPES,
     SIMPLE_GEOM_TYPES,
     SITE_TYPES,
     MeshGeom,
@@ -507,6 +514,38 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
         "actuator": {a.name for a in hrdf.actuators if a.name},
     }
     for i, s in enumerate(hrdf.sensors):
+        # Type and object types become XML element and attribute names: vocabulary only.
+        allowed = SENSOR_OBJTYPES.get(s.type)
+        if allowed is None:
+            out.append(
+                Problem(
+                    "sensor.csv",
+                    f"sensor type {s.type!r}: expected an MJCF sensor element that reads one "
+                    f"object, one of {sorted(SENSOR_OBJTYPES)}",
+                    row=i,
+                    column="type",
+                )
+            )
+            continue
+        if s.objtype not in allowed:
+            out.append(
+                Problem(
+                    "sensor.csv",
+                    f"objtype {s.objtype!r}: expected one of {list(allowed)} for a {s.type} sensor",
+                    row=i,
+                    column="objtype",
+                )
+            )
+            continue
+        if s.reftype is not None and s.reftype not in FRAME_OBJTYPES:
+            out.append(
+                Problem(
+                    "sensor.csv",
+                    f"reftype {s.reftype!r}: expected one of {list(FRAME_OBJTYPES)}",
+                    row=i,
+                    column="reftype",
+                )
+            )
         known = targets.get(s.objtype)
         if known is not None and s.objname not in known:
             out.append(
@@ -546,6 +585,50 @@ def _check_meta(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
     return out
 
 
+def check_extra(text: str | None) -> list[Problem]:
+    """Problems of an ``extra.xml`` fragment: safe, well-formed XML (no DTD or entities),
+    a ``<mujoco>`` root holding only :data:`EXTRA_SECTIONS`, nested at most
+    :data:`EXTRA_MAX_DEPTH` levels, naming no file (no ``<include>``, no ``file``
+    attribute). Its elements are copied into generated MJCF, so nothing else may pass."""
+    if not text or not text.strip():
+        return []
+    file = "extra.xml"
+    try:
+        root = SafeET.fromstring(text)
+    except (defusedxml.DefusedXmlException, SafeET.ParseError) as exc:
+        return [Problem(file, f"not safe, well-formed XML ({type(exc).__name__}): {exc}")]
+    if root.tag != "mujoco":
+        return [Problem(file, f"root element <{root.tag}>: expected <mujoco>")]
+    out: list[Problem] = []
+    for section in root:
+        if section.tag not in EXTRA_SECTIONS:
+            out.append(
+                Problem(
+                    file,
+                    f"section not allowed here: expected one of {list(EXTRA_SECTIONS)}",
+                    element=f"<{section.tag}>",
+                )
+            )
+    stack = [(root, 1)]
+    while stack:
+        el, depth = stack.pop()
+        if depth > EXTRA_MAX_DEPTH:
+            out.append(
+                Problem(
+                    file,
+                    f"elements nested deeper than {EXTRA_MAX_DEPTH} levels; refused",
+                    element=f"<{el.tag}>",
+                )
+            )
+            break
+        if el.tag == "include" or any(a.startswith("file") for a in el.attrib):
+            out.append(
+                Problem(file, "names a file: not allowed in extra.xml", element=f"<{el.tag}>")
+            )
+        stack.extend((child, depth + 1) for child in el)
+    return out
+
+
 def check_model(hrdf: HRDF, *, check_files: bool = True) -> list[Problem]:
     """All problems of an in-memory model (empty list when it is valid)."""
     problems = _check_tree(hrdf)
@@ -556,6 +639,7 @@ def check_model(hrdf: HRDF, *, check_files: bool = True) -> list[Problem]:
     problems += _check_geoms(hrdf, body_names, check_files)
     problems += _check_sites_sensors(hrdf, body_names)
     problems += _check_meta(hrdf, body_names)
+    problems += check_extra(hrdf.mjcf_extra)
     return problems
 
 

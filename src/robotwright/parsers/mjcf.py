@@ -26,6 +26,7 @@ from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roo
 from robotwright.errors import ConversionError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
     HRDF,
+    SENSOR_OBJTYPES,
     Actuator,
     Body,
     Joint,
@@ -62,6 +63,8 @@ _OBJ = {
     mujoco.mjtObj.mjOBJ_TENDON: "tendon",
 }
 _INTEGRATORS = {0: "Euler", 1: "RK4", 2: "implicit", 3: "implicitfast"}
+#: MJCF element names that differ from MuJoCo's sensor enum names (mjSENS_*).
+_SENSOR_ELEMENT = {"jointactfrc": "jointactuatorfrc", "tendonactfrc": "tendonactuatorfrc"}
 
 
 @dataclass(frozen=True)
@@ -733,10 +736,11 @@ def _sensors(
     for s in range(model.nsensor):
         sname = model.sensor(s).name or f"sensor_{s}"
         stype = mujoco.mjtSensor(int(model.sensor_type[s])).name[len("mjSENS_") :].lower()
+        stype = _SENSOR_ELEMENT.get(stype, stype)
         objtype = _OBJ.get(int(model.sensor_objtype[s]))
         where = f'<{stype} name="{sname}">'
-        if objtype is None or stype in ("user", "plugin"):
-            rep.warn("sensor dropped (its object type has no HRDF equivalent)", where)
+        if objtype is None or objtype not in SENSOR_OBJTYPES.get(stype, ()):
+            rep.warn("sensor dropped (its type or object type has no HRDF equivalent)", where)
             continue
         if not model.sensor(s).name:
             rep.warn(f"unnamed sensor named '{sname}'", where)

@@ -12,7 +12,7 @@ import numpy as np
 
 from robotwright._atomic import atomic_open, copy_file_atomic
 from robotwright.errors import RobotwrightError
-from robotwright.things.attrs import Choice, Flag, Integer, Real, Vector
+from robotwright.things.attrs import Choice, Flag, Integer, Real, ThingAttributeError, Vector
 from robotwright.things.base import BaseThing
 from robotwright.things.registry import asset_epoch
 from robotwright.things.xml_writer import write_mjcf
@@ -77,6 +77,13 @@ class ThingBuildError(RobotwrightError, ValueError):
     """MuJoCo rejected the model a World's Things describe."""
 
 
+#: MJCF ``<flag>`` names (``disabled``/``enabled``), from MuJoCo's enums.
+_DISABLE_FLAGS = frozenset(
+    n[len("mjDSBL_") :].lower() for n in mujoco.mjtDisableBit.__members__ if n != "mjNDISABLE"
+)
+_ENABLE_FLAGS = frozenset(
+    n[len("mjENBL_") :].lower() for n in mujoco.mjtEnableBit.__members__ if n != "mjNENABLE"
+)
 _COMPILER_ATTR: dict[str, Any] = {
     "autolimits": Flag(),
     "inertiafromgeom": Choice("false", "true", "auto"),
@@ -177,6 +184,16 @@ class World(BaseThing):
             value = getattr(self, key)
             if not spec.equal(value, _OPTION_DEFAULTS[key]):
                 parts.append(f'{key}="{spec.format(value)}"')
+        for kind, names, known in (
+            ("disabled", self.disabled, _DISABLE_FLAGS),
+            ("enabled", self.enabled, _ENABLE_FLAGS),
+        ):
+            unknown = sorted(str(f) for f in set(names) - known)
+            if unknown:  # flag names are written as attribute names: vocabulary only
+                raise ThingAttributeError(
+                    f"{self._label()}: {kind} flags {unknown}: expected MuJoCo <flag> "
+                    f"names, from {sorted(known)}"
+                )
         flags = [f'{f}="disable"' for f in sorted(self.disabled)]
         flags += [f'{f}="enable"' for f in sorted(self.enabled)]
         if not parts and not flags:

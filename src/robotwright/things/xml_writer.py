@@ -13,6 +13,8 @@ from collections.abc import Callable
 from typing import Any
 from xml.sax.saxutils import escape
 
+from robotwright._inputs import MJCF_MAX_BODY_DEPTH
+from robotwright.errors import GeneratorError
 from robotwright.things.attrs import ThingAttributeError
 from robotwright.things.base import BaseThing
 
@@ -274,7 +276,13 @@ def _vec(values: Any) -> str:
 def write_mjcf(
     world: Any, path_for: Callable[[str], str] | None = None
 ) -> tuple[str, dict[str, list[int]]]:
-    """MJCF text of a World and, per namespace, Thing IDs in model-id order."""
+    """MJCF text of a World and, per namespace, Thing IDs in model-id order.
+
+    Raises:
+        GeneratorError: bodies nest deeper than MuJoCo's MJCF reader accepts
+            (:data:`~robotwright._inputs.MJCF_MAX_BODY_DEPTH`).
+    """
+    _check_depth(world)
     w = _Writer(world, path_for)
     w.collect_assets()
     model_name = world.name or "robotwright"
@@ -297,3 +305,19 @@ def write_mjcf(
         w.out.append(snippet)
     w.out.append("</mujoco>")
     return "\n".join(w.out) + "\n", w.order
+
+
+def _check_depth(world: Any) -> None:
+    """Refuse (iteratively, before the recursive writer runs) a body tree deeper than
+    MuJoCo's XML reader accepts."""
+    stack = [(world, 0)]
+    while stack:
+        node, depth = stack.pop()
+        for child in node._children:
+            if child._NAMESPACE == "body":
+                if depth + 1 > MJCF_MAX_BODY_DEPTH:
+                    raise GeneratorError(
+                        f"{world._label()}: {child._label()} is nested {depth + 1} bodies "
+                        f"deep; MuJoCo's MJCF reader accepts at most {MJCF_MAX_BODY_DEPTH}"
+                    )
+                stack.append((child, depth + 1))
