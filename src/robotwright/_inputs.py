@@ -42,7 +42,7 @@ __all__ = [
     "read_text",
 ]
 
-#: meta.yaml, joint_mapping.yaml, grammar and library YAML files.
+#: meta.yaml, joint_mapping.yaml, grammar and library YAML files, grammar design files.
 MAX_YAML_BYTES = 1 << 20
 #: Each CSV table of an HRDF folder (a 10,000-body ``body.csv`` is about 2 MB).
 MAX_TABLE_BYTES = 64 << 20

@@ -84,6 +84,7 @@ def resolve_inside(
     root: PathLike,
     trusted: Sequence[Path] | None = None,
     what: str = "the robot folder",
+    hint: str = " (a folder outside can be trusted with asset_roots / --asset-root)",
 ) -> Path:
     """The resolved path of ``file`` (a relative one is taken from folder ``base``),
     which must lie inside folder ``root`` or a trusted folder.
@@ -94,6 +95,7 @@ def resolve_inside(
         root: the folder the path must stay inside (the robot's folder).
         trusted: resolved folders also allowed; ``None``: :func:`trusted_roots`.
         what: how messages name ``root``.
+        hint: appended to the message (how to trust a folder).
 
     Raises:
         UnsafePathError: the path leaves ``root`` (the message says where it resolves
@@ -120,7 +122,7 @@ def resolve_inside(
     )
     raise UnsafePathError(
         f"'{file}' resolves{how} to {resolved}, outside {what} {root_path}; expected a path "
-        "inside it (a folder outside can be trusted with asset_roots / --asset-root)"
+        f"inside it{hint}"
     )
 
 

@@ -309,6 +309,7 @@ def test_sensor_cells_written_as_xml_names_are_vocabulary(robot, tmp_path, capsy
     assert not out.exists()
 
 
+@pytest.mark.filterwarnings("ignore::robotwright.errors.ConversionWarning")
 def test_xml_writer_refuses_a_name_that_is_not_an_xml_name(robot) -> None:
     """Second line of defence: a model that skipped validation still cannot inject."""
     hrdf = HRDF.from_dir(robot)
@@ -378,3 +379,39 @@ def test_chain_deeper_than_mujoco_reads_is_refused_for_mjcf(tmp_path, capsys) ->
     # 496 nested bodies are written, and MuJoCo reads them.
     model = MJCFHumanoidGenerator.from_hrdf(_chain(496)).to_model()
     assert model.nbody == 497
+
+
+# ------------------------------------------------------------ wrong types in meta.yaml
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "column"),
+    [
+        ("simulator_config.timestep", "abc", "simulator_config.timestep"),
+        ("simulator_config.timestep", [1], "simulator_config.timestep"),
+        ("simulator_config.integrator", "bogus", "simulator_config.integrator"),
+        ("simulator_config.integrator", ["RK4"], "simulator_config.integrator"),
+        ("simulator_config.ground.type", "box", "simulator_config.ground.type"),
+        ("simulator_config.ground.friction", [1], "simulator_config.ground.friction"),
+        ("simulator_config.ground.contact_type", 3.4e38, "simulator_config.ground.contact_type"),
+        ("base_joint_name", ["a"], "base_joint_name"),
+        ("imu_config_list", [{"body_name": ["base_link"]}], "imu_config_list[0]"),
+        (
+            "imu_config_list",
+            [{"body_name": "base_link", "value": True}],
+            "imu_config_list[0].value",
+        ),
+    ],
+)
+def test_wrong_type_in_meta_yaml_is_a_located_error(robot, capsys, key, value, column) -> None:
+    meta = yaml.safe_load((robot / "meta.yaml").read_text())
+    *parents, last = key.split(".")
+    node = meta
+    for part in parents:
+        node = node[part]
+    node[last] = value
+    (robot / "meta.yaml").write_text(yaml.safe_dump(meta))
+    problems = _errors(robot)
+    assert any(p.file == "meta.yaml" and p.column == column for p in problems), problems
+    assert main(["validate", str(robot)]) == 1
+    assert f"meta.yaml: column '{column}'" in capsys.readouterr().out

@@ -5,6 +5,8 @@ nothing is written; trusted folders are an explicit opt-in."""
 
 from __future__ import annotations
 
+import os
+import threading
 from pathlib import Path
 
 import pytest
@@ -189,3 +191,46 @@ def test_urdf_symlinked_mesh_is_refused(tmp_path: Path, capsys) -> None:
     assert main(["convert", str(path), "-o", str(tmp_path / "out.xml")]) == 2
     assert not (tmp_path / "out.xml").exists()
     assert len(urdf_to_hrdf(path, asset_roots=(tmp_path / "outside",)).meshes) == 1
+
+
+# ----------------------------------------------------------- unreadable sources
+
+
+def _run_in_thread(argv: list[str]) -> int:
+    done: dict = {}
+    thread = threading.Thread(target=lambda: done.update(code=main(argv)), daemon=True)
+    thread.start()
+    thread.join(20)
+    assert not thread.is_alive(), f"hung: {argv}"
+    return done["code"]
+
+
+@pytest.mark.parametrize("command", ["convert", "roundtrip", "things"])
+def test_fifo_source_is_refused_without_hanging(tmp_path, capsys, command) -> None:
+    source = tmp_path / "robot.xml"
+    os.mkfifo(source)
+    argv = {
+        "convert": ["convert", str(source), "-o", str(tmp_path / "out.xml")],
+        "roundtrip": ["roundtrip", str(source)],
+        "things": ["things", str(source), str(tmp_path / "out.xml")],
+    }[command]
+    assert _run_in_thread(argv) == 2
+    captured = capsys.readouterr()
+    assert str(source) in captured.err and ("FIFO" in captured.err or "regular" in captured.err)
+    assert captured.out == ""
+    assert not (tmp_path / "out.xml").exists()
+
+
+@pytest.mark.parametrize("command", ["convert", "roundtrip", "things"])
+def test_non_utf8_source_is_exit_2_on_stderr(tmp_path, capsys, command) -> None:
+    source = tmp_path / "robot.xml"
+    source.write_bytes(b'<?xml version="1.0" encoding="utf-8"?><mujoco model="\xff"/>')
+    argv = {
+        "convert": ["convert", str(source), "-o", str(tmp_path / "out.xml")],
+        "roundtrip": ["roundtrip", str(source)],
+        "things": ["things", str(source), str(tmp_path / "out.xml")],
+    }[command]
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert str(source) in captured.err and "line 1" in captured.err
+    assert captured.out == ""

@@ -9,7 +9,8 @@ import time
 from pathlib import Path
 
 from robotwright._atomic import check_output_path
-from robotwright.errors import GrammarError, Problem
+from robotwright._inputs import MAX_YAML_BYTES, read_text
+from robotwright.errors import GrammarError, InputFileError, Problem
 
 
 def _int_at_least(low: int):
@@ -265,7 +266,9 @@ def _read_design(path: Path):
     from robotwright.grammar.design import Design
 
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path, MAX_YAML_BYTES)
+    except InputFileError as exc:
+        raise GrammarError([Problem(str(path), f"cannot read design: it {exc.reason}")]) from exc
     except OSError as exc:
         raise GrammarError(
             [Problem(str(path), f"cannot read design: {exc.strerror or exc}")]

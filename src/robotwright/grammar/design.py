@@ -20,7 +20,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from robotwright.errors import GrammarError, Problem
+from robotwright._inputs import load_json
+from robotwright.errors import GrammarError, InputFileError, Problem
 
 FORMAT = "robotwright-design/1"
 
@@ -118,9 +119,11 @@ class Design:
     @classmethod
     def from_json(cls, text: str, source: str = "<design>") -> Design:
         try:
-            data = json.loads(text)
+            data = load_json(text, source)
         except json.JSONDecodeError as exc:
             raise GrammarError([Problem(source, f"invalid JSON: {exc}")]) from exc
+        except InputFileError as exc:
+            raise GrammarError([Problem(source, exc.reason)]) from exc
         if not isinstance(data, dict):
             raise GrammarError([Problem(source, "a design must be a JSON object")])
         return cls.from_dict(data, source)

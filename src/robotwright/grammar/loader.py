@@ -13,7 +13,9 @@ from typing import Any
 
 import yaml
 
-from robotwright.errors import GrammarError, Problem
+from robotwright._inputs import load_yaml
+from robotwright._paths import resolve_inside
+from robotwright.errors import GrammarError, InputFileError, Problem, UnsafePathError
 from robotwright.grammar.library import (
     COMPONENT_KINDS,
     REQUIRED_PARAMS,
@@ -63,13 +65,15 @@ def default_grammar() -> Grammar:
 
 
 def _read_yaml(path: Path, problems: list[Problem]) -> dict[str, Any] | None:
+    # A regular file under the size cap, UTF-8, nested at most MAX_NESTING levels.
     try:
-        text = path.read_text(encoding="utf-8")
+        data = load_yaml(path)
+    except InputFileError as exc:
+        problems.append(Problem(str(path), f"cannot read file: it {exc.reason}"))
+        return None
     except OSError as exc:
         problems.append(Problem(str(path), f"cannot read file: {exc.strerror or exc}"))
         return None
-    try:
-        data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         problems.append(Problem(str(path), f"invalid YAML: {exc}"))
         return None
@@ -273,12 +277,22 @@ def load_grammar(path: str | Path, library: str | Path | Library | None = None) 
     if isinstance(library, Library):
         lib = library
     else:
-        if library is None:
-            lib_path = (
-                path.parent / str(data["library"])
-                if data.get("library")
-                else default_library_path()
-            )
+        lib_path: Path
+        if library is None and data.get("library"):
+            # Named by the (untrusted) grammar file: it must stay in the grammar's folder.
+            try:
+                lib_path = resolve_inside(
+                    str(data["library"]),
+                    base=path.parent,
+                    root=path.parent,
+                    what="the grammar's folder",
+                    hint="",
+                )
+            except UnsafePathError as exc:
+                problems.append(Problem(str(path), exc.reason, column="library"))
+                raise GrammarError(problems, f"cannot load grammar {path}") from None
+        elif library is None:
+            lib_path = default_library_path()
         else:
             lib_path = Path(library)
         lib_data = _read_yaml(lib_path, problems)

@@ -39,7 +39,9 @@ from robotwright.errors import (
 )
 from robotwright.hrdf.model import (
     FORMAT_VERSION,
+    GROUND_TYPES,
     HRDF,
+    INTEGRATORS,
     Actuator,
     Body,
     BodyNameConfig,
@@ -398,6 +400,33 @@ def _float_list(value: Any, size: int, key: str, problems: list[Problem]) -> tup
     return tuple(float(v) for v in value)
 
 
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _checked(value: Any, ok: bool, key: str, expected: str, problems: list[Problem]) -> Any:
+    """``value`` when ``ok`` (or ``None``); else ``None`` after reporting it at ``key``."""
+    if value is None or ok:
+        return value
+    problems.append(Problem("meta.yaml", f"{value!r}: expected {expected}", column=key))
+    return None
+
+
+def _number(value: Any, key: str, problems: list[Problem], *, minimum: float = -math.inf) -> Any:
+    ok = _is_number(value) and value >= minimum
+    low = "" if minimum == -math.inf else f" >= {minimum:g}"
+    return _checked(value, ok, key, f"a finite number{low}", problems)
+
+
+def _bitmask(value: Any, key: str, problems: list[Problem]) -> Any:
+    ok = isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 2**31
+    return _checked(value, ok, key, "an integer bitmask in [0, 2^31)", problems)
+
+
+def _text(value: Any, key: str, problems: list[Problem]) -> Any:
+    return _checked(value, isinstance(value, str) and value != "", key, "a name", problems)
+
+
 def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | None, dict]:
     """Returns (meta, body_parent_id, robotwright keys)."""
     meta = Meta(format_version=None, imu_config_list=None)
@@ -433,21 +462,36 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
         ground_raw = sim.get("ground")
         ground = None
         if isinstance(ground_raw, dict):
+            key = "simulator_config.ground."
+            gtype = ground_raw.get("type")
             ground = GroundConfig(
-                type=ground_raw.get("type"),
-                contact_type=ground_raw.get("contact_type"),
-                contact_affinity=ground_raw.get("contact_affinity"),
-                friction=ground_raw.get("friction"),
+                type=_checked(
+                    gtype, gtype in GROUND_TYPES, key + "type", repr(GROUND_TYPES[0]), problems
+                ),
+                contact_type=_bitmask(
+                    ground_raw.get("contact_type"), key + "contact_type", problems
+                ),
+                contact_affinity=_bitmask(
+                    ground_raw.get("contact_affinity"), key + "contact_affinity", problems
+                ),
+                friction=_number(ground_raw.get("friction"), key + "friction", problems, minimum=0),
             )
         elif ground_raw is not None:
             problems.append(
                 Problem("meta.yaml", "expected a mapping", column="simulator_config.ground")
             )
+        integrator = sim.get("integrator")
         meta.simulator_config = SimulatorConfig(
-            timestep=sim.get("timestep"),
+            timestep=_number(sim.get("timestep"), "simulator_config.timestep", problems),
             gravity=_float_list(sim.get("gravity"), 3, "simulator_config.gravity", problems),
             ground=ground,
-            integrator=sim.get("integrator"),
+            integrator=_checked(
+                integrator,
+                integrator in INTEGRATORS,
+                "simulator_config.integrator",
+                f"one of {list(INTEGRATORS)}",
+                problems,
+            ),
         )
         for key in sim:
             if key not in ("timestep", "gravity", "ground", "integrator"):
@@ -483,7 +527,7 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
             meta.imu_config_list = []
             for i, imu in enumerate(imus):
                 key = f"imu_config_list[{i}]"
-                if not isinstance(imu, dict) or not imu.get("body_name"):
+                if not isinstance(imu, dict) or not isinstance(imu.get("body_name"), str):
                     problems.append(
                         Problem("meta.yaml", "expected a mapping with body_name", column=key)
                     )
@@ -495,6 +539,15 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
                     imu.get("orientation", [1.0, 0.0, 0.0, 0.0]), 4, key + ".orientation", problems
                 )
                 value = imu.get("value") or []
+                if not isinstance(value, list):
+                    problems.append(
+                        Problem(
+                            "meta.yaml",
+                            f"{value!r}: expected a list of linacc, angvel, quat",
+                            column=key + ".value",
+                        )
+                    )
+                    value = []
                 bad = [v for v in value if v not in ("linacc", "angvel", "quat")]
                 if bad:
                     problems.append(
@@ -517,6 +570,8 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
     meta.motor_config_list = raw.get("motor_config_list")
     meta.format_version = raw.get("format_version")
     ext = {k: raw[k] for k in ("floating_base", "base_joint_name") if k in raw}
+    if "base_joint_name" in ext:
+        ext["base_joint_name"] = _text(ext["base_joint_name"], "base_joint_name", problems)
     meta.extra = {k: v for k, v in raw.items() if k not in HURODES_META_KEYS + EXTENSION_META_KEYS}
     for key in meta.extra:
         problems.append(

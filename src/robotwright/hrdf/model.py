@@ -88,6 +88,10 @@ SENSOR_OBJTYPES: dict[str, tuple[str, ...]] = {
         FRAME_OBJTYPES,
     ),  # fmt: skip
 }
+#: ``simulator_config.integrator`` values (MuJoCo integrator names).
+INTEGRATORS: tuple[str, ...] = ("Euler", "RK4", "implicit", "implicitfast")
+#: ``simulator_config.ground.type`` values the generators write.
+GROUND_TYPES: tuple[str, ...] = ("plane",)
 #: Top-level sections ``extra.xml`` (``HRDF.mjcf_extra``) may hold.
 EXTRA_SECTIONS: tuple[str, ...] = (
     "tendon",

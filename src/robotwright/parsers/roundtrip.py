@@ -599,7 +599,13 @@ def _check_input(path: Path, configs: int) -> None:
     if path.suffix.lower() not in (".urdf", ".xml", ".mjcf"):
         raise ConversionError([Problem(str(path), "expected a .urdf or .xml (MJCF) file")])
     if not path.is_file():
-        what = "is a folder" if path.is_dir() else "file not found"
+        what = (
+            "is a folder"
+            if path.is_dir()
+            else "not a regular file"
+            if path.exists()
+            else "file not found"
+        )
         raise ConversionError([Problem(str(path), f"{what}: expected a .urdf or .xml file")])
     parse_xml(path)  # not well-formed or unsafe XML: an input error, named with its line
 

@@ -9,20 +9,25 @@ from pathlib import Path
 import defusedxml
 import defusedxml.ElementTree as DET
 
-from robotwright.errors import ConversionError, Problem
+from robotwright._inputs import MAX_XML_BYTES, read_bytes
+from robotwright.errors import ConversionError, InputFileError, Problem
 
 
 def parse_xml(path: Path) -> ET.Element:
     """Root element of the XML file at ``path``.
 
     Raises:
-        ConversionError: the file is missing, not well-formed, or declares XML entities
-            features (refused: they allow entity-expansion and external-entity attacks).
+        ConversionError: the file is missing, not a regular file (a FIFO, a device),
+            larger than :data:`~robotwright._inputs.MAX_XML_BYTES`, not well-formed, or
+            declares XML entities features (refused: they allow entity-expansion and
+            external-entity attacks).
     """
     try:
-        return DET.parse(str(path)).getroot()
+        return DET.fromstring(read_bytes(path, MAX_XML_BYTES))
     except FileNotFoundError as exc:
         raise ConversionError([Problem(str(path), "file not found")]) from exc
+    except InputFileError as exc:
+        raise ConversionError([Problem(str(path), exc.reason)]) from exc
     except defusedxml.DefusedXmlException as exc:
         raise ConversionError(
             [Problem(str(path), f"unsafe XML refused ({type(exc).__name__}): {exc}")]

@@ -746,7 +746,7 @@ def world_from_path(
     :mod:`robotwright._paths`); :class:`~robotwright.errors.UnsafePathError` otherwise.
     """
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise ThingXMLError(f"{path}: no such MJCF file")
     try:
         text = read_bytes(path, MAX_XML_BYTES)
