@@ -89,15 +89,19 @@ def read_bytes(path: str | os.PathLike[str], limit: int) -> bytes:
             raise InputFileError(
                 path, f"is {_mib(st.st_size)}: larger than the {_mib(limit)} limit for this file"
             )
-        with os.fdopen(fd, "rb") as fh:
-            fd = -1  # closed by the file object
-            data = fh.read(limit + 1)
+        chunks: list[bytes] = []
+        total = 0
+        while True:  # normally one read of the whole file, then one that finds its end
+            chunk = os.read(fd, max(st.st_size + 1 - total, 1 << 16))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+            if total > limit:  # it grew while being read
+                raise InputFileError(path, f"is larger than the {_mib(limit)} limit for this file")
     finally:
-        if fd >= 0:
-            os.close(fd)
-    if len(data) > limit:  # it grew while being read
-        raise InputFileError(path, f"is larger than the {_mib(limit)} limit for this file")
-    return data
+        os.close(fd)
+    return b"".join(chunks)
 
 
 def _open_regular(path: str | os.PathLike[str]) -> tuple[int, os.stat_result]:

@@ -68,9 +68,9 @@ class HRDFMixin:
         """Absolute, normalised path of a mesh geom's file (as ``HRDF.mesh_path``; cached
         per load, kept as a string because generation uses it for every mesh row).
 
-        Raises:
-            robotwright.errors.UnsafePathError: the file leads out of the robot folder
-                (see :meth:`HRDF.mesh_source`).
+        That the path stays inside the robot folder was checked when the robot was
+        loaded (``check_model``); :meth:`mesh_sources`, which lists the files that
+        ``export(copy_meshes=True)`` copies, checks it again.
         """
         key = (mesh.file, mesh.name)
         path = self._mesh_abs.get(key)
@@ -84,18 +84,23 @@ class HRDFMixin:
             if hrdf.root_dir is not None and not os.path.isabs(rel):
                 rel = os.path.join(hrdf.root_dir, rel)
             path = os.path.abspath(rel)
-            # What the output references and what export(copy_meshes=True) copies: it
-            # must stay inside the robot folder or a trusted one.
-            hrdf.mesh_source(mesh)
             self._mesh_abs[key] = path
         return path
 
     def mesh_sources(self) -> list[tuple[str, Path]]:
-        """``(robot name, absolute path)`` of each distinct mesh file."""
+        """``(robot name, absolute path)`` of each distinct mesh file.
+
+        Raises:
+            robotwright.errors.UnsafePathError: a file leads out of the robot folder now
+                (see :meth:`HRDF.mesh_source`): the copier checks again.
+        """
         hrdf = self.loaded_hrdf
         seen: dict[str, None] = {}
         for m in hrdf.meshes:
-            seen.setdefault(self.mesh_abspath(m), None)
+            path = self.mesh_abspath(m)
+            if path not in seen:
+                hrdf.mesh_source(m)
+                seen[path] = None
         return [(hrdf.name, Path(p)) for p in seen]
 
     @property

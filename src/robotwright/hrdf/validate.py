@@ -438,7 +438,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
     default_dir = None
     if root is not None and os.sep not in str(ext):
         candidate = f"{root}{os.sep}meshes"
-        if not os.path.islink(candidate) and Path(root).resolve() == Path(root):
+        if not os.path.islink(candidate):
             default_dir = candidate
     for i, m in enumerate(hrdf.meshes):
         if not m.name:
