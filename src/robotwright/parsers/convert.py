@@ -37,7 +37,7 @@ def load_any(path: Path, *, strict: bool = False, **options: Any) -> tuple[HRDF,
 
     kind = file_kind(path, existing=True)
     if kind == "hrdf":
-        return HRDF.from_dir(path), []
+        return HRDF.from_dir(path, asset_roots=options.get("asset_roots")), []
     _check_options(path, kind, options)
     parse = urdf_to_hrdf_with_warnings if kind == "urdf" else mjcf_to_hrdf_with_warnings
     result = parse(path, strict=strict, **options)
