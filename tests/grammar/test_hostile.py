@@ -83,3 +83,62 @@ def test_deep_or_binary_design_file_is_a_grammar_error(tmp_path, capsys) -> None
     design.write_bytes(b"{\xff}")
     assert main(["grammar", "show", str(design)]) == 2
     assert "not UTF-8" in capsys.readouterr().err
+
+
+LIBRARY_EDITS = {
+    "reversed DoF range": (
+        "range: [0.0, stroke]",
+        "range: [stroke, 0.0]",
+        "component 'prismatic'",
+        "dofs[0]",
+        "lower > upper for {'stroke': 0.1}",
+    ),
+    "negative diameter": (
+        "diameter: {range: [0.01, 0.2], values: [0.04]}",
+        "diameter: {range: [-0.2, 0.2], values: [-0.04]}",
+        "component 'link'",
+        "params.diameter",
+        "expected a domain above 0 m",
+    ),
+    "NaN twist": (
+        "{type: hinge, twist: 1.5708, range: [-limit, limit]}",
+        "{type: hinge, twist: .nan, range: [-limit, limit]}",
+        "component 'universal'",
+        "dofs[1]",
+        "twist must be a number",
+    ),
+    "NaN density": (
+        "density: 1200.0",
+        "density: .nan",
+        "component 'link'",
+        "density",
+        "density must be a number in (0, 100000]",
+    ),
+    "absurd density": (
+        "density: 1200.0",
+        "density: 1.0e+308",
+        "component 'link'",
+        "density",
+        "density must be a number in (0, 100000]",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(LIBRARY_EDITS))
+def test_library_that_sampling_would_crash_on_is_refused(grammar, capsys, case) -> None:
+    """grammar check used to accept these; sample/search then crashed, or built a robot
+    of mass 0 (density NaN) or 4.5e304 kg (density 1e308)."""
+    old, new, element, column, text = LIBRARY_EDITS[case]
+    library = grammar.parent / "lib.yaml"
+    content = library.read_text()
+    assert old in content
+    library.write_text(content.replace(old, new, 1))
+    with pytest.raises(GrammarError) as exc:
+        load_grammar(grammar)
+    hits = [p for p in exc.value.problems if p.element == element and p.column == column]
+    assert hits and text in hits[0].message, exc.value.problems
+    assert main(["grammar", "check", str(grammar)]) == 1
+    assert text in capsys.readouterr().out
+    out = grammar.parent / "designs"
+    assert main(["grammar", "sample", "--grammar", str(grammar), "-o", str(out)]) == 2
+    assert not out.exists()

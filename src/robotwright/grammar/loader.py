@@ -6,6 +6,7 @@ whose entries name the file, the rule or component, and the field.
 
 from __future__ import annotations
 
+import math
 import warnings
 from importlib import resources
 from pathlib import Path
@@ -84,10 +85,31 @@ def _read_yaml(path: Path, problems: list[Problem]) -> dict[str, Any] | None:
 
 
 def _num(value: Any) -> float | None:
+    """``value`` as a float when it is a finite number (not a bool, NaN or infinity)."""
     if isinstance(value, bool):
         return None
-    if isinstance(value, (int, float)):
+    if isinstance(value, (int, float)) and math.isfinite(value):
         return float(value)
+    return None
+
+
+#: Highest material density accepted (kg/m^3): osmium, the densest element, is 22,590.
+MAX_DENSITY = 100_000.0
+
+
+def _reversed_range(dof: DofSpec, params: dict[str, ParamDomain]) -> dict[str, float] | None:
+    """Parameter values (``{}`` for numbers) for which the DoF's range has lower > upper,
+    or ``None`` when it is ordered for every choice of its parameters."""
+    names = sorted({i.lstrip("-") for i in dof.range if isinstance(i, str)} & set(params))
+    if len(names) != len({i.lstrip("-") for i in dof.range if isinstance(i, str)}):
+        return None  # an unknown parameter, reported already
+    choices: list[dict[str, float]] = [{}]
+    for name in names:
+        choices = [{**c, name: v} for c in choices for v in params[name].values]
+    for values in choices:
+        low, high = dof.resolve_range(values)
+        if low > high:
+            return values
     return None
 
 
@@ -181,6 +203,8 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
         for need, meaning in REQUIRED_PARAMS[kind].items():
             if need not in params and need not in (spec.get("params") or {}):
                 err(f"kind '{kind}' needs parameter '{need}' ({meaning})", "params")
+            elif need in params and "(m)" in meaning and not params[need].low > 0:
+                err(f"{need} is a size: expected a domain above 0 m", f"params.{need}")
         dofs: list[DofSpec] = []
         if kind == "connector":
             raw_dofs = spec.get("dofs")
@@ -211,9 +235,15 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                     else:
                         err(f"range item {item!r} is neither a number nor a parameter", col)
                 try:
-                    dofs.append(DofSpec(d.get("type"), twist, (items[0], items[1])))
+                    dof = DofSpec(d.get("type"), twist, (items[0], items[1]))
                 except (ValueError, IndexError) as exc:
                     err(str(exc), col)
+                    continue
+                reversed_at = _reversed_range(dof, params)
+                if reversed_at is not None:
+                    err(f"range {list(rng)} has lower > upper for {reversed_at}", col)
+                    continue
+                dofs.append(dof)
             for key in ("housing", "actuator"):
                 val = spec.get(key)
                 if not isinstance(val, dict) or any(
@@ -227,9 +257,10 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 if need not in (spec.get("actuator") or {}):
                     err(f"actuator needs '{need}'", "actuator")
         density = _num(spec.get("density", 1000.0))
-        if density is None or density <= 0:
+        if density is None or not 0 < density <= MAX_DENSITY:
             err(
-                f"density must be a positive number (kg/m^3), got {spec.get('density')!r}",
+                f"density must be a number in (0, {MAX_DENSITY:g}] kg/m^3, got "
+                f"{spec.get('density')!r}",
                 "density",
             )
             density = 1000.0
