@@ -118,3 +118,40 @@ def test_mjlab_sensor_matches_the_core_sensor_and_labels_geoms(clutter_model):
     one_hot = rw_mjlab.lidar_one_hot_classes(env, "lidar").reshape(3, 20000, 4)
     assert torch.equal(one_hot.argmax(-1).int(), data.semantic_labels)
     assert torch.equal(rw_mjlab.lidar_class_ids(env, "lidar"), data.semantic_labels.float())
+
+
+def test_go1_example_labels_every_class(tmp_path):
+    """The example's Go1 task on the CPU device: labels are the classes of the hit geoms."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
+    import mjlab_go1_semantic_lidar as example
+
+    env = example.make_env(2, "cpu")
+    sensor = env.scene["lidar"]
+    data = sensor.data
+    action = torch.zeros(env.num_envs, env.action_manager.total_action_dim)
+    dirs = []
+    for _ in range(3):
+        env.step(action)
+        assert env.scene["lidar"].data is data  # the same tensors every step
+        dirs.append(data.ray_directions_w.numpy().copy())
+    assert not np.allclose(dirs[0], dirs[1])  # the Mid-360 window advanced
+    ids, labels = data.geom_ids.numpy(), data.semantic_labels.numpy()
+    for g in np.unique(ids[ids >= 0]):
+        expect = classify_path(sensor.geom_paths[g], sensor.semantic_class_mapping)
+        assert (labels[ids == g] == expect).all(), sensor.geom_paths[g]
+    hit_names = {sensor.geom_paths[g].rsplit("/", 1)[-1] for g in np.unique(ids[ids >= 0])}
+    assert {"sofa_0_geom", "cracker_box_0_geom"} <= hit_names
+    assert set(np.unique(labels[data.hit_mask.numpy()]).tolist()) == {1, 2, 3}
+    dist = data.distances.numpy()
+    assert (dist[~data.hit_mask.numpy()] == 20.0).all() and (dist >= 0).all() and (dist <= 20).all()
+    # The seed's stacked observation is part of the actor's observation.
+    obs = env.observation_manager.compute()["actor"]
+    assert obs.shape[1] >= 2 * sensor.num_rays
+    summary = example.run(tmp_path, num_envs=2, steps=5, device="cpu")
+    assert Path(summary["png"]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert all(
+        summary["hits_per_class"][c] > 0 for c in ("terrain", "dynamic_obstacle", "valuable")
+    )
