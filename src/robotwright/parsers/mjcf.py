@@ -859,7 +859,7 @@ def parse_mjcf(
     tendon_section, names["tendon"] = mjcf_extra.tendons(model, names, rep.warn)
     for section in (
         tendon_section,
-        mjcf_extra.equalities(model, names, rep.warn),
+        mjcf_extra.equalities(model, names, rep.warn, mjcf_extra.welds_with_relpose(spec, model)),
         mjcf_extra.contacts(model, names, rep.warn),
     ):
         if section is not None:

@@ -135,8 +135,32 @@ def tendons(
     return (section if len(section) else None), kept
 
 
-def equalities(model: mujoco.MjModel, names: dict[str, set[str]], warn: Warn) -> ET.Element | None:
-    """``<equality>`` with the robot's connect, weld, joint and tendon constraints."""
+def welds_with_relpose(spec: mujoco.MjSpec, model: mujoco.MjModel) -> list[bool] | None:
+    """Per equality of ``model``: whether its source gives a weld ``relpose`` (a non-zero
+    quaternion part; MuJoCo computes an omitted one from the reference pose). None when
+    the spec's equalities do not line up with the model's.
+
+    Read from the spec, not the compiled model, so that the answer is the same on MuJoCo
+    3.11 and 4.x: 4.x flags it in ``eq_data[11]``, but 3.11's ``eq_data`` has 11 entries
+    and holds the computed relpose with nothing to tell it from a given one."""
+    eqs = spec.equalities
+    if len(eqs) != model.neq:
+        return None
+    return [bool(np.any(np.asarray(e.data[6:10], dtype=float) != 0)) for e in eqs]
+
+
+def equalities(
+    model: mujoco.MjModel,
+    names: dict[str, set[str]],
+    warn: Warn,
+    relpose_given: list[bool] | None = None,
+) -> ET.Element | None:
+    """``<equality>`` with the robot's connect, weld, joint and tendon constraints.
+
+    ``relpose_given`` (see :func:`welds_with_relpose`): a body weld whose source gave no
+    ``relpose`` is written without one, so that MuJoCo computes it again from the
+    reference pose (the same body poses give the same value); None writes every body
+    weld's compiled relpose, which compiles to the same model."""
     section = ET.Element("equality")
     eq = mujoco.mjtEq
     obj = mujoco.mjtObj
@@ -158,9 +182,7 @@ def equalities(model: mujoco.MjModel, names: dict[str, set[str]], warn: Warn) ->
             tag = "connect" if et == eq.mjEQ_CONNECT else "weld"
             if not site_based:
                 attrs["anchor"] = _f(data[0:3])
-                # data[11] = 1: MuJoCo computed relpose from qpos0 itself; leave it to do
-                # so again (the same body poses give the same value).
-                if tag == "weld" and data[11] == 0:
+                if tag == "weld" and (relpose_given is None or relpose_given[e]):
                     attrs["relpose"] = _f(data[3:10])
             if tag == "weld":
                 attrs["torquescale"] = _f(data[10])

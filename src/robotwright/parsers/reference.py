@@ -12,13 +12,18 @@ Frames: every pose is in the frame of the robot's root (MuJoCo world = URDF root
 
 from __future__ import annotations
 
+import functools
+import struct
+import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import defusedxml.ElementTree as DET
 import mujoco
 import numpy as np
 
+from robotwright._rotations import quat_to_mat, rpy_to_quat
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.xmlsafe import parse_xml
 
@@ -228,6 +233,222 @@ def _obj_name(model: mujoco.MjModel, objtype: int, objid: int) -> str:
 
 
 # -- URDF references ----------------------------------------------------------------------
+_INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+_PROBE_TENSOR = np.array([[0.02, 0.001, -0.002], [0.001, 0.03, 0.0015], [-0.002, 0.0015, 0.025]])
+
+
+# MuJoCo 3.11 differs from 4.x in four ways that matter to a URDF reference (the four
+# probes below). Each is detected by what the installed MuJoCo does (a probe, run once),
+# not by its version number: the workaround is applied only where MuJoCo needs it, so
+# that on a MuJoCo that gets these right the reference stays MuJoCo's own, independent
+# of our parser's code.
+@functools.cache
+def mujoco_urdf_keeps_inertial_rotation() -> bool:
+    """Whether MuJoCo's URDF import honours ``<inertial><origin rpy>``.
+
+    MuJoCo 3.11 drops that rotation and keeps the tensor as if it were written in the
+    link frame (google-deepmind/mujoco#3559, fixed by #3560; 4.x keeps it)."""
+    urdf = (
+        '<robot name="probe"><mujoco><compiler fusestatic="false"/></mujoco>'
+        '<link name="a"><inertial><origin rpy="0 0 1.5707963267948966"/><mass value="1"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="2.5"/></inertial></link>'
+        "</robot>"
+    )
+    model = mujoco.MjModel.from_xml_string(urdf)
+    rot = quat_to_mat(model.body_iquat[1])
+    tensor = rot @ np.diag(model.body_inertia[1]) @ rot.T
+    return bool(np.allclose(tensor, np.diag([2.0, 1.0, 2.5]), atol=1e-9))
+
+
+@functools.cache
+def mujoco_diagonalises_inertia_exactly() -> bool:
+    """Whether MuJoCo's compiler turns a full inertia tensor into principal moments and
+    axes to rounding (``R diag R^T`` within 1e-13 of the tensor, relative).
+
+    MuJoCo 3.11's ``mju_eig3`` stops its Jacobi sweeps once the next rotation is below
+    ~1e-6 rad, so the principal axes it compiles are off by up to that much (the tensor
+    rebuilt from them is 4.5e-8 off on this probe); 4.x's is exact to ~2e-15."""
+    i = _PROBE_TENSOR
+    full = " ".join(repr(float(x)) for x in (i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]))
+    model = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><freejoint/><inertial pos="0 0 0" mass="1" '
+        f'fullinertia="{full}"/></body></worldbody></mujoco>'
+    )
+    rot = quat_to_mat(model.body_iquat[1])
+    rebuilt = rot @ np.diag(model.body_inertia[1]) @ rot.T
+    return bool(np.abs(rebuilt - i).max() <= 1e-13 * np.abs(i).max())
+
+
+@functools.cache
+def mujoco_urdf_imports_mimic() -> bool:
+    """Whether MuJoCo's URDF import turns ``<mimic>`` into a joint equality (4.x does,
+    with ``polycoef = (offset, multiplier, 0, 0, 0)``; 3.11 ignores ``<mimic>``)."""
+    link = (
+        '<link name="{0}"><inertial><mass value="1"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+    )
+    joint = (
+        '<joint name="{0}" type="revolute"><parent link="{1}"/><child link="{2}"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/>{3}</joint>'
+    )
+    urdf = (
+        '<robot name="probe"><mujoco><compiler fusestatic="false"/></mujoco>'
+        + "".join(link.format(n) for n in "abc")
+        + joint.format("j1", "a", "b", "")
+        + joint.format("j2", "b", "c", '<mimic joint="j1" multiplier="2" offset="0.5"/>')
+        + "</robot>"
+    )
+    return mujoco.MjModel.from_xml_string(urdf).neq == 1
+
+
+def _tetrahedron_stl(size: float = 1.0) -> bytes:
+    """A binary STL tetrahedron (for the probe below)."""
+    o, x, y, z = (0, 0, 0), (size, 0, 0), (0, size, 0), (0, 0, size)
+    tris = [(o, x, y), (o, z, x), (o, y, z), (x, z, y)]
+    out = b"\0" * 80 + struct.pack("<I", len(tris))
+    for a, b, c in tris:
+        out += struct.pack("<12fH", 0, 0, 0, *a, *b, *c, 0)
+    return out
+
+
+@functools.cache
+def mujoco_urdf_keeps_mesh_files_apart() -> bool:
+    """Whether MuJoCo's URDF import gives each collision geom the mesh of its own file and
+    ``scale``. MuJoCo 3.11 does not: it makes one mesh per scale of a file name but gives
+    a geom the first scale's mesh again from the third use on (scales a, b, a, b: the
+    last geom gets a), and takes two files of one name in different folders for one
+    mesh. 4.x gets both right. The probe tries both."""
+    with tempfile.TemporaryDirectory(prefix="robotwright-probe-") as tmp:
+        one, other = Path(tmp, "one", "probe.stl"), Path(tmp, "other", "probe.stl")
+        for path, size in ((one, 1.0), (other, 2.0)):
+            path.parent.mkdir()
+            path.write_bytes(_tetrahedron_stl(size))
+        uses = [(one, "1 -1 1"), (one, "1 1 1"), (one, "1 -1 1"), (one, "1 1 1"), (other, "1 1 1")]
+        links = "".join(
+            f'<link name="l{i}"><inertial><mass value="1"/>'
+            '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
+            f'<collision><geometry><mesh filename="{f}" scale="{s}"/></geometry></collision>'
+            "</link>"
+            for i, (f, s) in enumerate(uses)
+        )
+        joints = "".join(
+            f'<joint name="j{i}" type="fixed"><parent link="l0"/><child link="l{i}"/></joint>'
+            for i in range(1, len(uses))
+        )
+        urdf = (
+            '<robot name="probe"><mujoco><compiler fusestatic="false" strippath="false"/>'
+            f"</mujoco>{links}{joints}</robot>"
+        )
+        model = mujoco.MjModel.from_xml_string(urdf)
+    # Each geom's mesh: its y scale, and its size relative to the first (MuJoCo moves the
+    # vertices to the mesh's principal frame, so compare sizes, not coordinates).
+    got = []
+    for g in range(model.ngeom):
+        mesh = int(model.geom_dataid[g])
+        verts = model.mesh_vert[model.mesh_vertadr[mesh] : model.mesh_vertadr[mesh] + 4]
+        got.append((float(model.mesh_scale[mesh][1]), float(np.ptp(verts, axis=0).max())))
+    sizes = [round(size / got[0][1], 6) for _, size in got]
+    return [y for y, _ in got] == [-1.0, 1.0, -1.0, 1.0, 1.0] and sizes == [1, 1, 1, 1, 2]
+
+
+def _split_mesh_scales(root: ET.Element) -> dict[str, bytes]:
+    """Give each (file, scale) pair of the collision meshes its own mesh name.
+
+    MuJoCo names a URDF mesh after its file name without folder and extension. MuJoCo
+    3.11 keys its meshes on that name and the scale only, and gives a geom the first
+    scale's mesh again from the third use on (see :func:`mujoco_urdf_keeps_mesh_files_apart`):
+    two files of one name in different folders (talos: ``torso/base_link_collision.STL``
+    and ``gripper/base_link_collision.STL``) or a file used with two scales (mirrored
+    limbs) get the wrong mesh; 4.x gets both right. The second and later pairs of a name
+    are renamed here to ``<name>__<k><ext>``, a file MuJoCo reads from the returned
+    assets (that file's bytes). Visual meshes are left alone (``urdf_for_mujoco``
+    discards them). A file that cannot be read is left as written: MuJoCo's own error
+    then names it.
+    """
+    pairs_seen: dict[str, list[tuple[str, tuple[float, ...]]]] = {}
+    renamed: dict[tuple[str, tuple[float, ...]], str] = {}
+    assets: dict[str, bytes] = {}
+    for collision in root.iter("collision"):
+        for mesh in collision.iter("mesh"):
+            file = mesh.get("filename")
+            if not file:
+                continue
+            try:
+                scale = tuple(float(v) for v in mesh.get("scale", "1 1 1").split())
+            except ValueError:
+                continue
+            name = Path(file).stem
+            seen = pairs_seen.setdefault(name, [])
+            if (file, scale) not in seen:
+                seen.append((file, scale))
+            k = seen.index((file, scale))
+            if k == 0:
+                continue
+            if (file, scale) not in renamed:
+                alias = f"{name}__{k}{Path(file).suffix}"
+                try:
+                    assets[alias] = Path(file).read_bytes()
+                except OSError:
+                    continue
+                renamed[(file, scale)] = alias
+            mesh.set("filename", renamed[(file, scale)])
+    return assets
+
+
+def _mimic_equalities(root: ET.Element) -> list[tuple[str, str, float, float]]:
+    """(joint, mimicked joint, multiplier, offset) of every ``<joint><mimic>``."""
+    out = []
+    for joint in root.iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is None or not joint.get("name") or not mimic.get("joint"):
+            continue
+        try:
+            mult = float(mimic.get("multiplier", "1"))
+            offset = float(mimic.get("offset", "0"))
+        except ValueError:
+            continue
+        out.append((joint.get("name", ""), mimic.get("joint", ""), mult, offset))
+    return out
+
+
+def _inertia_into_link_frame(root: ET.Element) -> None:
+    """Rewrite each ``<inertial>`` whose ``<origin rpy>`` rotates the inertia into the
+    equivalent one with ``rpy="0 0 0"`` and the tensor ``R I R^T`` in the link frame.
+
+    For a MuJoCo that drops that rotation (3.11, see
+    :func:`mujoco_urdf_keeps_inertial_rotation`): the rewritten URDF is the same robot
+    for any correct importer. The tensor is computed as the URDF parser computes it, so
+    on such a MuJoCo the rotation of inertial frames is checked against our own
+    arithmetic (4.x checks it independently). An ``<inertial>`` with numbers that do not
+    parse is left as written: MuJoCo's own error then names it.
+    """
+    for inertial in root.iter("inertial"):
+        origin = inertial.find("origin")
+        if origin is None or origin.get("rpy") is None:
+            continue
+        try:
+            rpy = [float(v) for v in origin.get("rpy", "").split()]
+            i_el = inertial.find("inertia")
+            v = {k: float(i_el.get(k, "0")) for k in _INERTIA_KEYS} if i_el is not None else {}
+        except ValueError:
+            continue
+        if len(rpy) != 3:
+            continue
+        if any(rpy) and i_el is not None:
+            local = np.array(
+                [
+                    [v["ixx"], v["ixy"], v["ixz"]],
+                    [v["ixy"], v["iyy"], v["iyz"]],
+                    [v["ixz"], v["iyz"], v["izz"]],
+                ]
+            )
+            rot = quat_to_mat(rpy_to_quat(rpy))
+            t = rot @ local @ rot.T
+            for k, (r, c) in zip(_INERTIA_KEYS, ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+                i_el.set(k, repr(float(t[r, c])))
+        origin.set("rpy", "0 0 0")
+
+
 def urdf_for_mujoco(
     path: Path,
     package_map=None,
@@ -236,8 +457,10 @@ def urdf_for_mujoco(
     bound_mass=None,
     bound_inertia=None,
 ) -> str:
-    """The URDF text with mesh URIs made absolute and a ``<mujoco><compiler>`` block that
-    keeps every link a body (``fusestatic="false"``), takes inertia only from
+    """The URDF text with mesh URIs made absolute, rotated inertial frames written in the
+    link frame where MuJoCo would drop the rotation (see
+    :func:`_inertia_into_link_frame`) and a ``<mujoco><compiler>`` block
+    that keeps every link a body (``fusestatic="false"``), takes inertia only from
     ``<inertial>`` (``inertiafromgeom="false"``) and drops visual geoms."""
     root = parse_xml(path)
     for mesh in root.iter("mesh"):
@@ -248,6 +471,8 @@ def urdf_for_mujoco(
             except UnresolvedMesh:
                 continue  # left as written: MuJoCo's own error then names the file
             mesh.set("filename", str(resolved))
+    if not mujoco_urdf_keeps_inertial_rotation():
+        _inertia_into_link_frame(root)
     for old in root.findall("mujoco"):
         root.remove(old)
     mj = ET.SubElement(root, "mujoco")
@@ -266,10 +491,73 @@ def urdf_for_mujoco(
     return ET.tostring(root, encoding="unicode")
 
 
+def compile_urdf(text: str) -> mujoco.MjModel:
+    """MuJoCo's import of a URDF text (as :func:`urdf_for_mujoco` writes it), compiled.
+
+    On MuJoCo 4.x this is ``MjModel.from_xml_string(text)``. Where the installed MuJoCo
+    gets a URDF wrong (3.11; each found by a probe), the import is completed so that the
+    reference is the same as 4.x's: ``<mimic>`` added as the joint equality 4.x makes
+    (:func:`mujoco_urdf_imports_mimic`), each scale of a mesh file its own mesh name
+    (:func:`_split_mesh_scales`), and each body's tensor, as MuJoCo's URDF reader stored
+    it, given to the compiler already diagonalised (``numpy.linalg.eigh``) where the
+    compiler does not diagonalise to rounding
+    (:func:`mujoco_diagonalises_inertia_exactly`). Everything else (masses, centres of
+    mass, which tensor goes to which body, frames, joints, geoms) stays MuJoCo's own
+    import. Raises ValueError when MuJoCo refuses it.
+    """
+    if (
+        mujoco_diagonalises_inertia_exactly()
+        and mujoco_urdf_imports_mimic()
+        and mujoco_urdf_keeps_mesh_files_apart()
+    ):
+        return mujoco.MjModel.from_xml_string(text)
+    root = DET.fromstring(text)
+    assets: dict[str, bytes] = {}
+    if not mujoco_urdf_keeps_mesh_files_apart():
+        assets = _split_mesh_scales(root)
+        if assets:
+            text = ET.tostring(root, encoding="unicode")
+    spec = mujoco.MjSpec.from_string(text, assets=assets or None)
+    if not mujoco_urdf_imports_mimic():
+        # As MuJoCo 4.x's URDF reader does (same fields, defaults for the rest).
+        joints = {j.name for j in spec.joints}
+        for joint, mimicked, mult, offset in _mimic_equalities(root):
+            if joint in joints and mimicked in joints:
+                eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=joint, name2=mimicked)
+                data = np.array(eq.data, dtype=float)
+                data[:5] = (offset, mult, 0.0, 0.0, 0.0)
+                eq.data = data
+    if mujoco_diagonalises_inertia_exactly():
+        return spec.compile()
+    # With the inertial rotation dropped by this MuJoCo, urdf_for_mujoco has written
+    # every tensor in the link frame and the reader's iquat is not the tensor's frame;
+    # otherwise the tensor is given in the frame iquat.
+    in_link_frame = not mujoco_urdf_keeps_inertial_rotation()
+    for body in spec.bodies:
+        f = np.asarray(body.fullinertia, dtype=float)
+        if not body.explicitinertial or np.isnan(f[0]):
+            continue
+        tensor = np.array([[f[0], f[3], f[4]], [f[3], f[1], f[5]], [f[4], f[5], f[2]]])
+        if not in_link_frame:
+            rot = quat_to_mat(body.iquat)
+            tensor = rot @ tensor @ rot.T
+        values, vectors = np.linalg.eigh(tensor)
+        if np.linalg.det(vectors) < 0:
+            vectors[:, 2] = -vectors[:, 2]
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, vectors.flatten())
+        body.inertia = values
+        body.iquat = quat
+        body.fullinertia = [np.nan, 0, 0, 0, 0, 0]
+    return spec.compile()
+
+
 def urdf_mujoco_view(path: Path, package_map=None, **compiler) -> RobotView:
-    """MuJoCo's own URDF import of ``path`` (raises ValueError when MuJoCo refuses it)."""
+    """MuJoCo's own URDF import of ``path`` (raises ValueError when MuJoCo refuses it;
+    see :func:`urdf_for_mujoco` and :func:`compile_urdf` for what is completed for it on
+    MuJoCo 3.11)."""
     text = urdf_for_mujoco(path, package_map, **compiler)
-    return view_from_model(mujoco.MjModel.from_xml_string(text), "mujoco")
+    return view_from_model(compile_urdf(text), "mujoco")
 
 
 def _repair(

@@ -515,10 +515,10 @@ def _our_urdf(hrdf: HRDF) -> tuple[mujoco.MjModel, dict[str, str], dict[str, str
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             gen.export(out)
-        from robotwright.parsers.reference import urdf_for_mujoco
+        from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
 
         text = urdf_for_mujoco(out)
-        return mujoco.MjModel.from_xml_string(text), dict(gen.dummy_links), dict(gen.frame_links)
+        return compile_urdf(text), dict(gen.dummy_links), dict(gen.frame_links)
 
 
 def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
