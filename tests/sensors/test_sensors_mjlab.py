@@ -1,6 +1,15 @@
-"""The mjlab adapter: our kernels inside mjlab's ray-cast pipeline (marked ``mjlab``)."""
+"""The mjlab adapter: our kernels inside mjlab's ray-cast pipeline (marked ``mjlab``).
+
+Runs in the MuJoCo 3.11 environment of ``.ci/run`` (mjlab pins MuJoCo 3.11), on warp's
+CPU device; skipped with a reason where mjlab is not installed.
+"""
 
 from __future__ import annotations
+
+import math
+import sys
+import warnings
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -13,17 +22,26 @@ pytest.importorskip("mjlab", reason="mjlab not installed (the MuJoCo 3.11 enviro
 import torch  # noqa: E402
 import warp as wp  # noqa: E402
 from mjlab.sensor.builtin_sensor import ObjRef  # noqa: E402
+from mjlab.sensor.raycast_sensor import GridPatternCfg as MjlabGridPatternCfg  # noqa: E402
 from mjlab.sensor.raycast_sensor import RayCastSensor  # noqa: E402
 from mjlab.sensor.sensor_context import SensorContext  # noqa: E402
 from mjlab.sim.sim_data import WarpBridge  # noqa: E402
 
+from robotwright.errors import SensorError  # noqa: E402
 from robotwright.sensors import (  # noqa: E402
+    DEFAULT_SEMANTIC_CLASS_MAPPING,
+    FilePatternCfg,
+    GridPatternCfg,
     LivoxPatternCfg,
+    PinholeCameraPatternCfg,
     SemanticLidarCfg,
     SemanticLidarSensor,
+    SpinningLidarPatternCfg,
     classify_path,
 )
 from robotwright.sensors import mjlab as rw_mjlab  # noqa: E402
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _robot_in_group_3(model: mujoco.MjModel) -> mujoco.MjModel:
@@ -35,9 +53,10 @@ def _robot_in_group_3(model: mujoco.MjModel) -> mujoco.MjModel:
 
 
 class _Env:
-    """The parts of an mjlab env the sensor uses: a scene dict and mjlab's sense sequence."""
+    """The parts of an mjlab env the sensor uses: a scene dict and mjlab's sense sequence
+    (``Simulation.sense``: prepare, then refit the BVH and cast, then finalize)."""
 
-    def __init__(self, model, host, cfg) -> None:
+    def __init__(self, model: mujoco.MjModel, host: list[mujoco.MjData], cfg) -> None:
         import mujoco_warp as mjw
 
         with wp.ScopedDevice("cpu"):
@@ -63,46 +82,74 @@ class _Env:
         self.ctx.finalize()
 
 
+def _check_labels(sensor, data) -> None:
+    """Each label is the class of the hit geom's path; misses are label 0, id -1."""
+    ids, labels = data.geom_ids.numpy(), data.semantic_labels.numpy()
+    hit = data.hit_mask.numpy()
+    assert ((ids >= 0) == hit).all()
+    for g in np.unique(ids[hit]):
+        expect = classify_path(sensor.geom_paths[g], sensor.semantic_class_mapping)
+        assert (labels[ids == g] == expect).all(), sensor.geom_paths[g]
+    assert (labels[~hit] == 0).all()
+
+
+def _compare_with_core(data, ref: SemanticLidarSensor) -> None:
+    """>= 99.9% of geom ids equal; labels equal where ids agree; distances close."""
+    ids, ids_ref = data.geom_ids.numpy(), ref.get_mesh_ids()
+    same = ids == ids_ref
+    assert same.mean() >= 0.999, same.mean()
+    labels, labels_ref = data.semantic_labels.numpy(), ref.get_semantic_labels()
+    assert (labels[same] == labels_ref[same]).all()
+    both = same & (ids_ref >= 0)
+    dist_ref = ref.get_distances()[both]
+    err = np.abs(data.distances.numpy()[both] - dist_ref)
+    # float32 rays (mujoco-warp) against float64 (MuJoCo): directions are rounded to
+    # ~1e-7 rad, which grazing hits turn into up to ~1e-6 m per metre of range; float32
+    # mesh/heightfield triangles add ~1e-5 m on a few grazing hits.
+    assert (err <= 1e-5 + 2e-6 * dist_ref).mean() >= 0.999 and err.max() < 1e-4
+
+
 def test_mjlab_sensor_matches_the_core_sensor_and_labels_geoms(clutter_model):
     model = _robot_in_group_3(clutter_model)
     host = random_envs(model, 3, seed=9)
     pattern = LivoxPatternCfg(num_rays=20000)
+    offset = {"offset_pos": (0.05, -0.02, 0.03), "offset_rot": (0.9659258, 0.0, 0.258819, 0.0)}
     cfg = rw_mjlab.SemanticLidarSensorCfg(
         name="lidar",
         frame=ObjRef(type="site", name="lidar"),
-        lidar_pattern=pattern,
+        pattern=pattern,
         max_distance=30.0,
+        **offset,
     )
     env = _Env(model, host, cfg)
     assert isinstance(env.sensor, RayCastSensor)  # mjlab's scene treats it as a ray sensor
     ref = SemanticLidarSensor(
         SemanticLidarCfg(
-            prim_path="lidar", pattern_cfg=pattern, max_distance=30.0, return_mesh_ids=True
+            prim_path="lidar",
+            pattern_cfg=pattern,
+            max_distance=30.0,
+            return_mesh_ids=True,
+            **offset,
         ),
         model,
         host,
     )
+    # Same hittable geoms: mjlab's groups + parent body vs the core's robot exclusion.
+    assert (env.sensor.hittable_geom_mask == ref.hittable_geom_mask).all()
     data = env.sensor.data
+    pointer = data.distances.data_ptr()
     first_dirs = None
-    for _step in range(3):
+    for step in range(3):
         env.sense()
         ref.update()
-        assert env.sensor.data is data  # same tensors every step (zero-copy views)
-        ids, ids_ref = data.geom_ids.numpy(), ref.get_mesh_ids()
-        same = ids == ids_ref
-        assert same.mean() >= 0.999
-        both = same & (ids_ref >= 0)
-        err = np.abs(data.distances.numpy()[both] - ref.get_distances()[both])
-        # float32 mesh/heightfield triangles (mujoco-warp 3.11): a few grazing hits differ
-        # by up to ~2e-5 m; the rest agree to 1e-5 m.
-        assert (err <= 1e-5).mean() >= 0.999 and err.max() < 1e-4
-        # Labels are the class of the hit geom's path, as the seed classifies it.
-        labels = data.semantic_labels.numpy()
-        for g in np.unique(ids[ids >= 0]):
-            expect = classify_path(env.sensor.geom_paths[g], env.sensor.semantic_class_mapping)
-            assert (labels[ids == g] == expect).all()
-        assert (labels[ids < 0] == 0).all() and (data.distances.numpy()[ids < 0] == 30.0).all()
-        assert set(np.unique(labels).tolist()) == {0, 1, 2, 3}
+        assert env.sensor.data is data and data.distances.data_ptr() == pointer
+        assert data.distances.data_ptr() == env.sensor._buffers["distances"].ptr  # zero-copy
+        assert int(data.frame[0]) == step == ref.data.frame
+        _compare_with_core(data, ref)
+        _check_labels(env.sensor, data)
+        np.testing.assert_allclose(data.pos_w.numpy(), ref.data.pos_w, atol=1e-5)
+        assert (data.distances.numpy()[~data.hit_mask.numpy()] == 30.0).all()
+        assert set(np.unique(data.semantic_labels.numpy()).tolist()) == {0, 1, 2, 3}
         assert data.distances.device == torch.device("cpu") and data.distances.shape == (3, 20000)
         dirs = data.ray_directions_w.numpy().copy()
         if first_dirs is None:
@@ -112,46 +159,343 @@ def test_mjlab_sensor_matches_the_core_sensor_and_labels_geoms(clutter_model):
     # Observation terms.
     obs = rw_mjlab.lidar_semantic_obs(env, "lidar")
     assert obs.shape == (3, 40000) and torch.isfinite(obs).all()
+    assert torch.equal(obs[:, 0::2], data.distances)
     assert torch.equal(obs[:, 1::2], data.semantic_labels.float())
     norm = rw_mjlab.lidar_distances_normalized(env, "lidar")
     assert float(norm.max()) == 1.0 and float(norm.min()) >= 0.0
+    assert torch.equal(norm, data.distances / 30.0)
     one_hot = rw_mjlab.lidar_one_hot_classes(env, "lidar").reshape(3, 20000, 4)
+    assert torch.equal(one_hot.sum(-1), torch.ones(3, 20000))
     assert torch.equal(one_hot.argmax(-1).int(), data.semantic_labels)
     assert torch.equal(rw_mjlab.lidar_class_ids(env, "lidar"), data.semantic_labels.float())
 
 
-def test_go1_example_labels_every_class(tmp_path):
-    """The example's Go1 task on the CPU device: labels are the classes of the hit geoms."""
-    import sys
-    from pathlib import Path
+def _angles_file(tmp_path: Path) -> Path:
+    path = tmp_path / "rays.csv"
+    az = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+    rows = [f"{a:.6f},{e:.6f}" for e in (-0.3, -0.1, 0.1) for a in az]
+    path.write_text("azimuth,elevation\n" + "\n".join(rows) + "\n")
+    return path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
-    import mjlab_go1_semantic_lidar as example
 
-    env = example.make_env(2, "cpu")
-    sensor = env.scene["lidar"]
-    data = sensor.data
-    action = torch.zeros(env.num_envs, env.action_manager.total_action_dim)
-    dirs = []
-    for _ in range(3):
-        env.step(action)
-        assert env.scene["lidar"].data is data  # the same tensors every step
-        dirs.append(data.ray_directions_w.numpy().copy())
-    assert not np.allclose(dirs[0], dirs[1])  # the Mid-360 window advanced
-    ids, labels = data.geom_ids.numpy(), data.semantic_labels.numpy()
-    for g in np.unique(ids[ids >= 0]):
-        expect = classify_path(sensor.geom_paths[g], sensor.semantic_class_mapping)
-        assert (labels[ids == g] == expect).all(), sensor.geom_paths[g]
-    hit_names = {sensor.geom_paths[g].rsplit("/", 1)[-1] for g in np.unique(ids[ids >= 0])}
-    assert {"sofa_0_geom", "cracker_box_0_geom"} <= hit_names
-    assert set(np.unique(labels[data.hit_mask.numpy()]).tolist()) == {1, 2, 3}
-    dist = data.distances.numpy()
-    assert (dist[~data.hit_mask.numpy()] == 20.0).all() and (dist >= 0).all() and (dist <= 20).all()
-    # The seed's stacked observation is part of the actor's observation.
-    obs = env.observation_manager.compute()["actor"]
-    assert obs.shape[1] >= 2 * sensor.num_rays
-    summary = example.run(tmp_path, num_envs=2, steps=5, device="cpu")
-    assert Path(summary["png"]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert all(
-        summary["hits_per_class"][c] > 0 for c in ("terrain", "dynamic_obstacle", "valuable")
+@pytest.mark.parametrize(
+    "make_pattern",
+    [
+        lambda tmp: LivoxPatternCfg(sensor_type="avia", num_rays=1500),
+        lambda tmp: SpinningLidarPatternCfg.vlp16(horizontal_resolution=math.radians(2.0)),
+        lambda tmp: GridPatternCfg(size=(2.0, 1.0), resolution=0.1),
+        lambda tmp: PinholeCameraPatternCfg(width=32, height=24),
+        lambda tmp: FilePatternCfg(path=_angles_file(tmp)),
+    ],
+    ids=["avia", "vlp16", "grid", "pinhole", "file"],
+)
+def test_every_robotwright_pattern_matches_the_core_sensor(clutter_model, tmp_path, make_pattern):
+    model = _robot_in_group_3(clutter_model)
+    host = random_envs(model, 2, seed=3)
+    pattern = make_pattern(tmp_path)
+    cfg = rw_mjlab.SemanticLidarSensorCfg(
+        name="lidar", frame=ObjRef(type="site", name="lidar"), pattern=pattern, max_distance=30.0
     )
+    env = _Env(model, host, cfg)
+    ref = SemanticLidarSensor(
+        SemanticLidarCfg(
+            prim_path="lidar", pattern_cfg=pattern, max_distance=30.0, return_mesh_ids=True
+        ),
+        model,
+        host,
+    )
+    assert env.sensor.num_rays == pattern.num_rays == ref.num_rays
+    for _ in range(2):
+        env.sense()
+        ref.update()
+        _compare_with_core(env.sensor.data, ref)
+        _check_labels(env.sensor, env.sensor.data)
+        # Rays start at the pattern's origins: world origin = pos + R @ table origin.
+        o, _ = env.sensor.table.window(int(env.sensor.data.frame[0]))
+        rot = ref.data.ray_rot_w
+        expect = ref.data.pos_w[:, None, :] + np.einsum("eij,nj->eni", rot, o)
+        np.testing.assert_allclose(env.sensor.data.ray_origins_w.numpy(), expect, atol=1e-5)
+    assert env.sensor.data.hit_mask.numpy().any()
+
+
+def test_mjlab_patterns_geom_frames_and_alignment(clutter_model):
+    """mjlab's own grid pattern, on a geom frame with yaw alignment, casts as mjlab does."""
+    model = _robot_in_group_3(clutter_model)
+    host = random_envs(model, 2, seed=5)
+    grid = MjlabGridPatternCfg(size=(0.6, 0.4), resolution=0.2, direction=(0.0, 0.0, -1.0))
+    cfg = rw_mjlab.SemanticLidarSensorCfg(
+        name="scan",
+        frame=ObjRef(type="geom", name="base"),
+        pattern=grid,
+        ray_alignment="yaw",
+        max_distance=5.0,
+    )
+    env = _Env(model, host, cfg)
+    env.sense()
+    data = env.sensor.data
+    offsets, dirs = grid.generate_rays(None, "cpu")
+    g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "base")
+    for e, d in enumerate(host):
+        np.testing.assert_allclose(data.pos_w.numpy()[e], d.geom_xpos[g], atol=1e-5)
+        mat = d.geom_xmat[g].reshape(3, 3)
+        yaw = math.atan2(mat[1, 0], mat[0, 0])
+        c, s = math.cos(yaw), math.sin(yaw)
+        rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        np.testing.assert_allclose(
+            data.ray_origins_w.numpy()[e], d.geom_xpos[g] + offsets.numpy() @ rot.T, atol=1e-5
+        )
+        np.testing.assert_allclose(data.ray_directions_w.numpy()[e], dirs.numpy(), atol=1e-6)
+    # Straight down onto the ground plane (the robot's own geoms are in group 3).
+    hit = data.hit_mask.numpy()
+    assert hit.all()
+    names = {env.sensor.geom_paths[i] for i in np.unique(data.geom_ids.numpy())}
+    assert names == {"/world/ground"}
+    z = np.array([d.geom_xpos[g][2] for d in host])
+    assert data.distances.shape == (2, offsets.shape[0]) == (2, 12)
+    np.testing.assert_allclose(data.distances.numpy(), np.repeat(z[:, None], 12, 1), atol=1e-4)
+    assert (data.semantic_labels.numpy() == 1).all()
+
+
+def test_range_model_and_miss_value(clutter_model):
+    model = _robot_in_group_3(clutter_model)
+    host = random_envs(model, 2, seed=1)
+    base = dict(name="lidar", frame=ObjRef(type="site", name="lidar"), max_distance=6.0)
+    pattern = LivoxPatternCfg(num_rays=4000)
+    clean = _Env(model, host, rw_mjlab.SemanticLidarSensorCfg(**base, pattern=pattern))
+    noisy = _Env(
+        model,
+        host,
+        rw_mjlab.SemanticLidarSensorCfg(
+            **base,
+            pattern=pattern,
+            min_distance=0.5,
+            range_noise_std=0.01,
+            dropout_prob=0.2,
+            miss_distance=-1.0,
+            seed=7,
+        ),
+    )
+    clean.sense()
+    noisy.sense()
+    c, n = clean.sensor.data, noisy.sensor.data
+    c_hit, n_hit = c.hit_mask.numpy(), n.hit_mask.numpy()
+    assert not (n_hit & ~c_hit).any()  # noise and dropout never create hits
+    kept = n_hit.sum() / (c_hit & (c.distances.numpy() >= 0.5)).sum()
+    assert 0.75 < kept < 0.85  # dropout 0.2
+    diff = n.distances.numpy()[n_hit] - c.distances.numpy()[n_hit]
+    assert 0.008 < diff.std() < 0.012 and np.abs(diff).max() < 0.1
+    assert (n.distances.numpy()[~n_hit] == -1.0).all()
+    assert np.isnan(n.hit_pos_w.numpy()[~n_hit]).all()
+    assert ((n.distances.numpy()[n_hit] >= 0.5) & (n.distances.numpy()[n_hit] <= 6.0)).all()
+    # The CPU column blocks (parallel launches) give exactly the one-launch result (the
+    # CUDA path), noise and dropout included: each ray's random stream is its own.
+    for threads in (1, 3):
+        other = _Env(
+            model,
+            host,
+            rw_mjlab.SemanticLidarSensorCfg(
+                **base,
+                pattern=pattern,
+                min_distance=0.5,
+                range_noise_std=0.01,
+                dropout_prob=0.2,
+                miss_distance=-1.0,
+                seed=7,
+                num_threads=threads,
+            ),
+        )
+        assert len(other.sensor._blocks) == threads
+        other.sense()
+        o = other.sensor.data
+        for key in ("distances", "geom_ids", "semantic_labels", "hit_mask"):
+            assert torch.equal(getattr(o, key), getattr(n, key)), (threads, key)
+
+
+SELF_SEEING_XML = """
+<mujoco>
+  <worldbody>
+    <body name="terrain"><geom name="terrain" type="plane" size="10 10 0.1"/></body>
+    <body name="robot" pos="0 0 0.5"><freejoint/>
+      <geom name="base" type="box" size="0.2 0.1 0.05" group="3"/>
+      <body name="leg" pos="0 0 -0.2"><geom name="shin" type="capsule" size="0.03 0.15"/></body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_warnings_for_self_hits_and_unclassified_terrain():
+    model = mujoco.MjModel.from_xml_string(SELF_SEEING_XML)
+    host = random_envs(model, 1)
+    cfg = rw_mjlab.SemanticLidarSensorCfg(
+        name="lidar", frame=ObjRef(type="body", name="robot"), pattern=GridPatternCfg()
+    )
+    with pytest.warns(UserWarning) as caught:
+        env = _Env(model, host, cfg)
+    text = " ".join(str(w.message) for w in caught)
+    assert "/world/robot/leg/shin" in text and "see its own robot" in text
+    assert "/world/terrain/terrain" in text and "mjlab_class_mapping" in text
+    env.sense()
+    # The shin (group 0, not the parent body) is hit: what the warning is about.
+    shin = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "shin")
+    assert (env.sensor.data.geom_ids.numpy() == shin).any()
+    # With mjlab's terrain keyword the terrain is class 1 and the warning is gone.
+    mapped = rw_mjlab.SemanticLidarSensorCfg(
+        name="lidar",
+        frame=ObjRef(type="body", name="robot"),
+        pattern=GridPatternCfg(),
+        semantic_class_mapping=rw_mjlab.mjlab_class_mapping(),
+        include_geom_groups=(1,),
+    )
+    model.geom_group[0] = 1  # terrain in group 1, the shin (group 0) now excluded
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env = _Env(model, host, mapped)
+    assert env.sensor.classify_geom(0) == 1
+    assert (
+        rw_mjlab.mjlab_class_mapping()["terrain"][:4] == DEFAULT_SEMANTIC_CLASS_MAPPING["terrain"]
+    )
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"frame": "trunk"}, "frame: expected one ObjRef"),
+        ({"frame": ObjRef(type="joint", name="hip")}, "frame: expected one ObjRef"),
+        ({"pattern": "mid360"}, "pattern: expected a robotwright PatternCfg"),
+        ({"max_distance": 0.0}, "min_distance < max_distance"),
+        ({"dropout_prob": 1.5}, "dropout_prob"),
+        ({"offset_rot": (0.0, 0.0, 0.0, 0.0)}, "offset_rot"),
+        ({"semantic_class_mapping": {"terrain": []}}, "empty keyword list"),
+        ({"miss_distance": math.inf}, "miss_distance"),
+        ({"ray_alignment": "roll"}, "ray_alignment"),
+    ],
+)
+def test_config_is_validated(kwargs, message):
+    base = {"name": "lidar", "frame": ObjRef(type="body", name="trunk", entity="robot")}
+    with pytest.raises(SensorError, match=message):
+        rw_mjlab.SemanticLidarSensorCfg(**{**base, **kwargs})
+
+
+def test_observation_terms_refuse_other_sensors():
+    class _FakeEnv:
+        scene = {"terrain_scan": object()}
+
+    with pytest.raises(SensorError, match="not a robotwright"):
+        rw_mjlab.lidar_semantic_obs(_FakeEnv(), "terrain_scan")
+
+
+# ------------------------------------------------------------------ the Go1 example
+@pytest.fixture(scope="module")
+def example():
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        import mjlab_go1_semantic_lidar as module
+    finally:
+        sys.path.remove(str(EXAMPLES))
+    return module
+
+
+def _host_datas(env) -> list[mujoco.MjData]:
+    """Host MjData of every environment from the mjlab simulation's state."""
+    model = env.sim.mj_model
+    qpos = env.sim.data.qpos.cpu().numpy().astype(np.float64)
+    datas = []
+    for q in qpos:
+        d = mujoco.MjData(model)
+        d.qpos[:] = q
+        mujoco.mj_kinematics(model, d)
+        datas.append(d)
+    return datas
+
+
+def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example):
+    """The example's Go1 task on the CPU device, 3 envs, 12 steps of random actions."""
+    env = example.make_env(3, "cpu")
+    sensor = env.scene["lidar"]
+    assert isinstance(sensor, RayCastSensor) and sensor in env.sim._sensor_context.raycast_sensors
+    data = sensor.data
+    views = {k: getattr(data, k).data_ptr() for k in ("distances", "semantic_labels", "geom_ids")}
+    device = torch.device(env.device)
+    table = sensor.table
+    generator = torch.Generator().manual_seed(1)
+    seen: set[int] = set()
+    frames, dirs_prev = [], None
+    for _ in range(12):
+        action = torch.rand(env.num_envs, env.action_manager.total_action_dim, generator=generator)
+        obs, *_ = env.step(action * 2.0 - 1.0)
+        # The same tensors every step, views of the device buffers, on the env's device.
+        assert env.scene["lidar"].data is data
+        assert {k: getattr(data, k).data_ptr() for k in views} == views
+        assert data.distances.data_ptr() == sensor._buffers["distances"].ptr
+        for t in (data.distances, data.semantic_labels, data.geom_ids, data.hit_pos_w):
+            assert t.device == device
+        assert data.distances.shape == (3, table.rays_per_frame) == data.geom_ids.shape
+        assert data.hit_pos_w.shape == (3, table.rays_per_frame, 3)
+        # The Mid-360 window advances one frame per step: the directions change and, in
+        # the sensor frame, are the table rows of this frame.
+        frames.append(int(data.frame[0]))
+        dirs = data.ray_directions_w.numpy().copy()
+        if dirs_prev is not None:
+            assert not np.allclose(dirs, dirs_prev)
+        dirs_prev = dirs
+        q = data.quat_w.numpy().astype(np.float64)
+        for e in range(env.num_envs):
+            rot = np.empty(9)
+            mujoco.mju_quat2Mat(rot, q[e] / np.linalg.norm(q[e]))
+            local = dirs[e] @ rot.reshape(3, 3)
+            np.testing.assert_allclose(local, table.window(frames[-1])[1], atol=2e-5)
+        _check_labels(sensor, data)
+        hit = data.hit_mask.numpy()
+        seen |= set(np.unique(data.semantic_labels.numpy()[hit]).tolist())
+        dist = data.distances.numpy()
+        assert (dist >= 0).all() and (dist <= example.MAX_DISTANCE).all()
+        assert (dist[~hit] == example.MAX_DISTANCE).all()
+        assert np.isnan(data.hit_pos_w.numpy()[~hit]).all()
+        expect = data.ray_origins_w.numpy() + dirs * dist[..., None]
+        np.testing.assert_allclose(data.hit_pos_w.numpy()[hit], expect[hit], atol=1e-4)
+    assert frames == list(range(frames[0], frames[0] + 12))
+    # Every class of the default mapping appears among the hits (and nothing unknown).
+    assert tuple(DEFAULT_SEMANTIC_CLASS_MAPPING) == sensor.class_names[1:]
+    assert seen == set(range(1, len(sensor.class_names)))
+    hit_names = {sensor.geom_paths[g] for g in np.unique(data.geom_ids.numpy()) if g >= 0}
+    assert "/world/terrain/terrain" in hit_names
+    # The seed's stacked observation is the actor's last term, exactly.
+    n = sensor.num_rays
+    stacked = rw_mjlab.lidar_semantic_obs(env, "lidar")
+    assert obs["actor"].shape[1] > 2 * n and torch.equal(obs["actor"][:, -2 * n :], stacked)
+    # The core sensor (MuJoCo engine, float64) on host MjData made from the sim state,
+    # at the same pattern frame, with the same hittable geoms.
+    model = env.sim.mj_model
+    ref = SemanticLidarSensor(
+        SemanticLidarCfg(
+            prim_path="robot/trunk",
+            pattern_cfg=LivoxPatternCfg(sensor_type="mid360"),
+            offset_pos=sensor.cfg.offset_pos,
+            max_distance=example.MAX_DISTANCE,
+            semantic_class_mapping=sensor.semantic_class_mapping,
+            return_mesh_ids=True,
+        ),
+        model,
+        _host_datas(env),
+    )
+    assert (ref.hittable_geom_mask == sensor.hittable_geom_mask).all()
+    robot = np.flatnonzero(model.body_rootid == model.body("robot/trunk").id)
+    assert not sensor.hittable_geom_mask[np.isin(model.geom_bodyid, robot)].any()
+    for _ in range(frames[-1] + 1):
+        ref.update()
+    assert ref.data.frame == frames[-1]
+    np.testing.assert_allclose(data.pos_w.numpy(), ref.data.pos_w, atol=1e-4)
+    _compare_with_core(data, ref)
+    env.close()
+
+
+def test_go1_example_main_prints_a_summary_and_saves_the_picture(example, tmp_path, capsys):
+    summary = example.main([str(tmp_path), "--envs", "2", "--steps", "5", "--device", "cpu"])
+    out = capsys.readouterr().out
+    assert "2 envs x 20000 rays on cpu: 5 steps" in out and "hits per class" in out
+    assert Path(summary["png"]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    counts = summary["hits_per_class"]
+    assert counts["unknown"] == 0
+    assert all(counts[c] > 0 for c in DEFAULT_SEMANTIC_CLASS_MAPPING)
+    assert summary["actor_obs"][1] > 2 * summary["rays"]
