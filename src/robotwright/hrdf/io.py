@@ -12,7 +12,7 @@ import io
 import math
 import os
 import warnings
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from itertools import repeat
 from pathlib import Path
@@ -141,22 +141,29 @@ def _flat_columns(lines: list[str], width: int) -> list[list[str]] | None:
     return [flat[j::width] for j in range(width)]
 
 
-def _folder_text(path: Path, limit: int, problems: list[Problem]) -> str | None:
-    """The text of a file of the robot folder (``path.parent``), or ``None`` after
+def _folder_read(path: Path, read: Callable[[Path], Any], problems: list[Problem]) -> Any:
+    """``read(path)`` for a file of the robot folder (``path.parent``), or ``None`` after
     reporting why it cannot be read: a symbolic link leading out of the folder, not a
-    regular file (FIFO, device), over ``limit`` bytes, not UTF-8 (see
-    :mod:`robotwright._inputs`)."""
+    regular file (FIFO, device), over its size limit, not UTF-8 (see
+    :mod:`robotwright._inputs`), not parseable YAML."""
     try:
         if os.path.islink(path):
             resolve_inside(path.name, base=path.parent, root=path.parent, trusted=())
-        return read_text(path, limit)
+        return read(path)
     except UnsafePathError as exc:
         problems.append(Problem(path.name, f"the file is a link out of the robot folder: {exc}"))
     except InputFileError as exc:
         problems.append(Problem(path.name, f"cannot read file: it {exc.reason}"))
     except OSError as exc:
         problems.append(Problem(path.name, f"cannot read file: {exc.strerror or exc}"))
+    except yaml.YAMLError as exc:
+        problems.append(Problem(path.name, f"cannot parse YAML: {exc}"))
     return None
+
+
+def _folder_text(path: Path, limit: int, problems: list[Problem]) -> str | None:
+    """The text of a file of the robot folder, at most ``limit`` bytes (see :func:`_folder_read`)."""
+    return _folder_read(path, lambda p: read_text(p, limit), problems)
 
 
 def _read_table(
@@ -372,19 +379,7 @@ def _records(cls: type, fields: list[str], rows: list[tuple[Any, ...] | None]) -
 
 
 def _load_yaml(path: Path, problems: list[Problem]) -> Any:
-    try:
-        if os.path.islink(path):
-            resolve_inside(path.name, base=path.parent, root=path.parent, trusted=())
-        return load_yaml(path, MAX_YAML_BYTES)
-    except UnsafePathError as exc:
-        problems.append(Problem(path.name, f"the file is a link out of the robot folder: {exc}"))
-    except InputFileError as exc:
-        problems.append(Problem(path.name, f"cannot read file: it {exc.reason}"))
-    except OSError as exc:
-        problems.append(Problem(path.name, f"cannot read file: {exc.strerror or exc}"))
-    except yaml.YAMLError as exc:
-        problems.append(Problem(path.name, f"cannot parse YAML: {exc}"))
-    return None
+    return _folder_read(path, lambda p: load_yaml(p, MAX_YAML_BYTES), problems)
 
 
 def _float_list(value: Any, size: int, key: str, problems: list[Problem]) -> tuple | None:
