@@ -22,8 +22,9 @@ import numpy as np
 
 from robotwright.errors import SensorError
 from robotwright.sensors.patterns import RayTable
+from robotwright.sensors.raycast import split_ranges
 
-__all__ = ["WarpLidarPipeline", "RangeModel", "import_warp"]
+__all__ = ["WarpLidarPipeline", "RangeModel", "import_warp", "ray_blocks"]
 
 _ALIGN = {"base": 0, "yaw": 1, "world": 2}
 
@@ -45,6 +46,14 @@ def import_warp() -> tuple[Any, Any]:
             f"(import failed: {exc})"
         ) from exc
     return wp, mjw
+
+
+def ray_blocks(num_rays: int, device: Any, num_threads: int | None) -> list[tuple[int, int]]:
+    """Column blocks ``[a, b)`` of a frame's rays cast by parallel launches: one on CUDA;
+    ``num_threads`` (default one per core) on warp's CPU device, which runs a kernel on one
+    core (warp releases the GIL while it runs)."""
+    threads = 1 if device.is_cuda else max(1, int(num_threads or os.cpu_count() or 1))
+    return split_ranges(num_rays, threads)
 
 
 @dataclass(frozen=True)
@@ -175,9 +184,7 @@ class WarpLidarPipeline:
             self.points = wp.full((e, n), wp.vec3(np.nan, np.nan, np.nan), dtype=wp.vec3)
             self._carrier_pos = wp.zeros((e, 1), dtype=wp.vec3)
             self._carrier_mat = wp.zeros((e, 1), dtype=wp.mat33)
-        threads = 1 if self.device.is_cuda else max(1, int(num_threads or os.cpu_count() or 1))
-        bounds = [n * k // threads for k in range(threads + 1)]
-        self._blocks = [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+        self._blocks = ray_blocks(n, self.device, num_threads)
         self._pool = ThreadPoolExecutor(len(self._blocks)) if len(self._blocks) > 1 else None
 
     def close(self) -> None:

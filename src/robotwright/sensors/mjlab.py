@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -51,7 +50,7 @@ import numpy as np
 import torch
 
 from robotwright.errors import SensorError
-from robotwright.sensors.device import import_warp
+from robotwright.sensors.device import import_warp, ray_blocks
 
 # Before mjlab initialises warp: warp quiet, as the core's warp engine keeps it.
 wp, mjw = import_warp()
@@ -342,9 +341,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         self._offset_pos = wp.vec3(*np.asarray(cfg.offset_pos, dtype=np.float32))
         self._offset_mat = wp.mat33(*rot.astype(np.float32))
         self._buffers = b
-        threads = 1 if dev.is_cuda else max(1, int(cfg.num_threads or os.cpu_count() or 1))
-        bounds = [n * k // threads for k in range(threads + 1)]
-        self._blocks = [(lo, hi) for lo, hi in zip(bounds[:-1], bounds[1:]) if hi > lo]
+        self._blocks = ray_blocks(n, dev, cfg.num_threads)
         self._pool = ThreadPoolExecutor(len(self._blocks)) if len(self._blocks) > 1 else None
         t = wp.to_torch
         self._lidar_data = MjlabSemanticLidarData(

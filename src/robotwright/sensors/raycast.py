@@ -49,7 +49,7 @@ def make_ray_model(model: mujoco.MjModel, hittable: np.ndarray) -> mujoco.MjMode
     return ray_model
 
 
-def _split(n: int, parts: int) -> list[tuple[int, int]]:
+def split_ranges(n: int, parts: int) -> list[tuple[int, int]]:
     """``parts`` contiguous near-equal ranges covering ``range(n)`` (empty ones dropped)."""
     bounds = [n * k // parts for k in range(parts + 1)]
     return [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
@@ -119,7 +119,7 @@ class MujocoRayEngine:
         origins_s = np.asarray(origins_s, dtype=np.float64)
         # Enough chunks to keep every thread busy, whole environments when there are many.
         per_env = max(1, -(-self.num_threads // num_envs))
-        tasks = [(e, a, b) for e in range(num_envs) for a, b in _split(num_rays, per_env)]
+        tasks = [(e, a, b) for e in range(num_envs) for a, b in split_ranges(num_rays, per_env)]
         groups = [tasks[i :: self.num_threads] for i in range(self.num_threads)]
 
         def run(worker: int) -> None:
