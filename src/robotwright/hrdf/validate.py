@@ -38,6 +38,8 @@ from robotwright.hrdf.model import (
 QUAT_NORM_TOL = 1e-4
 INERTIA_TRIANGLE_RTOL = 1e-9
 AXIS_NORM_MIN = 1e-9
+#: MuJoCo's smallest mass or principal inertia of a moving body (``mjMINVAL``).
+MJ_MINVAL = 1e-15
 #: The per-row checks below start with a quick pass over the row, written as exactly the
 #: negation of every check that follows it, so that messages are built only for rows
 #: with a problem. Tests turn it off to compare both ways on broken rows.
@@ -141,13 +143,13 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
         if (
             _QUICK_PASS
             and b.name
-            and b.mass > 0
+            and b.mass >= MJ_MINVAL
             and not abs(hypot(*b.quat) - 1.0) > QUAT_NORM_TOL
             and not abs(hypot(*b.inertial_quat) - 1.0) > QUAT_NORM_TOL
             and len(d) == 3
-            and d[0] > 0
-            and d[1] > 0
-            and d[2] > 0
+            and d[0] >= MJ_MINVAL
+            and d[1] >= MJ_MINVAL
+            and d[2] >= MJ_MINVAL
             and not d[0] + d[1] < d[2] * k
             and not d[1] + d[2] < d[0] * k
             and not d[2] + d[0] < d[1] * k
@@ -155,42 +157,75 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
             continue
         if not b.name:
             out.append(Problem("body.csv", "empty body name", row=i, column="name"))
-        # A body without joints is welded to its parent: MuJoCo accepts it massless (URDF
-        # frame links, sensor mounts), provided its inertia is zero too.
-        welded = b.name not in moving
-        massless_frame = welded and b.mass == 0.0 and all(v == 0.0 for v in b.diag_inertia)
-        if not b.mass > 0 and not massless_frame:
-            hint = " (or 0, with zero inertia, for a body without joints)" if welded else ""
+        if not b.mass >= 0:
             out.append(
-                Problem("body.csv", f"mass {b.mass} kg: expected > 0{hint}", row=i, column="mass")
+                Problem("body.csv", f"mass {b.mass} kg: expected >= 0", row=i, column="mass")
             )
         for col, q in (("quat", b.quat), ("inertial_quat", b.inertial_quat)):
             msg = _quat_problem(q)
             if msg:
                 out.append(Problem("body.csv", msg, row=i, column=col))
         d = b.diag_inertia
-        if massless_frame:
-            continue
-        if any(not v > 0 for v in d):
+        if len(d) != 3 or any(not v >= 0 for v in d):
             out.append(
                 Problem(
-                    "body.csv", f"diag_inertia {d}: expected all > 0", row=i, column="diag_inertia"
+                    "body.csv", f"diag_inertia {d}: expected all >= 0", row=i, column="diag_inertia"
                 )
             )
-        else:
-            for a, bb, c in ((d[0], d[1], d[2]), (d[1], d[2], d[0]), (d[2], d[0], d[1])):
-                if a + bb < c * (1.0 - INERTIA_TRIANGLE_RTOL):
-                    out.append(
-                        Problem(
-                            "body.csv",
-                            f"diag_inertia {d} violates the triangle inequality "
-                            f"({a} + {bb} < {c}): not a physical rigid body",
-                            row=i,
-                            column="diag_inertia",
-                        )
+            continue
+        for a, bb, c in ((d[0], d[1], d[2]), (d[1], d[2], d[0]), (d[2], d[0], d[1])):
+            if a + bb < c * (1.0 - INERTIA_TRIANGLE_RTOL):
+                out.append(
+                    Problem(
+                        "body.csv",
+                        f"diag_inertia {d} violates the triangle inequality "
+                        f"({a} + {bb} < {c}): not a physical rigid body",
+                        row=i,
+                        column="diag_inertia",
                     )
-                    break
+                )
+                break
+        if b.mass >= 0 and b.name in moving and not _carries_mass(hrdf, i, moving):
+            out.append(
+                Problem(
+                    "body.csv",
+                    f"mass {b.mass} kg, diag_inertia {d}: a body with joints needs mass and "
+                    f"every principal inertia >= {MJ_MINVAL}, or a child without joints "
+                    "(welded to it) that has them, as MuJoCo requires",
+                    row=i,
+                    column="mass",
+                )
+            )
     return out
+
+
+def _massive(b) -> bool:
+    d = b.diag_inertia
+    return b.mass >= MJ_MINVAL and len(d) == 3 and all(v >= MJ_MINVAL for v in d)
+
+
+def moving_bodies_without_mass(hrdf: HRDF) -> list[str]:
+    """Names of the bodies with joints that MuJoCo refuses: neither they nor a body
+    welded to them has mass and principal inertias >= ``MJ_MINVAL``."""
+    moving = {j.body for j in hrdf.joints}
+    return [
+        b.name
+        for i, b in enumerate(hrdf.bodies)
+        if b.name in moving and not _carries_mass(hrdf, i, moving)
+    ]
+
+
+def _carries_mass(hrdf: HRDF, index: int, moving: set[str]) -> bool:
+    """MuJoCo's rule for a body with joints: it has mass and inertia itself, or one of
+    the bodies welded to it (descendants reached without crossing a joint) has."""
+    stack = [index]
+    while stack:
+        i = stack.pop()
+        b = hrdf.bodies[i]
+        if _massive(b):
+            return True
+        stack.extend(k for k, c in enumerate(hrdf.bodies) if c.parent == i and c.name not in moving)
+    return False
 
 
 def _check_joints(hrdf: HRDF, body_names: set[str]) -> list[Problem]:

@@ -73,7 +73,12 @@ def combine(
     """
     total = float(sum(m for m, _, _ in parts))
     if total <= 0:
-        return 0.0, np.zeros(3), np.zeros((3, 3))
+        # Massless parts may still carry inertia (MuJoCo keeps it): no parallel-axis
+        # term without mass, so the tensors add; the first part's centre is the centre.
+        if not parts:
+            return 0.0, np.zeros(3), np.zeros((3, 3))
+        tensor = sum(np.asarray(t, dtype=float) for _, _, t in parts)
+        return 0.0, np.asarray(parts[0][1], dtype=float), tensor
     com = sum(m * np.asarray(c, dtype=float) for m, c, _ in parts) / total
     tensor = np.zeros((3, 3))
     for m, c, t in parts:

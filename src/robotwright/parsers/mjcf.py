@@ -46,7 +46,7 @@ from robotwright.parsers.meshes import (
     mesh_store,
 )
 from robotwright.parsers.reference import body_name, joint_name
-from robotwright.parsers.report import ParseResult, Reporter
+from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
 from robotwright.parsers.xmlsafe import parse_xml
 
 _JOINT = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
@@ -450,16 +450,6 @@ def _bodies(
     index = {b: k for k, b in enumerate(bodies_ids)}
     bodies: list[Body] = []
     for b in bodies_ids:
-        # A body with no mass and no inertia at all is a frame: fine while welded (the
-        # HRDF checks refuse it on a moving joint). Anything partly massless is reported.
-        frame = model.body_mass[b] == 0 and model.body_inertia[b].max() == 0
-        if (model.body_mass[b] <= 0 or model.body_inertia[b].min() <= 0) and not frame:
-            rep.warn(
-                f"zero-inertia or massless body (mass {float(model.body_mass[b])}): HRDF "
-                "checks need mass > 0 and moments > 0 (or both zero on a welded frame); "
-                "massless_frames='site' turns a massless leaf frame into a site",
-                f'<body name="{body_name(model, b)}">',
-            )
         if model.body_mocapid[b] >= 0:
             rep.warn("mocap flag dropped", f'<body name="{body_name(model, b)}">')
         if model.body_gravcomp[b] != 0:
@@ -505,7 +495,8 @@ def _joints(
                     )
                 ]
             )
-        if name is None and jt != "free":
+        if name is None:
+            # The free joint too: our MJCF and URDF then name it alike (URDF needs a name).
             name = joint_name(model, j)
             rep.warn(f"unnamed joint named '{name}'", where)
         dof = int(model.jnt_dofadr[j])
@@ -918,5 +909,6 @@ def parse_mjcf(
         mjcf_extra=extra,
         root_dir=store.root,
     )
+    warn_massless_moving(hrdf, rep, '<body name="{}">')
     warnings = rep.finish(strict)
     return ParseResult(hrdf, warnings, str(path))

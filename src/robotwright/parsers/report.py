@@ -64,3 +64,19 @@ class Reporter:
             for p in self.problems:
                 LOG.warning("%s", p)
         return list(self.problems)
+
+
+def warn_massless_moving(hrdf: HRDF, rep: Reporter, element: str) -> None:
+    """Warn about each body with joints that MuJoCo (and so the generators) will refuse:
+    no mass and inertia of its own nor in a body welded to it. ``element`` is a format
+    string for the body's element in the source (``{}`` = body name)."""
+    from robotwright.hrdf.validate import moving_bodies_without_mass
+
+    for name in moving_bodies_without_mass(hrdf):
+        rep.warn(
+            "body with joints and no mass or principal inertia >= 1e-15 kg (m^2), itself or "
+            "in a body welded to it: MuJoCo refuses it, so generation will fail "
+            "(fixed_joints='merge' folds fixed links into it; bound_mass/bound_inertia "
+            "raise it)",
+            element.format(name),
+        )

@@ -37,7 +37,7 @@ from robotwright.parsers import inertia as inr
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
 from robotwright.parsers.meshes import MeshConversionError, conversion_note, mesh_store
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
-from robotwright.parsers.report import ParseResult, Reporter
+from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
 from robotwright.parsers.xmlsafe import describe, parse_xml
 
 VISUAL_GROUP = 2
@@ -562,17 +562,6 @@ def _body_record(
         new = tuple(max(v, opt.bound_inertia) for v in diag)
         rep.warn(f"principal moments {diag} raised to bound_inertia: {new}", where)
         diag = new
-    # A link with no mass and no inertia at all is a frame: fine while welded (the HRDF
-    # checks refuse it on a moving joint). Anything partly massless is reported.
-    frame = mass == 0 and max(diag) == 0
-    if (mass <= 0 or min(diag) <= 0) and not frame:
-        rep.warn(
-            f"zero-inertia or massless body (mass {mass}, moments {diag}): HRDF checks "
-            "need mass > 0 and moments > 0 (or both zero on a welded frame); "
-            "fixed_joints='merge' folds fixed links into their parent, "
-            "bound_mass/bound_inertia raise them",
-            where,
-        )
     pose = b["pose"]
     return Body(
         name=name,
@@ -703,7 +692,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
                     )
                 ]
             )
-        massless = not d.has_inertial or d.mass == 0.0
+        massless = not d.has_inertial or (d.mass == 0.0 and not d.tensor.any())
         leaf = not children[name]
         as_site = jtype == "fixed" and (
             opt.fixed_joints == "merge" or (opt.fixed_joints == "site" and massless and leaf)
@@ -711,7 +700,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         if as_site:
             owner[name] = (parent_body, pose)
             target = bodies[parent_body]
-            if d.mass > 0:
+            if d.mass > 0 or d.tensor.any():  # a massless inertia is kept as written
                 target["parts"].append(
                     (d.mass, pose.pos + pose.rot @ d.com, pose.rot @ d.tensor @ pose.rot.T)
                 )
@@ -723,12 +712,18 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         bodies[name] = {
             "parent": parent_body,
             "pose": pose,
-            "parts": [(d.mass, d.com, d.tensor)] if d.mass > 0 else [],
+            "parts": [(d.mass, d.com, d.tensor)] if d.mass > 0 or d.tensor.any() else [],
             "geoms": list(d.geoms),
         }
         body_order.append(name)
         if j is None:
             if free_root:
+                if free_name is None:
+                    # The name our URDF generator gives it, so our MJCF names it alike.
+                    taken = {x.get("name") for x in joints}
+                    free_name = "floating_base"
+                    while free_name in taken:
+                        free_name += "_"
                 hrdf_joints.append(Joint(name=free_name, body=name, type="free"))
             continue
         if jtype == "fixed":
@@ -784,6 +779,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         mjcf_extra=extra,
         root_dir=reader.store.root,
     )
+    warn_massless_moving(hrdf, rep, '<link name="{}">')
     warnings = rep.finish(strict)
     return ParseResult(hrdf, warnings, str(path))
 
