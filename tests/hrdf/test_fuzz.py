@@ -4,9 +4,14 @@ cases in the same order (fewer on a slow machine).
 Each case copies a valid robot and applies one to three random mutations: a CSV cell
 replaced by a hostile value (markup, paths, NaN, huge numbers, long text), a
 ``meta.yaml`` value replaced by a value of another type, a file truncated or replaced by
-random bytes, a file replaced by a symbolic link out of the folder. Whatever the input:
+random bytes, a file replaced by a symbolic link out of the folder, a hostile mesh file
+(empty, truncated, ASCII, random bytes, a NaN vertex, flat, too many faces) or a hostile
+``extra.xml`` (unknown names, a keyframe of the wrong size, entities, a wrong root).
+Whatever the input:
 
 - ``validate_dir`` returns its problems, ``HRDF.from_dir`` raises only ``HRDFError``;
+- a folder that validates loads, exports to MJCF and URDF, and its MJCF compiles in
+  MuJoCo;
 - a robot that loads has every mesh inside its folder;
 - the MJCF and URDF generators and ``save`` raise only robotwright errors, and a failed
   ``save`` leaves nothing behind.
@@ -22,6 +27,7 @@ import time
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 import trimesh
 import yaml
@@ -43,6 +49,41 @@ CELLS = [
     "site", "body", "joint", "framepos", "hinge", "box", "0.5", "1", "2", "0.001",
 ]  # fmt: skip
 META_VALUES = ["abc", [1], {"a": 1}, None, True, -1, 1e308, "", [[[]]], 0, "plane", "RK4"]
+EXTRAS = [
+    "<mujoco><contact><exclude body1='base_link' body2='nobody'/></contact></mujoco>",
+    "<mujoco><keyframe><key name='k' qpos='0 0'/></keyframe></mujoco>",
+    "<mujoco><equality><joint joint1='shoulder_pan_joint' joint2='nojoint'/></equality></mujoco>",
+    "<mujoco><tendon><fixed name='t'><joint joint='nojoint' coef='1'/></fixed></tendon></mujoco>",
+    "<mujoco><sensor><jointpos name='s' joint='nojoint'/></sensor></mujoco>",
+    "<mujoco><sensor><bogus name='s'/></sensor></mujoco>",
+    '<!DOCTYPE m [<!ENTITY e "x">]><mujoco><keyframe><key name="&e;"/></keyframe></mujoco>',
+    "<robot><link name='a'/></robot>",
+    "<mujoco><keyframe><key name='k' time='nan'/></keyframe></mujoco>",
+    "<mujoco><contact><pair geom1='x' geom2='y'/></contact></mujoco>",
+    "<mujoco><actuator><motor joint='shoulder_pan_joint' gear='1e400'/></actuator></mujoco>",
+]
+
+
+def _hostile_meshes() -> list[bytes]:
+    box = trimesh.creation.box(extents=(0.05, 0.05, 0.05))
+    good = box.export(file_type="stl")
+    nan = box.vertices.copy()
+    nan[0, 0] = np.nan
+    flat = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
+    ascii_stl = box.export(file_type="stl_ascii")
+    return [
+        b"",
+        good[: len(good) // 2],
+        ascii_stl.encode() if isinstance(ascii_stl, str) else ascii_stl,
+        trimesh.Trimesh(nan, box.faces, process=False).export(file_type="stl"),
+        flat.export(file_type="stl"),
+        trimesh.Trimesh(np.zeros((3, 3)), [[0, 1, 2]], process=False).export(file_type="stl"),
+        # a header that announces 200,001 faces (MuJoCo's limit is 200,000), data to match
+        good[:80] + (200_001).to_bytes(4, "little") + good[84:134] * 200_001,
+    ]
+
+
+HOSTILE_MESHES = _hostile_meshes()
 MESH_HEADER = (
     "contact_type,contact_affinity,static_friction,dynamic_friction,restitution,"
     "pos0,pos1,pos2,quat0,quat1,quat2,quat3,rgba0,rgba1,rgba2,rgba3,body_name,name,file"
@@ -66,6 +107,15 @@ def sources(tmp_path_factory) -> list[Path]:
 
 
 def _mutate(folder: Path, rng: random.Random) -> str:
+    pick = rng.random()
+    if pick < 0.08:
+        (folder / "extra.xml").write_text(text := rng.choice(EXTRAS))
+        return f"extra.xml = {text!r}"
+    mesh = folder / "meshes" / "part.stl"
+    if pick < 0.16 and mesh.is_file() and not mesh.is_symlink():
+        data = rng.choice(HOSTILE_MESHES)
+        mesh.write_bytes(data)
+        return f"meshes/part.stl = hostile mesh of {len(data)} bytes"
     files = sorted(p for p in folder.iterdir() if p.is_file())
     target = rng.choice(files)
     roll = rng.random()
@@ -121,13 +171,19 @@ def _mutate(folder: Path, rng: random.Random) -> str:
 
 
 def _check_case(folder: Path, out: Path) -> None:
-    validate_dir(folder)  # returns problems, raises nothing
+    problems = validate_dir(folder)  # returns problems, raises nothing
+    valid = not any(p.severity == "error" for p in problems)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # HRDF and conversion warnings are fine here
         try:
             hrdf = HRDF.from_dir(folder)
         except HRDFError:
+            assert not valid, "validate found no error, loading refused the folder"
             return
+        if valid:  # validates => exports and compiles
+            model = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
+            assert model.nbody == len(hrdf.bodies) + 1
+            assert URDFHumanoidGenerator.from_hrdf(hrdf).generate() is not None
         inside = folder.resolve()
         assert all(hrdf.mesh_source(m).is_relative_to(inside) for m in hrdf.meshes)
         for gen in (MJCFHumanoidGenerator, URDFHumanoidGenerator):

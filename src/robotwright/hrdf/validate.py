@@ -539,6 +539,16 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
         msg = _quat_problem(s.quat)
         if msg:
             out.append(Problem("site.csv", msg, row=i, column="quat"))
+        used = _SIZE_USED.get(s.type, 3)
+        if s.type in SITE_TYPES and any(not v > 0 for v in s.size[:used]):
+            out.append(
+                Problem(
+                    "site.csv",
+                    f"{s.type} size {s.size}: expected the first {used} value(s) > 0",
+                    row=i,
+                    column="size0",
+                )
+            )
     for name in sorted(_duplicates(s.name for s in hrdf.sensors)):
         out.append(Problem("sensor.csv", f"duplicate sensor name '{name}'", column="name"))
     targets = {
@@ -678,9 +688,17 @@ def check_model(hrdf: HRDF, *, check_files: bool = True) -> list[Problem]:
     return problems
 
 
-def validate_dir(path: str | Path) -> list[Problem]:
-    """Read and check an HRDF folder; return every problem (errors and warnings)."""
+def validate_dir(path: str | Path, *, compile_model: bool = True) -> list[Problem]:
+    """Read and check an HRDF folder; return every problem (errors and warnings).
+
+    With ``compile_model`` (the default), a folder without table errors is also exported in
+    memory and compiled with MuJoCo (see :func:`robotwright.hrdf.compiles.check_compiles`):
+    a folder that validates exports to MJCF and URDF, and its MJCF compiles.
+    """
+    from robotwright.hrdf.compiles import check_compiles
     from robotwright.hrdf.io import collect_hrdf_dir
 
-    _, problems = collect_hrdf_dir(path)
+    hrdf, problems = collect_hrdf_dir(path)
+    if compile_model and hrdf is not None and not any(p.severity == "error" for p in problems):
+        problems += check_compiles(hrdf)
     return problems
