@@ -185,7 +185,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
     def _add_mesh_assets(self, hrdf: HRDF, prefix: str | None) -> list[str]:
         """One ``<mesh>`` per distinct (file, scale); returns the asset name of each row."""
         asset = self.get_elem("asset")
-        by_key: dict[tuple[str, tuple[float, float, float]], str] = {}
+        by_key: dict[tuple[str, tuple[float, float, float], str | None], str] = {}
         used: set[str] = set()
         names: list[str] = []
         listings: dict[str, set[str] | None] = {}
@@ -196,7 +196,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                     f"robot '{hrdf.name}': mesh.csv row {row} (mesh '{m.name}'): "
                     f"file '{path}' does not exist"
                 )
-            key = (path, tuple(m.scale))
+            key = (path, tuple(m.scale), m.inertia)
             name = by_key.get(key)
             if name is None:
                 name, n = m.name, 1
@@ -208,6 +208,8 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                 attrs = {"name": prefixed(prefix, name), "file": path}
                 if m.scale != (1.0, 1.0, 1.0):
                     attrs["scale"] = fmt_vec(m.scale)
+                if m.inertia is not None:
+                    attrs["inertia"] = m.inertia  # centre and volume as in the source
                 ET.SubElement(asset, "mesh", attrs)
             names.append(prefixed(prefix, name))
         return names

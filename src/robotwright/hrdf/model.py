@@ -244,6 +244,10 @@ class Geom:
     geom_name: str | None = None
 
 
+#: MuJoCo's ``<mesh inertia>`` modes.
+MESH_INERTIA_MODES = ("legacy", "convex", "exact", "shell")
+
+
 @dataclass(frozen=True)
 class MeshGeom(Geom):
     """A geom whose shape is a mesh file.
@@ -253,11 +257,15 @@ class MeshGeom(Geom):
             ``file`` is set. Several rows may share one mesh (e.g. visual + collision).
         file: mesh file path relative to the HRDF folder, or ``None`` for the default.
         scale: per-axis scale applied to the mesh vertices.
+        inertia: MuJoCo's mesh inertia mode (one of :data:`MESH_INERTIA_MODES`: how it
+            computes the mesh's volume, centre and inertia; ``"shell"`` for open or flat
+            meshes), or ``None`` for MuJoCo's default (legacy).
     """
 
     name: str = ""
     file: str | None = None
     scale: Vec3 = (1.0, 1.0, 1.0)
+    inertia: str | None = None
 
 
 @dataclass(frozen=True)

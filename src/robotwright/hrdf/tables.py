@@ -137,6 +137,7 @@ MESH_COLUMNS: list[Column] = [
     *_geom_ext(),
     Column("file", "str", "file", required=False, default=None, empty_ok=True),
     Column("scale", "float", "scale", 3, required=False, default=(1.0, 1.0, 1.0)),
+    Column("inertia", "str", "inertia", required=False, default=None, empty_ok=True),
 ]
 
 SIMPLE_GEOM_COLUMNS: list[Column] = [

@@ -29,6 +29,7 @@ from robotwright.hrdf.model import (
     FRAME_OBJTYPES,
     HRDF,
     JOINT_TYPES,
+    MESH_INERTIA_MODES,
     SENSOR_OBJTYPES,
     SIMPLE_GEOM_TYPES,
     SITE_TYPES,
@@ -482,6 +483,15 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
         if m.scale != unit and any(not s > 0 for s in m.scale):
             out.append(
                 Problem("mesh.csv", f"scale {m.scale}: expected > 0", row=i, column="scale0")
+            )
+        if m.inertia is not None and m.inertia not in MESH_INERTIA_MODES:
+            out.append(
+                Problem(
+                    "mesh.csv",
+                    f"inertia {m.inertia!r}: expected one of {list(MESH_INERTIA_MODES)} or empty",
+                    row=i,
+                    column="inertia",
+                )
             )
         # A plain file listed in the robot's own meshes/ folder is inside and exists.
         if (

@@ -605,7 +605,6 @@ def _geoms(
                 unheld = [
                     attr
                     for attr, default in (
-                        ("inertia", mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY),
                         ("maxhullvert", -1),
                         ("smoothnormal", False),
                     )
@@ -636,9 +635,16 @@ def _geoms(
             pos = model.geom_pos[g] - inr.quat_to_mat(quat) @ model.mesh_pos[mid]
             owner, pos, quat = _reparent(model, b, pos, quat, frames)
             common["body"] = body_name(model, owner)
+            mode = m_spec.inertia.name.removeprefix("mjMESH_INERTIA_").lower()
             meshes.append(
                 MeshGeom(
-                    name=mname, file=rel, scale=_t3(m_spec.scale), pos=pos, quat=quat, **common
+                    name=mname,
+                    file=rel,
+                    scale=_t3(m_spec.scale),
+                    inertia=None if mode == "legacy" else mode,
+                    pos=pos,
+                    quat=quat,
+                    **common,
                 )
             )
         else:
