@@ -1,18 +1,33 @@
 """All-or-nothing file and folder writing: write to a temporary name, then rename.
 
-Readers never see a partial file, and a failed write (an exception, Ctrl-C) leaves
-neither the temporary nor a half-written target behind; an existing target is only
-replaced once the new content is complete. The temporary lives in the target's folder
-so that the final rename stays on one file system (``os.replace`` is atomic there).
+Readers never see a partial file, and a failed write (an exception, Ctrl-C, a full disk)
+leaves neither the temporary nor a half-written target nor a new empty folder behind; an
+existing target is only replaced once the new content is complete. The temporary lives
+in the target's folder so that the final rename stays on one file system
+(``os.replace`` is atomic there).
+
+Outputs made of several files (a model and its copied meshes) are written into a hidden
+staging folder next to them and moved into place only when all are complete
+(:func:`atomic_files`). A process killed outright (``kill -9``) cannot clean up: its
+temporaries carry its process id, and the next write into the same folder removes those
+of processes that no longer run.
+
+Outputs get the user's normal permissions (``0o666`` for files and ``0o777`` for folders,
+less the umask), not the private ``0o600``/``0o700`` of Python's temporary files.
+
+A write that fails for lack of space (or a read-only or quota-limited file system)
+raises :class:`~robotwright.errors.OutputPathError` naming the output, not the source.
 """
 
 from __future__ import annotations
 
+import errno
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import IO, Any
 
@@ -20,12 +35,22 @@ from robotwright.errors import OutputPathError
 
 __all__ = [
     "atomic_dir",
+    "atomic_files",
     "atomic_open",
     "atomic_path",
     "check_output_path",
     "copy_file_atomic",
     "write_text_atomic",
 ]
+
+#: errors of the output side of a write: no space, no quota, too big, read-only.
+WRITE_ERRNOS = frozenset(
+    {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS}
+    | ({errno.ENOTSUP} if hasattr(errno, "ENOTSUP") else set())
+)
+#: name of a temporary made here: ``.<target name>.<pid>.<8 random characters>[.tmp]``.
+_TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<pid>\d+)\.[a-z0-9_]{8}(\.tmp)?$")
+_STAGE = "rw-stage"
 
 
 def check_output_path(path: str | os.PathLike[str], *, folder: bool = False) -> None:
@@ -46,14 +71,100 @@ def check_output_path(path: str | os.PathLike[str], *, folder: bool = False) -> 
             break
 
 
-def _mkstemp(path: Path, **kw: Any) -> tuple[int, str]:
-    check_output_path(path)
+def write_error(path: str | os.PathLike[str], exc: OSError) -> OSError:
+    """``exc`` as an :class:`OutputPathError` naming ``path`` when it is an error of the
+    output side (:data:`WRITE_ERRNOS`), else ``exc`` itself."""
+    if isinstance(exc, OutputPathError) or exc.errno not in WRITE_ERRNOS:
+        return exc
+    return OutputPathError(f"{path}: cannot write it: {exc.strerror or exc}")
+
+
+def _umask() -> int:
+    """The process umask, read without changing it where the system tells it
+    (``os.umask`` can only be read by setting it, which races with other threads)."""
     try:
-        return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent, **kw)
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _running(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True  # another user's process, or no way to tell: leave its files alone
+    return True
+
+
+def remove_stale_temporaries(folder: str | os.PathLike[str], target: str) -> None:
+    """Remove the temporaries for ``target`` in ``folder`` left by killed processes."""
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return
+    for entry in entries:
+        match = _TEMP_NAME.match(entry.name)
+        if match is None or match["target"] != target or _running(int(match["pid"])):
+            continue
+        if entry.is_dir(follow_symlinks=False):
+            shutil.rmtree(entry.path, ignore_errors=True)
+        else:
+            with suppress(OSError):
+                os.unlink(entry.path)
+
+
+def _prefix(name: str) -> str:
+    return f".{name}.{os.getpid()}."
+
+
+def _make_parents(folder: Path) -> list[Path]:
+    """Create ``folder`` and its missing parents; return the ones created, deepest first."""
+    created: list[Path] = []
+    p = folder
+    while not p.exists():
+        created.append(p)
+        if p.parent == p:
+            break
+        p = p.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        _remove_empty(created)
+        raise OutputPathError(f"{folder}: cannot create the folder: {exc.strerror or exc}") from exc
+    return created
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    for p in folders:  # deepest first
+        try:
+            p.rmdir()
+        except OSError:
+            break
+
+
+def _mkstemp(path: Path) -> str:
+    check_output_path(path)
+    remove_stale_temporaries(path.parent, path.name)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=_prefix(path.name), suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        # mkstemp makes the file private (0600); the output is an ordinary file of the user.
+        os.chmod(tmp, 0o666 & ~_umask())
     except OSError as exc:
         raise OutputPathError(
             f"{path}: cannot write in folder {path.parent}: {exc.strerror or exc}"
         ) from exc
+    return tmp
 
 
 @contextmanager
@@ -61,18 +172,22 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield an empty temporary file next to ``path``; on success rename it onto ``path``.
 
     The caller writes the temporary by name (for writers that only take a path).
-    On any exception the temporary is removed and ``path`` is left as it was.
-    The folder of ``path`` must exist.
+    On any exception the temporary is removed and ``path`` is left as it was; a full
+    disk raises :class:`OutputPathError` naming ``path``. The folder of ``path`` must
+    exist.
     """
     path = Path(path)
-    fd, tmp = _mkstemp(path)
-    os.close(fd)
+    tmp = _mkstemp(path)
     try:
         yield Path(tmp)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            err = write_error(path, exc)
+            if err is not exc:
+                raise err from exc
         raise
 
 
@@ -88,11 +203,28 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
 
 
 def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`."""
+    """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`.
+    Folders it created are removed again when the write fails."""
     check_output_path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_open(path, "w") as fh:
-        fh.write(text)
+    created = _make_parents(path.parent)
+    try:
+        with atomic_open(path, "w") as fh:
+            fh.write(text)
+    except BaseException:
+        _remove_empty(created)
+        raise
+
+
+def _copy(src: Path, tmp: Path, dst: Path) -> None:
+    from robotwright._inputs import copy_regular_file
+
+    try:
+        copy_regular_file(src, tmp)
+    except OSError as exc:
+        err = write_error(dst, exc)
+        if err is not exc:
+            raise OutputPathError(f"{err} (copying {src})") from exc
+        raise
 
 
 def copy_file_atomic(src: Path, dst: Path) -> None:
@@ -101,12 +233,87 @@ def copy_file_atomic(src: Path, dst: Path) -> None:
     Only a regular file is copied: a FIFO or a device as ``src`` raises
     :class:`~robotwright.errors.InputFileError` before anything is read or written.
     """
-    from robotwright._inputs import copy_regular_file
-
     check_output_path(dst)
-    dst.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(dst) as tmp:
-        copy_regular_file(src, tmp)
+    created = _make_parents(dst.parent)
+    try:
+        with atomic_path(dst) as tmp:
+            _copy(src, tmp, dst)
+    except BaseException:
+        _remove_empty(created)
+        raise
+
+
+class StagedFiles:
+    """The files of one output, written under a staging folder, moved into place at once.
+
+    Use through :func:`atomic_files`. Paths are relative to the output folder.
+    """
+
+    def __init__(self, out_dir: Path, stage: Path) -> None:
+        self.out_dir = out_dir
+        self.stage = stage
+        self._files: list[str] = []
+
+    def path(self, rel: str | os.PathLike[str]) -> Path:
+        """The staging path to write for ``out_dir/rel`` (its folder is created)."""
+        rel_path = Path(rel)
+        if rel_path.is_absolute() or ".." in rel_path.parts:
+            raise ValueError(f"staged output path {rel!s} must stay inside {self.out_dir}")
+        target = self.stage / rel_path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        self._files.append(str(rel_path))
+        return target
+
+    def write_text(self, rel: str | os.PathLike[str], text: str) -> None:
+        """Stage ``text`` (UTF-8) as ``out_dir/rel``."""
+        staged = self.path(rel)
+        try:
+            staged.write_text(text, encoding="utf-8")
+        except OSError as exc:
+            raise write_error(self.out_dir / rel, exc) from exc
+
+    def copy(self, src: Path, rel: str | os.PathLike[str]) -> None:
+        """Stage a copy of the regular file ``src`` as ``out_dir/rel``."""
+        _copy(src, self.path(rel), self.out_dir / rel)
+
+    def _commit(self) -> None:
+        """Move every staged file onto its place, in the order staged (the caller stages
+        the file that names the others last, so it appears last)."""
+        for rel in dict.fromkeys(self._files):
+            dst = self.out_dir / rel
+            check_output_path(dst)
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(self.stage / rel, dst)
+
+
+@contextmanager
+def atomic_files(out_dir: str | os.PathLike[str]) -> Iterator[StagedFiles]:
+    """Write several files of ``out_dir`` all or nothing.
+
+    The block stages each file (``staged.write_text(rel, ...)``, ``staged.copy(src,
+    rel)``, or writes ``staged.path(rel)`` itself) in a hidden folder inside
+    ``out_dir``; when the block succeeds the files are renamed into place (existing
+    files of the same names are replaced, others are left alone). On any exception
+    nothing of ``out_dir`` changes, and folders created for it are removed.
+    """
+    out_dir = Path(out_dir)
+    check_output_path(out_dir, folder=True)
+    created = _make_parents(out_dir)
+    remove_stale_temporaries(out_dir, _STAGE)
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=_prefix(_STAGE), dir=out_dir))
+    except OSError as exc:
+        _remove_empty(created)
+        raise OutputPathError(f"{out_dir}: cannot write in it: {exc.strerror or exc}") from exc
+    staged = StagedFiles(out_dir, stage)
+    try:
+        yield staged
+        staged._commit()
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        _remove_empty(created)
+        raise
+    shutil.rmtree(stage, ignore_errors=True)
 
 
 @contextmanager
@@ -115,27 +322,37 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
 
     An existing ``target`` (file or folder) is replaced only after the block succeeded;
     callers decide beforehand whether replacing is allowed. On any exception the
-    temporary folder is removed and ``target`` is left as it was. Creates the parent folder.
+    temporary folder is removed and ``target`` is left as it was. Creates the parent
+    folder (removed again on failure when it was created here).
     """
     target = Path(target)
     check_output_path(target, folder=True)
+    created = _make_parents(target.parent)
+    remove_stale_temporaries(target.parent, target.name)
     try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=_prefix(target.name), dir=target.parent))
+        # mkdtemp makes the folder private (0700); the output is an ordinary folder.
+        tmp.chmod(0o777 & ~_umask())
     except OSError as exc:
+        _remove_empty(created)
         raise OutputPathError(
             f"{target}: cannot create a folder in {target.parent}: {exc.strerror or exc}"
         ) from exc
     try:
         yield tmp
-        if target.exists():
+        if target.exists() or target.is_symlink():
             # Move the old one aside first: os.replace cannot overwrite a non-empty folder.
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old.", dir=target.parent))
+            old = Path(tempfile.mkdtemp(prefix=_prefix(target.name), dir=target.parent))
             os.replace(target, old / "x")
             os.replace(tmp, target)
             shutil.rmtree(old, ignore_errors=True)
         else:
             os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
+        _remove_empty(created)
+        if isinstance(exc, OSError):
+            err = write_error(target, exc)
+            if err is not exc:
+                raise err from exc
         raise

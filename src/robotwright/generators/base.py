@@ -13,7 +13,7 @@ from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import Any
 
-from robotwright._atomic import copy_file_atomic, write_text_atomic
+from robotwright._atomic import atomic_files, check_output_path, write_text_atomic
 from robotwright.errors import GeneratorError
 from robotwright.generators.xmlfmt import to_xml_string
 
@@ -157,6 +157,8 @@ class GeneratorBase(ABC):
         if copy_meshes and file_path is None:
             raise GeneratorError("export(copy_meshes=True) needs a file_path to copy next to")
         path = Path(file_path).resolve() if file_path is not None else None
+        if path is not None:
+            check_output_path(path)  # before any work: a folder, or a file as a parent
         saved_dir, saved_copy = self.output_dir, self._mesh_copy
         try:
             if path is not None:
@@ -165,10 +167,15 @@ class GeneratorBase(ABC):
                 self._mesh_copy = _plan_mesh_copies(self.mesh_sources(), path.parent)
             self.generate(**kwargs)
             text = self.xml_str
-            if path is not None:
-                for src, dst in self._mesh_copy.items():
-                    if src != dst:
-                        copy_file_atomic(src, dst)
+            if path is not None and self._mesh_copy:
+                # All or nothing: the copies and the file are staged, then moved into place
+                # (the file last, so it never names a mesh that is not there yet).
+                with atomic_files(path.parent) as staged:
+                    for src, dst in self._mesh_copy.items():
+                        if src != dst:
+                            staged.copy(src, dst.relative_to(path.parent))
+                    staged.write_text(path.name, text)
+            elif path is not None:
                 write_text_atomic(path, text)
         finally:
             self.output_dir, self._mesh_copy = saved_dir, saved_copy

@@ -10,7 +10,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from robotwright._atomic import atomic_open, copy_file_atomic
+from robotwright._atomic import atomic_files, check_output_path
 from robotwright.errors import RobotwrightError
 from robotwright.things.attrs import Choice, Flag, Integer, Real, ThingAttributeError, Vector
 from robotwright.things.base import BaseThing
@@ -231,8 +231,8 @@ class World(BaseThing):
         Returns the written path.
         """
         path = Path(path)
+        check_output_path(path)  # before any work: a folder, or a file as a parent
         out_dir = path.parent
-        out_dir.mkdir(parents=True, exist_ok=True)
         copies: dict[str, str] = {}
 
         def path_for(file: str) -> str:
@@ -253,13 +253,14 @@ class World(BaseThing):
         for src in copies:
             if not os.path.isfile(src):
                 raise FileNotFoundError(f"{self._label()}: asset file {src!r} does not exist")
-        if copies:
-            (out_dir / "assets").mkdir(exist_ok=True)
+        # Compiled before anything is written: a model MuJoCo refuses leaves no output.
+        self.model  # noqa: B018 - compiles, or raises
+        # All or nothing: assets and file are staged, then moved into place (the file last,
+        # so an old file keeps loading until then). Regular files only are copied.
+        with atomic_files(out_dir) as staged:
             for src, rel in copies.items():
-                # Atomic, and regular files only (a FIFO or device is refused unread).
-                copy_file_atomic(Path(src), out_dir / "assets" / rel)
-        with atomic_open(path, "w") as fh:
-            fh.write(text)
+                staged.copy(Path(src), f"assets/{rel}")
+            staged.write_text(path.name, text)
         return path
 
     # ------------------------------------------------------------------ reading
