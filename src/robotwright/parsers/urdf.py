@@ -41,6 +41,8 @@ from robotwright.parsers.report import ParseResult, Reporter, warn_massless_movi
 from robotwright.parsers.xmlsafe import describe, parse_xml
 
 VISUAL_GROUP = 2
+#: Joints from a root link named "world" that stay on its child when the root is dropped.
+_WORLD_CHILD_JOINTS = ("revolute", "continuous", "prismatic")
 COLLISION_GROUP = 3
 _KNOWN_TOP = {"link", "joint", "material"}
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
@@ -621,6 +623,8 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     free_root = opt.floating_base
     free_name: str | None = None
     dropped_root: tuple[str, str] | None = None
+    # A root link named "world" is MuJoCo's world: its moving joint stays on the child.
+    root_joint: ET.Element | None = None
     r = data[root_name]
     # (With bound_mass the root is not massless: it stays, as in MuJoCo's importer.)
     if (
@@ -630,14 +634,22 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         and len(children[root_name]) == 1
     ):
         j = children[root_name][0]
-        if j.get("type") in ("fixed", "floating"):
+        moving_from_world = root_name == "world" and j.get("type") in _WORLD_CHILD_JOINTS
+        if j.get("type") in ("fixed", "floating") or moving_from_world:
             child = j.find("child").get("link")
             root_pose = _origin(j.find("origin"), rep, describe(j))
             if j.get("type") == "floating":
                 free_root, free_name = True, j.get("name")
+            if moving_from_world:
+                root_joint = j
+            kept = (
+                ", the joint kept on it (a root link named 'world' is MuJoCo's world)"
+                if moving_from_world
+                else ""
+            )
             rep.warn(
                 f"massless root link '{root_name}' dropped; '{child}' is the root, placed at "
-                f"the pose of {j.get('type')} joint '{j.get('name')}'",
+                f"the pose of {j.get('type')} joint '{j.get('name')}'{kept}",
                 describe(links[root_name]),
             )
             order.remove(root_name)
@@ -716,6 +728,8 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
             "geoms": list(d.geoms),
         }
         body_order.append(name)
+        if j is None and root_joint is not None:
+            j, jtype = root_joint, root_joint.get("type")
         if j is None:
             if free_root:
                 if free_name is None:
@@ -767,6 +781,8 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
                 rep.warn(f"geom name '{g.geom_name}' repeated: renamed '{new_name}'")
                 table[i] = _replace_name(g, new_name, "geom_name")
     extra = _mimic_extra(mimics, {j.name for j in hrdf_joints}, rep)
+    tables = (hrdf_bodies, hrdf_joints, geoms_mesh, geoms_simple, sites)
+    _rename_world_body(tables, {x.get("name") for x in links.values()}, rep)
     hrdf = HRDF(
         name=root.get("name") or path.stem,
         bodies=hrdf_bodies,
@@ -782,6 +798,26 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     warn_massless_moving(hrdf, rep, '<link name="{}">')
     warnings = rep.finish(strict)
     return ParseResult(hrdf, warnings, str(path))
+
+
+def _rename_world_body(tables: tuple[list, ...], taken: set[str], rep: Reporter) -> None:
+    """A link named ``world`` that stays a body (it has mass, geometry, a parent or
+    several children) is renamed: ``world`` is MuJoCo's world body, our MJCF would not
+    compile. Renamed in place in (bodies, joints, meshes, simple geoms, sites)."""
+    from dataclasses import replace
+
+    bodies, *others = tables
+    if not any(b.name == "world" for b in bodies):
+        return
+    new = "world_link"
+    while new in taken:
+        new += "_"
+    rep.warn(
+        f"link 'world' renamed '{new}' ('world' is MuJoCo's world body)", '<link name="world">'
+    )
+    bodies[:] = [replace(b, name=new) if b.name == "world" else b for b in bodies]
+    for table in others:
+        table[:] = [replace(x, body=new) if x.body == "world" else x for x in table]
 
 
 def _replace_name(g, name: str, field_name: str):
