@@ -9,10 +9,16 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import platform
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from importlib import metadata
+from typing import Any
 
+from robotwright import __version__
+from robotwright._notes import CaughtNotes, collect_notes, summary_line
 from robotwright._paths import trusted_asset_roots
+from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
 
 # Modules that expose ``register(subparsers: argparse._SubParsersAction) -> None``.
@@ -24,6 +30,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.grammar.cli",
     "robotwright.generators.cli",
     "robotwright.things.cli",
+    "robotwright.view.cli",
 )
 
 #: Commands that read robots from files: they take ``--asset-root DIR`` (see
@@ -36,17 +43,63 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "convert",
     "roundtrip",
     "things",
+    "view",
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with a close-name suggestion when a choice (a command, ``--format``,
+    ``--objective``, ...) is misspelt; subcommand parsers are of this class too."""
+
+    def _check_value(self, action: argparse.Action, value: Any) -> None:
+        if action.choices is not None and value not in action.choices:
+            choices = ", ".join(map(repr, action.choices))
+            hint = did_you_mean(str(value), map(str, action.choices))
+            raise argparse.ArgumentError(
+                action, f"invalid choice: {value!r} (choose from {choices}){hint}"
+            )
+
+
+def _version() -> str:
+    try:
+        mujoco = metadata.version("mujoco")
+    except metadata.PackageNotFoundError:
+        mujoco = "not installed"
+    return f"robotwright {__version__} (MuJoCo {mujoco}, Python {platform.python_version()})"
+
+
+def _all_parsers(parser: argparse.ArgumentParser) -> Iterator[argparse.ArgumentParser]:
+    """``parser`` and every subcommand parser below it (grammar's actions included)."""
+    yield parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in dict.fromkeys(action.choices.values()):
+                yield from _all_parsers(child)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    """The ``robotwright`` parser. Registering a command imports its ``cli`` module only:
+    MuJoCo, numpy and the like are imported when a command runs, so ``--help`` is quick."""
+    parser = _Parser(
         prog="robotwright",
         description="Describe, generate, compose and sense robots for simulation.",
+        epilog="Run 'robotwright COMMAND --help' for a command's options.",
     )
+    parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for module_name in _COMMAND_MODULES:
         importlib.import_module(module_name).register(sub)
+    for p in _all_parsers(parser):
+        p.add_argument(
+            "-v",
+            "--verbose",
+            action="store_true",
+            # Unset on subcommands unless given, so `robotwright -v export ...` and
+            # `robotwright export ... -v` both work.
+            default=False if p is parser else argparse.SUPPRESS,
+            help="list every conversion note (value or element not kept), not only the "
+            "summary line",
+        )
     for name in _ASSET_COMMANDS:
         sub.choices[name].add_argument(
             "--asset-root",
@@ -60,12 +113,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _report_notes(caught: CaughtNotes, verbose: bool) -> None:
+    """One summary line of the conversion notes on stderr (each note with ``-v``); other
+    libraries' warnings are shown once each."""
+    for message in dict.fromkeys(str(w.message) for w in caught.others):
+        print(f"warning: {message}", file=sys.stderr)
+    if not caught.notes:
+        return
+    if verbose:
+        for note in caught.notes:
+            print(f"note: {note.text}", file=sys.stderr)
+        print(summary_line(caught.notes, "listed above"), file=sys.stderr)
+    else:
+        print(summary_line(caught.notes, "-v lists each"), file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; returns its exit code (2 for bad input, with a one-line error)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with trusted_asset_roots(getattr(args, "asset_roots", None) or []):
-            return int(args.func(args) or 0)
+        roots = getattr(args, "asset_roots", None) or []
+        with trusted_asset_roots(roots), collect_notes() as caught:
+            code = int(args.func(args) or 0)
+        _report_notes(caught, bool(args.verbose))
+        return code
     except RobotwrightError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

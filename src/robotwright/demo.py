@@ -16,14 +16,15 @@ import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import mujoco
-
+from robotwright._notes import notes_of
 from robotwright.hrdf.cli import format_info
 from robotwright.hrdf.io import HRDFWarning
 from robotwright.hrdf.model import HRDF
-from robotwright.things import Body, Box, Cylinder, Free, World
+
+if TYPE_CHECKING:  # MuJoCo and Things load when the demo runs, not with `robotwright --help`
+    from robotwright.things import World
 
 DEFAULT_OUT = Path("robotwright_demo")
 
@@ -54,6 +55,8 @@ def step_hrdf(out: Path, ctx: dict[str, Any]) -> str:
 
 
 def step_export(out: Path, ctx: dict[str, Any]) -> str:
+    import mujoco
+
     from robotwright.generators.tasks import export_robot
 
     written = []
@@ -110,7 +113,10 @@ def step_limb(out: Path, ctx: dict[str, Any]) -> str:
 
 
 def step_scene(out: Path, ctx: dict[str, Any]) -> str:
+    import mujoco
+
     from robotwright.generators.tasks import compose_scene
+    from robotwright.things import World
 
     scene_dir = out / "scene"
     robots_xml = compose_scene(
@@ -162,6 +168,8 @@ DEMO_SEED = 3
 
 def furnish(world: World) -> World:
     """Add walls, boxes and furniture named so that each falls in one semantic class."""
+    from robotwright.things import Body, Box, Cylinder, Free
+
     wood, fabric, card = (0.55, 0.38, 0.22, 1.0), (0.25, 0.35, 0.6, 1.0), (0.85, 0.2, 0.15, 1.0)
     grey = (0.8, 0.8, 0.78, 1.0)
     for name, pos, size in (
@@ -231,8 +239,10 @@ def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             results[title] = step(out, ctx)
-        notes += [f"[{title}] {w.category.__name__}: {w.message}" for w in caught]
-        note = f", {len(caught)} conversion note(s)" if caught else ""
+        # One note per value or element, the unit the notes file lists (one per line).
+        step_notes = [f"[{title}] {n.text}" for w in caught for n in notes_of(str(w.message))]
+        notes += step_notes
+        note = f", {len(step_notes)} conversion note(s)" if step_notes else ""
         print(f"      {results[title]} ({time.perf_counter() - t0:.1f} s{note})", flush=True)
     (out / "summary.json").write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
     (out / "conversion_notes.txt").write_text("\n".join(notes) + "\n", encoding="utf-8")

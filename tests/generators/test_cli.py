@@ -56,11 +56,16 @@ def test_parse_robot_spec():
     assert key is None and robot == "/some/path" and p.yaw == 0.5 and p.pos == (0, 0, 1)
 
 
-def test_export_prints_conversion_notes_as_warnings(tmp_path, capsys):
+def test_export_prints_one_notes_summary_and_each_note_with_v(tmp_path, capsys):
     assert main(["export", "arm6", "--format", "urdf", "-o", str(tmp_path / "a.urdf")]) == 0
-    err = capsys.readouterr().err
-    assert err.startswith("warning: robot 'arm6' to URDF:")
-    assert "capsule" in err
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "conversion note(s)" in err[0] and "-v lists each" in err[0]
+    count = int(err[0].split()[0])
+    assert main(["export", "arm6", "-o", str(tmp_path / "b.urdf"), "-v"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    notes = [line for line in err if line.startswith("note: robot 'arm6' to URDF:")]
+    assert len(notes) == count and any("capsule" in line for line in notes)
+    assert err[-1].startswith(f"{count} conversion note(s)")
 
 
 @pytest.mark.parametrize("command", ["export", "compose"])
@@ -80,7 +85,8 @@ def test_output_that_is_a_folder_or_under_a_file_is_a_clear_error(tmp_path, caps
     [
         (["export", "arm6", "-o", "OUT/a.txt"], "expected a file name ending in .xml or .mjcf"),
         (["export", "arm6", "--format", "urdf", "-o", "OUT/a.sdf"], "ending in .urdf or .xml"),
-        (["compose", "arm6", "-o", "OUT/scene"], "got '(none)'"),
+        (["compose", "arm6", "-o", "OUT/scene"], "cannot tell the format from '(no extension)'"),
+        (["compose", "arm6", "--format", "mjcf", "-o", "OUT/scene"], "got '(none)'"),
     ],
 )
 def test_wrong_output_extension_is_refused(tmp_path, capsys, argv, expected):

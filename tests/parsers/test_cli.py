@@ -13,9 +13,13 @@ from robotwright.parsers.convert import convert
 
 def test_convert_mjcf_to_hrdf_to_urdf_and_mjcf(probe: Path, tmp_path: Path, capsys) -> None:
     folder = tmp_path / "out_hrdf"
-    assert main(["convert", str(probe), "-o", str(folder)]) == 0
-    out = capsys.readouterr().out
-    assert "warning:" in out and "worldbody" in out and f"wrote {folder}" in out
+    assert main(["convert", str(probe), "-o", str(folder), "-v"]) == 0
+    captured = capsys.readouterr()
+    assert f"wrote {folder}" in captured.out
+    # The losses go to stderr: each note with -v, then the summary line counting them.
+    notes = [line for line in captured.err.splitlines() if line.startswith("note: ")]
+    assert any("worldbody" in line for line in notes)
+    assert captured.err.splitlines()[-1].startswith(f"{len(notes)} conversion note(s)")
     assert (folder / "body.csv").is_file() and any((folder / "meshes").iterdir())
     xml = tmp_path / "again.xml"
     assert main(["convert", str(folder), "-o", str(xml)]) == 0
@@ -35,7 +39,7 @@ def test_convert_refuses_to_overwrite_and_unknown_types(
     out.write_text("keep me")
     # A clean exit 2 naming the file and the flag, not a FileExistsError traceback.
     assert main(["convert", str(probe), "-o", str(out)]) == 2
-    assert f"{out} exists (pass overwrite=True / --overwrite)" in capsys.readouterr().err
+    assert f"{out}: exists; not replacing it (give --overwrite" in capsys.readouterr().err
     with pytest.raises(FileExistsError):  # the library call still raises a FileExistsError
         convert(probe, out)
     assert out.read_text() == "keep me"

@@ -4,16 +4,13 @@ from __future__ import annotations
 
 import argparse
 import re
-import sys
-import warnings
-from collections.abc import Callable
 from pathlib import Path
 
+from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import GeneratorError
-from robotwright.generators.mjcf import MJCFHumanoidGenerator
 from robotwright.generators.placement import Placement
-from robotwright.generators.tasks import compose_scene, load_robot
-from robotwright.generators.urdf import URDFHumanoidGenerator
+
+_FORMAT_HELP = "mjcf or urdf (default: from the -o file name: .urdf is URDF, .xml or .mjcf is MJCF)"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,17 +20,29 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Write a robot (bundled name or HRDF folder) as MJCF or URDF. Mesh "
         "paths are written relative to the output file, so it loads as is.",
     )
-    p.add_argument("robot", help="robot name or HRDF folder")
-    p.add_argument("--format", choices=("mjcf", "urdf"), default="mjcf")
-    p.add_argument("--prefix", default=None, help="MJCF: prefix every name with P_")
+    p.add_argument("robot", help="bundled robot name (arm6, mini_humanoid) or HRDF folder")
+    p.add_argument("--format", choices=("mjcf", "urdf"), default=None, help=_FORMAT_HELP)
+    p.add_argument(
+        "--prefix",
+        default=None,
+        metavar="P",
+        help="MJCF: prefix every name with P_ (default: none)",
+    )
     p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")
     p.add_argument(
         "--no-mujoco-tag", action="store_true", help="URDF: leave out the <mujoco> block"
     )
-    p.add_argument("--copy-meshes", action="store_true", help="copy meshes next to the output file")
-    p.add_argument("--strict", action="store_true", help="fail instead of warning on losses")
-    p.add_argument("-o", "--output", required=True, help="output file")
-    p.set_defaults(func=_printing_warnings(_export_quiet))
+    p.add_argument(
+        "--copy-meshes",
+        action="store_true",
+        help="copy meshes into meshes/ next to the output file (default: point at the robot's)",
+    )
+    p.add_argument(
+        "--strict", action="store_true", help="fail instead of writing when a value is lost"
+    )
+    p.add_argument("-o", "--output", required=True, help="output file (.xml, .mjcf or .urdf)")
+    add_overwrite_flag(p)
+    p.set_defaults(func=_export)
 
     p = sub.add_parser(
         "compose",
@@ -41,46 +50,61 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Compose robots into one MJCF (or URDF) scene. Each ROBOT is "
         "[KEY=]NAME_OR_PATH[@x,y,z[,yaw]] (metres, radians); names are prefixed with "
         "KEY (default: the robot name, numbered when repeated).",
+        epilog="Example: robotwright compose h=mini_humanoid arm=arm6@1.2,0.8,0,3.1416 "
+        "-o scene.xml",
     )
-    p.add_argument("robots", nargs="+", metavar="ROBOT")
-    p.add_argument("--format", choices=("mjcf", "urdf"), default="mjcf")
+    p.add_argument(
+        "robots",
+        nargs="+",
+        metavar="ROBOT",
+        help="[KEY=]NAME_OR_PATH[@x,y,z[,yaw]]: a bundled robot name or HRDF folder, "
+        "optionally keyed and placed at x, y, z [m] turned by yaw [rad] about z "
+        "(default: robots side by side)",
+    )
+    p.add_argument("--format", choices=("mjcf", "urdf"), default=None, help=_FORMAT_HELP)
     p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")
-    p.add_argument("--copy-meshes", action="store_true", help="copy meshes next to the output file")
-    p.add_argument("-o", "--output", required=True, help="output scene file")
-    p.set_defaults(func=_printing_warnings(_compose_quiet))
+    p.add_argument(
+        "--copy-meshes",
+        action="store_true",
+        help="copy meshes into meshes/ next to the output file (default: point at the robots')",
+    )
+    p.add_argument("-o", "--output", required=True, help="output scene file (.xml or .urdf)")
+    add_overwrite_flag(p)
+    p.set_defaults(func=_compose)
 
 
 #: File name endings accepted per output format (URDF is often saved as .xml too).
 _EXTENSIONS = {"mjcf": (".xml", ".mjcf"), "urdf": (".urdf", ".xml")}
 
 
-def _check_extension(output: str, fmt: str) -> None:
+def output_format(output: str, fmt: str | None) -> str:
+    """The output format: ``fmt`` when given (checked against the file name), else the
+    one the file name's extension says (.urdf: URDF; .xml, .mjcf: MJCF)."""
     suffix = Path(output).suffix.lower()
+    if fmt is None:
+        if suffix == ".urdf":
+            return "urdf"
+        if suffix in (".xml", ".mjcf"):
+            return "mjcf"
+        raise GeneratorError(
+            f"{output}: cannot tell the format from '{suffix or '(no extension)'}': "
+            "expected a file name ending in .xml or .mjcf (MJCF) or .urdf (URDF), or --format"
+        )
     if suffix not in _EXTENSIONS[fmt]:
         raise GeneratorError(
             f"{output}: expected a file name ending in {' or '.join(_EXTENSIONS[fmt])} "
             f"for --format {fmt}, got '{suffix or '(none)'}'"
         )
+    return fmt
 
 
-def _printing_warnings(
-    run: Callable[[argparse.Namespace], int],
-) -> Callable[[argparse.Namespace], int]:
-    """``run`` with the conversion warnings it raises printed to stderr, once each."""
+def _export(args: argparse.Namespace) -> int:
+    from robotwright.generators.mjcf import MJCFHumanoidGenerator
+    from robotwright.generators.tasks import load_robot
+    from robotwright.generators.urdf import URDFHumanoidGenerator
 
-    def wrapped(args: argparse.Namespace) -> int:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            code = run(args)
-        for w in caught:
-            print(f"warning: {w.message}", file=sys.stderr)
-        return code
-
-    return wrapped
-
-
-def _export_quiet(args: argparse.Namespace) -> int:
-    _check_extension(args.output, args.format)
+    args.format = output_format(args.output, args.format)
+    check_overwrite(args.output, args.overwrite)
     hrdf = load_robot(args.robot)
     out = Path(args.output)
     if args.format == "mjcf":
@@ -119,8 +143,11 @@ def parse_robot_spec(spec: str) -> tuple[str | None, str, Placement | None]:
     return key, spec, placement
 
 
-def _compose_quiet(args: argparse.Namespace) -> int:
-    _check_extension(args.output, args.format)
+def _compose(args: argparse.Namespace) -> int:
+    from robotwright.generators.tasks import compose_scene, load_robot
+
+    args.format = output_format(args.output, args.format)
+    check_overwrite(args.output, args.overwrite)
     robots: list[tuple[str, object]] = []
     placements: dict[str, Placement] = {}
     used: dict[str, int] = {}

@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from robotwright._suggest import did_you_mean
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.mjcf_base import MJCFGeneratorBase, name_clashes
 from robotwright.generators.placement import Placement, compose, composite_members, qrot
@@ -362,8 +363,16 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
                     if site.get("name") == name:
                         pos, quat = _pose(site)
                         return body, pos, quat
+        known = []
+        if parent.worldbody is not None:
+            known = [
+                e.get("name", "") for e in parent.worldbody.iter() if e.tag in ("body", "site")
+            ]
+            # Users name frames without the robot's prefix (see prefixed()).
+            known = [n.removeprefix(f"{parent.prefix}_") if parent.prefix else n for n in known]
         raise GeneratorError(
             f"robot '{parent.key}' has no site or body named '{frame}' to attach at"
+            + did_you_mean(frame, known)
         )
 
     def _merge_keyframes(self, robots: list[_Robot]) -> None:

@@ -18,15 +18,19 @@ Quick use::
 from __future__ import annotations
 
 import random
+from typing import TYPE_CHECKING
 
-from robotwright.grammar.build import Limb, build, build_hrdf
-from robotwright.grammar.derive import count, count_by_links, enumerate_designs, replay, sample
-from robotwright.grammar.design import Design, to_dot
-from robotwright.grammar.dh import DHRow, fk
-from robotwright.grammar.loader import default_grammar, load_grammar, load_library
-from robotwright.grammar.mount import mount_on
-from robotwright.grammar.rules import Grammar
-from robotwright.hrdf.model import HRDF
+from robotwright._lazy import attach
+
+if TYPE_CHECKING:
+    from robotwright.grammar.build import Limb, build, build_hrdf
+    from robotwright.grammar.derive import count, count_by_links, enumerate_designs, replay, sample
+    from robotwright.grammar.design import Design, to_dot
+    from robotwright.grammar.dh import DHRow, fk
+    from robotwright.grammar.loader import default_grammar, load_grammar, load_library
+    from robotwright.grammar.mount import mount_on
+    from robotwright.grammar.rules import Grammar
+    from robotwright.hrdf.model import HRDF
 
 __all__ = [
     "DHRow",
@@ -50,10 +54,14 @@ __all__ = [
     "to_dot",
 ]
 
+attach(__name__, __file__)
+
 
 def demo_limb_design(seed: int = 0, max_links: int = 3) -> Design:
     """A design drawn uniformly with ``random.Random(seed)`` from the bundled grammar,
     redrawn until it has no self-collision at the zero pose (deterministic per seed)."""
+    from robotwright.grammar.derive import sample
+    from robotwright.grammar.loader import default_grammar
     from robotwright.grammar.objectives import EvalContext, NoSelfCollision
 
     g = default_grammar()
@@ -68,4 +76,7 @@ def demo_limb_design(seed: int = 0, max_links: int = 3) -> Design:
 
 def demo_limb(seed: int = 0, max_links: int = 3, name: str = "srl") -> HRDF:
     """A grammar-generated limb as an HRDF robot (fixed base at its mount frame)."""
+    from robotwright.grammar.build import build_hrdf
+    from robotwright.grammar.loader import default_grammar
+
     return build_hrdf(default_grammar(), demo_limb_design(seed, max_links), name=name)

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from robotwright._rotations import compose_pose
+from robotwright._suggest import did_you_mean
 from robotwright.errors import GrammarError, Problem
 from robotwright.hrdf.model import HRDF
 
@@ -61,7 +62,8 @@ def mount_on(
             [
                 Problem(
                     robot.name,
-                    f"no body or site named {at!r} to mount on (bodies: {sorted(body_names)[:12]}..., sites: {[s.name for s in robot.sites]})",
+                    f"no body or site named {at!r} to mount on (bodies: {sorted(body_names)[:12]}..., sites: {[s.name for s in robot.sites]})"
+                    + did_you_mean(at, [*body_names, *(s.name for s in robot.sites)]),
                 )
             ]
         )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
 
 #: Folder of the robots shipped with robotwright.
@@ -40,8 +41,12 @@ def find_robot(name: str) -> Path:
         tried.append(str(candidate))
         if (candidate / "meta.yaml").is_file():
             return candidate
+    known = bundled_robot_names() + [
+        p.name for root in search_roots() if root.is_dir() for p in root.iterdir() if p.is_dir()
+    ]
     raise RobotNotFoundError(
         f"no robot named '{name}': looked in {tried}; bundled robots: {bundled_robot_names()}"
+        + did_you_mean(name, known)
     )
 
 

@@ -926,7 +926,9 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
             (tmp / EXTRA_MJCF_FILE).write_text(hrdf.mjcf_extra, encoding="utf-8")
 
     if target.exists() and not overwrite:
-        raise OutputExistsError(f"{target} exists (pass overwrite=True to replace it)")
+        raise OutputExistsError(
+            f"{target} exists (replace it with overwrite=True, on the command line --overwrite)"
+        )
     with atomic_dir(target) as tmp:
         fill(tmp)
     return target

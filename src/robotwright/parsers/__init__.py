@@ -5,14 +5,19 @@
 >>> robot, warnings = urdf_to_hrdf_with_warnings("panda.urdf")  # ParseResult
 """
 
-from robotwright.parsers.api import (
-    mjcf_to_hrdf,
-    mjcf_to_hrdf_with_warnings,
-    urdf_to_hrdf,
-    urdf_to_hrdf_with_warnings,
-)
-from robotwright.parsers.report import ParseResult
-from robotwright.parsers.urdf import URDFOptions
+from typing import TYPE_CHECKING
+
+from robotwright._lazy import attach
+
+if TYPE_CHECKING:
+    from robotwright.parsers.api import (
+        mjcf_to_hrdf,
+        mjcf_to_hrdf_with_warnings,
+        urdf_to_hrdf,
+        urdf_to_hrdf_with_warnings,
+    )
+    from robotwright.parsers.report import ParseResult
+    from robotwright.parsers.urdf import URDFOptions
 
 __all__ = [
     "ParseResult",
@@ -22,3 +27,5 @@ __all__ = [
     "urdf_to_hrdf",
     "urdf_to_hrdf_with_warnings",
 ]
+
+attach(__name__, __file__)

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import argparse
 import logging
+import warnings
+from pathlib import Path
+
+from robotwright._outputs import add_overwrite_flag, check_overwrite
+from robotwright.errors import ConversionWarning
 
 
 def _options(args: argparse.Namespace) -> dict:
@@ -20,7 +25,30 @@ def _options(args: argparse.Namespace) -> dict:
     for name in ("balance_inertia", "join_obj_objects"):
         if getattr(args, name, False):
             opts[name] = True
+    if getattr(args, "actuators", None):
+        opts["actuators"] = args.actuators
     return opts
+
+
+def _source_args(p: argparse.ArgumentParser) -> None:
+    """Options of the parsers (URDF/MJCF source -> HRDF), shared by convert and roundtrip."""
+    p.add_argument(
+        "--fixed-joints",
+        choices=("keep", "merge", "site"),
+        help="URDF sources: a link on a fixed joint stays a body (keep, the default), is "
+        "merged into its parent (merge), or becomes a site when massless (site)",
+    )
+    p.add_argument(
+        "--actuators",
+        choices=("none", "motor"),
+        help="URDF sources: none (default; URDF has no actuators) or one torque motor per "
+        "moving joint with an effort limit (peak torque = effort)",
+    )
+    p.add_argument(
+        "--root-body",
+        metavar="NAME",
+        help="MJCF sources: the top-level body that is the robot (when the world holds several)",
+    )
 
 
 def _repair_args(p: argparse.ArgumentParser) -> None:
@@ -29,9 +57,20 @@ def _repair_args(p: argparse.ArgumentParser) -> None:
         choices=("keep", "site"),
         help="MJCF: turn massless leaf frame bodies into sites",
     )
-    p.add_argument("--balance-inertia", action="store_true", help="URDF: MuJoCo's balanceinertia")
-    p.add_argument("--bound-mass", type=float, help="URDF: raise masses below this (kg)")
-    p.add_argument("--bound-inertia", type=float, help="URDF: raise moments below this (kg m^2)")
+    p.add_argument(
+        "--balance-inertia",
+        action="store_true",
+        help="URDF: repair principal moments that break A + B >= C, as MuJoCo's balanceinertia",
+    )
+    p.add_argument(
+        "--bound-mass", type=float, metavar="KG", help="URDF: raise masses below KG to KG"
+    )
+    p.add_argument(
+        "--bound-inertia",
+        type=float,
+        metavar="KG_M2",
+        help="URDF: raise principal moments below KG_M2 [kg m^2] to it",
+    )
     p.add_argument(
         "--join-obj-objects",
         action="store_true",
@@ -47,11 +86,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "MJCF) or is an HRDF folder. Every dropped or approximated element is printed.",
     )
     p.add_argument("src", help="source .urdf, .xml (MJCF) or HRDF folder")
-    p.add_argument("-o", "--output", required=True, help="output .urdf, .xml or folder")
-    p.add_argument("--fixed-joints", choices=("keep", "merge", "site"), help="URDF sources")
-    p.add_argument("--root-body", help="MJCF sources: the top-level body that is the robot")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="output .urdf (URDF), .xml (MJCF) or folder (HRDF); meshes are copied next to it",
+    )
+    _source_args(p)
     p.add_argument("--strict", action="store_true", help="fail instead of dropping anything")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing output")
+    add_overwrite_flag(p)
     _repair_args(p)
     p.set_defaults(func=_convert)
 
@@ -62,11 +105,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "compare the compiled models with the source compiled by MuJoCo (or yourdfpy): "
         "masses, inertias, joints, actuators, sites, sensors and forward kinematics.",
     )
-    p.add_argument("source")
-    p.add_argument("--configs", type=int, default=50, help="random configurations for FK")
-    p.add_argument("--fixed-joints", choices=("keep", "merge", "site"), help="URDF sources")
-    p.add_argument("--root-body", help="MJCF sources: the top-level body that is the robot")
-    p.add_argument("--show-warnings", action="store_true", help="list the parse warnings")
+    p.add_argument("source", help="robot file to check: .urdf or MJCF .xml")
+    p.add_argument(
+        "--configs",
+        type=int,
+        default=50,
+        help="random joint configurations compared in forward kinematics (default 50)",
+    )
+    _source_args(p)
+    p.add_argument(
+        "--show-warnings", action="store_true", help="list the parse warnings (as -v does)"
+    )
     p.add_argument(
         "--reference",
         choices=("auto", "mujoco", "yourdfpy"),
@@ -81,12 +130,16 @@ def _convert(args: argparse.Namespace) -> int:
     from robotwright.parsers.convert import convert
 
     logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
+    check_overwrite(args.output, args.overwrite)
+    # An existing empty folder holds nothing to lose: the rule lets it be written into.
+    overwrite = args.overwrite or Path(args.output).is_dir()
     messages = convert(
-        args.src, args.output, strict=args.strict, overwrite=args.overwrite, **_options(args)
+        args.src, args.output, strict=args.strict, overwrite=overwrite, **_options(args)
     )
+    # Reported like every command's losses: one summary line, each with -v.
     for m in messages:
-        print(f"warning: {m}")
-    print(f"wrote {args.output} ({len(messages)} warning(s))")
+        warnings.warn(m, ConversionWarning, stacklevel=1)
+    print(f"wrote {args.output}")
     return 0
 
 
@@ -98,7 +151,7 @@ def _roundtrip(args: argparse.Namespace) -> int:
         args.source, configs=args.configs, reference=args.reference, **_options(args)
     )
     print(report.table())
-    if args.show_warnings:
+    if args.show_warnings or args.verbose:
         for w in report.warnings:
             print(f"warning: {w}")
     return 0 if report.ok else 1

@@ -373,7 +373,7 @@ def _select_robot(
                 Problem(
                     str(path),
                     f"the world holds {len(top)} top-level bodies {names}: an HRDF is one "
-                    "robot; pass root_body=<name>",
+                    "robot; choose one with root_body=<name> (command line: --root-body NAME)",
                 )
             ]
         )

@@ -753,8 +753,8 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     if dropped_limits:
         rep.warn(
             f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept (HRDF joints "
-            "carry no force limit; pass actuators='motor' to keep them as motors): "
-            + ", ".join(dropped_limits)
+            "carry no force limit; keep them as motors with actuators='motor', "
+            "on the command line --actuators motor): " + ", ".join(dropped_limits)
         )
 
     hrdf_bodies: list[Body] = []

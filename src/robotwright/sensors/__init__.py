@@ -7,27 +7,36 @@
 >>> sensor.get_distances(), sensor.get_pointcloud(), sensor.get_semantic_labels()
 """
 
-from robotwright.sensors.config import DEFAULT_SEMANTIC_CLASS_MAPPING, LidarCfg, SemanticLidarCfg
-from robotwright.sensors.lidar import LidarSensor, LidarSensorData, geom_paths
-from robotwright.sensors.patterns import (
-    PATTERN_NAMES,
-    FilePatternCfg,
-    GridPatternCfg,
-    LivoxPatternCfg,
-    PatternCfg,
-    PinholeCameraPatternCfg,
-    RayTable,
-    SpinningLidarPatternCfg,
-    pattern_from_name,
-)
-from robotwright.sensors.raycast import warp_available
-from robotwright.sensors.scan import scan_to_files
-from robotwright.sensors.semantic import (
-    SemanticLidarData,
-    SemanticLidarSensor,
-    classify_path,
-    geom_class_table,
-)
+from typing import TYPE_CHECKING
+
+from robotwright._lazy import attach
+
+if TYPE_CHECKING:
+    from robotwright.sensors.config import (
+        DEFAULT_SEMANTIC_CLASS_MAPPING,
+        LidarCfg,
+        SemanticLidarCfg,
+    )
+    from robotwright.sensors.lidar import LidarSensor, LidarSensorData, geom_paths
+    from robotwright.sensors.patterns import (
+        PATTERN_NAMES,
+        FilePatternCfg,
+        GridPatternCfg,
+        LivoxPatternCfg,
+        PatternCfg,
+        PinholeCameraPatternCfg,
+        RayTable,
+        SpinningLidarPatternCfg,
+        pattern_from_name,
+    )
+    from robotwright.sensors.raycast import warp_available
+    from robotwright.sensors.scan import scan_to_files
+    from robotwright.sensors.semantic import (
+        SemanticLidarData,
+        SemanticLidarSensor,
+        classify_path,
+        geom_class_table,
+    )
 
 __all__ = [
     "DEFAULT_SEMANTIC_CLASS_MAPPING",
@@ -52,3 +61,5 @@ __all__ = [
     "scan_to_files",
     "warp_available",
 ]
+
+attach(__name__, __file__)

@@ -6,13 +6,9 @@ import argparse
 import json
 from pathlib import Path
 
-import mujoco
-
 from robotwright._atomic import check_output_path
 from robotwright.errors import ConversionError, SensorError
-from robotwright.parsers.xmlsafe import parse_xml
-from robotwright.sensors.patterns import PATTERN_NAMES
-from robotwright.sensors.scan import scan_to_files
+from robotwright.sensors._names import PATTERN_NAMES
 
 __all__ = ["register", "run"]
 
@@ -64,6 +60,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import mujoco
+
+    from robotwright.parsers.xmlsafe import parse_xml
+    from robotwright.sensors.scan import scan_to_files
+
     if args.output is None and args.png is None:
         raise SensorError("nothing to write: give -o SCAN.npz and/or --png SCAN.png")
     if not args.scene.is_file():

@@ -18,7 +18,6 @@ numpy copies, zero-copy torch tensors or warp arrays (``cfg.output``).
 
 from __future__ import annotations
 
-import difflib
 import fnmatch
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -27,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
+from robotwright._suggest import did_you_mean
 from robotwright.errors import SensorError
 from robotwright.sensors.config import LidarCfg
 from robotwright.sensors.device import RangeModel, WarpLidarPipeline
@@ -342,8 +342,7 @@ class LidarSensor:
         for candidate in prim_path_candidates(name):
             if candidate.lower() in lowered:
                 return self._resolve_carrier(lowered[candidate.lower()])
-        close = difflib.get_close_matches(name, [n for n in names if n], n=3)
-        hint = f"; did you mean {', '.join(map(repr, close))}?" if close else ""
+        hint = did_you_mean(name, names)
         raise SensorError(
             f"{type(self.cfg).__name__}.prim_path: no body or site named {name!r} in the model{hint}"
         )

@@ -26,6 +26,7 @@ from typing import ClassVar, Literal
 import numpy as np
 
 from robotwright.errors import SensorError
+from robotwright.sensors._names import PATTERN_NAMES
 
 __all__ = [
     "PatternCfg",
@@ -535,10 +536,6 @@ def _read_angle_table(path: Path) -> np.ndarray:
             )
         rows.append(values)
     return np.asarray(rows, dtype=np.float64).reshape(-1, 2)
-
-
-#: Names accepted by :func:`pattern_from_name` (and the CLI's ``--pattern``).
-PATTERN_NAMES: tuple[str, ...] = ("mid360", "avia", "vlp16", "vlp32", "os128", "grid", "pinhole")
 
 
 def pattern_from_name(name: str) -> PatternCfg:

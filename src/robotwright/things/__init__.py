@@ -16,61 +16,66 @@ deterministically, write compact MJCF and compile through ``mujoco.MjSpec``::
     print(hinge.qpos, arm.xpos)
 """
 
-from robotwright.things.actuators import Actuator, General, Motor, Position, Velocity
-from robotwright.things.assets import Material, Texture
-from robotwright.things.attrs import ThingAttributeError
-from robotwright.things.base import BaseThing, ThingType
-from robotwright.things.body import Body
-from robotwright.things.cameras import Camera
-from robotwright.things.geoms import (
-    Box,
-    Capsule,
-    Cylinder,
-    Ellipsoid,
-    Geom,
-    HField,
-    Mesh,
-    Plane,
-    Sphere,
-)
-from robotwright.things.hrdf_bridge import hrdf_to_body, hrdf_to_world, things_to_hrdf
-from robotwright.things.joints import Ball, Free, Hinge, Joint, Slide
-from robotwright.things.lights import Light
-from robotwright.things.registry import REGISTRY
-from robotwright.things.sensors import (
-    Accelerometer,
-    ActuatorFrc,
-    ActuatorPos,
-    ActuatorVel,
-    BallAngVel,
-    BallQuat,
-    Force,
-    FrameAngAcc,
-    FrameAngVel,
-    FrameLinAcc,
-    FrameLinVel,
-    FramePos,
-    FrameQuat,
-    FrameSensor,
-    FrameXAxis,
-    FrameYAxis,
-    FrameZAxis,
-    Gyro,
-    JointActuatorFrc,
-    JointPos,
-    JointVel,
-    Magnetometer,
-    Rangefinder,
-    Sensor,
-    SubtreeAngMom,
-    SubtreeCom,
-    SubtreeLinVel,
-    Torque,
-    Touch,
-    Velocimeter,
-)
-from robotwright.things.sites import Site
-from robotwright.things.world import World
+from typing import TYPE_CHECKING
+
+from robotwright._lazy import attach
+
+if TYPE_CHECKING:
+    from robotwright.things.actuators import Actuator, General, Motor, Position, Velocity
+    from robotwright.things.assets import Material, MeshAsset, Texture
+    from robotwright.things.attrs import ThingAttributeError
+    from robotwright.things.base import BaseThing, ThingType
+    from robotwright.things.body import Body
+    from robotwright.things.cameras import Camera
+    from robotwright.things.geoms import (
+        Box,
+        Capsule,
+        Cylinder,
+        Ellipsoid,
+        Geom,
+        HField,
+        Mesh,
+        Plane,
+        Sphere,
+    )
+    from robotwright.things.hrdf_bridge import hrdf_to_body, hrdf_to_world, things_to_hrdf
+    from robotwright.things.joints import Ball, Free, Hinge, Joint, Slide
+    from robotwright.things.lights import Light
+    from robotwright.things.registry import REGISTRY
+    from robotwright.things.sensors import (
+        Accelerometer,
+        ActuatorFrc,
+        ActuatorPos,
+        ActuatorVel,
+        BallAngVel,
+        BallQuat,
+        Force,
+        FrameAngAcc,
+        FrameAngVel,
+        FrameLinAcc,
+        FrameLinVel,
+        FramePos,
+        FrameQuat,
+        FrameSensor,
+        FrameXAxis,
+        FrameYAxis,
+        FrameZAxis,
+        Gyro,
+        JointActuatorFrc,
+        JointPos,
+        JointVel,
+        Magnetometer,
+        Rangefinder,
+        Sensor,
+        SubtreeAngMom,
+        SubtreeCom,
+        SubtreeLinVel,
+        Torque,
+        Touch,
+        Velocimeter,
+    )
+    from robotwright.things.sites import Site
+    from robotwright.things.world import World
 
 __all__ = [
     "REGISTRY",
@@ -114,6 +119,7 @@ __all__ = [
     "Magnetometer",
     "Material",
     "Mesh",
+    "MeshAsset",
     "Motor",
     "Plane",
     "Position",
@@ -137,3 +143,5 @@ __all__ = [
     "hrdf_to_world",
     "things_to_hrdf",
 ]
+
+attach(__name__, __file__)

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import warnings
 from pathlib import Path
+
+from robotwright._outputs import add_overwrite_flag, check_overwrite
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -16,9 +17,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "next to it) or as an HRDF folder. Anything that cannot be represented is named in "
         "a warning (an error with --strict).",
     )
-    p.add_argument("source", help="MJCF file (.xml) or HRDF folder")
+    p.add_argument(
+        "source", help="MJCF file (.xml), HRDF folder or bundled robot name (arm6, mini_humanoid)"
+    )
     p.add_argument("output", help="output .xml file (MJCF) or folder (HRDF)")
-    p.add_argument("--strict", action="store_true", help="fail instead of warning on losses")
+    p.add_argument(
+        "--strict", action="store_true", help="fail instead of writing when a value is lost"
+    )
+    add_overwrite_flag(p)
     p.set_defaults(func=_run)
 
 
@@ -26,6 +32,7 @@ def _run(args: argparse.Namespace) -> int:
     from robotwright._atomic import check_output_path
     from robotwright.errors import OutputPathError
     from robotwright.hrdf import HRDF
+    from robotwright.hrdf.assets import resolve_robot
     from robotwright.things import World, hrdf_to_world, things_to_hrdf
 
     source, output = Path(args.source), Path(args.output)
@@ -35,18 +42,16 @@ def _run(args: argparse.Namespace) -> int:
             f"{output}: expected a .xml file (MJCF) or a folder name without extension (HRDF)"
         )
     check_output_path(output, folder=not to_xml)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        if source.is_dir():
-            world = hrdf_to_world(HRDF.from_dir(source), strict=args.strict)
-        else:
-            world = World.from_xml_path(source, strict=args.strict)
-        if to_xml:
-            written = world.export(output)
-        else:
-            written = things_to_hrdf(world, strict=args.strict).save(output)
-    for w in caught:
-        print(f"warning: {w.message}")
+    check_overwrite(output, args.overwrite)
+    if source.is_file() or source.suffix.lower() == ".xml":
+        world = World.from_xml_path(source, strict=args.strict)
+    else:  # an HRDF folder, or a robot name (bundled or under $HURODES_ASSETS_PATH)
+        world = hrdf_to_world(HRDF.from_dir(resolve_robot(args.source)), strict=args.strict)
+    if to_xml:
+        written = world.export(output)
+    else:
+        # check_overwrite allowed it: an empty folder, or --overwrite.
+        written = things_to_hrdf(world, strict=args.strict).save(output, overwrite=True)
     model = world.model
     print(
         f"{source} -> {written}: {model.nbody - 1} bodies, {model.njnt} joints, "
