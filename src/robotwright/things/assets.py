@@ -27,11 +27,31 @@ _TEXTURE_ATTR: dict[str, Any] = {
     "file": Text(),
     "gridsize": Vector(2, integer=True),
     "gridlayout": Text(),
+    # One image file per cube face (MJCF order: right, left, up, down, front, back).
+    "fileright": Text(),
+    "fileleft": Text(),
+    "fileup": Text(),
+    "filedown": Text(),
+    "filefront": Text(),
+    "fileback": Text(),
 }
+
+#: Texture attributes that name files (copied on export like a mesh file).
+TEXTURE_FILE_ATTRS = (
+    "file",
+    "fileright",
+    "fileleft",
+    "fileup",
+    "filedown",
+    "filefront",
+    "fileback",
+)
 
 
 class Texture(BaseThing):
-    """A texture: a ``builtin`` pattern or an image ``file`` (absolute or relative path)."""
+    """A texture: a ``builtin`` pattern, an image ``file`` (absolute or relative path), or
+    for a cube/skybox one image per face (``fileright``, ``fileleft``, ``fileup``,
+    ``filedown``, ``filefront``, ``fileback``)."""
 
     _TAG = "texture"
     _ASSET_KIND = "texture"
@@ -50,6 +70,7 @@ class Texture(BaseThing):
         "file": None,
         "gridsize": np.array([1, 1]),
         "gridlayout": None,
+        **{key: None for key in TEXTURE_FILE_ATTRS[1:]},
     }
 
     def __init__(self, name: str | None = None, parent: BaseThing | None = None, **kwargs: Any):
@@ -88,6 +109,43 @@ class Material(BaseThing):
         "texture": None,
         "texrepeat": np.ones(2),
         "texuniform": False,
+    }
+
+    def __init__(self, name: str | None = None, parent: BaseThing | None = None, **kwargs: Any):
+        super().__init__(name=name, parent=parent, **kwargs)
+
+
+_MESH_ATTR: dict[str, Any] = {
+    "file": Text(),
+    "scale": Vector(3),
+    "vertex": Vector(None, optional=True),
+    "face": Vector(None, optional=True, integer=True),
+    "maxhullvert": Integer(minimum=-1),
+    "inertia": Choice("convex", "exact", "legacy", "shell"),
+    "refpos": Vector(3),
+    "refquat": Vector(4, nonzero=True),
+}
+
+
+class MeshAsset(BaseThing):
+    """A ``<mesh>`` asset that no geom uses (a geom owns its mesh: see
+    :class:`~robotwright.things.geoms.Mesh`). MuJoCo compiles such meshes into the model
+    (``nmesh``, mesh ids), so reading MJCF keeps them in ``World.assets``; ``file`` is
+    copied on export like any mesh file. Units: ``scale`` is unitless, ``refpos`` in m."""
+
+    _TAG = "mesh"
+    _ASSET_KIND = "mesh"
+    _NEW_MUJOCO_ATTR = _MESH_ATTR
+    _NEW_BLUEPRINTS_ATTR = _MESH_ATTR
+    _NEW_DEFAULT_VALS = {
+        "file": None,
+        "scale": np.ones(3),
+        "vertex": None,
+        "face": None,
+        "maxhullvert": -1,
+        "inertia": "legacy",
+        "refpos": np.zeros(3),
+        "refquat": np.array([1.0, 0, 0, 0]),
     }
 
     def __init__(self, name: str | None = None, parent: BaseThing | None = None, **kwargs: Any):

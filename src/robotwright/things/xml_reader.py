@@ -45,13 +45,14 @@ from robotwright.errors import (
 )
 from robotwright.things import actuators as A
 from robotwright.things import sensors as S
-from robotwright.things.assets import Material, Texture
+from robotwright.things.assets import TEXTURE_FILE_ATTRS, Material, MeshAsset, Texture
 from robotwright.things.base import BaseThing
 from robotwright.things.body import Body
 from robotwright.things.cameras import Camera
 from robotwright.things.geoms import GEOM_CLASSES
 from robotwright.things.joints import JOINT_CLASSES
 from robotwright.things.lights import Light
+from robotwright.things.precision import SECTION_REFINERS, refine_listed
 from robotwright.things.raw import RawElement
 from robotwright.things.sites import Site
 from robotwright.things.world import OPTION_ATTR, World
@@ -85,6 +86,8 @@ class _Reader:
         self.materials: dict[str, Material] = {}
         self.textures: dict[str, Texture] = {}
         self.used_hfields: set[str] = set()
+        self.used_meshes: set[str] = set()
+        self.compiled: mujoco.MjModel | None = None  # set once the spec is compiled
 
     # ------------------------------------------------------------------ helpers
     def lose(self, element: str, message: str) -> None:
@@ -132,8 +135,8 @@ class _Reader:
         spec = self.spec
         for tex in spec.textures:
             where = f'<texture name="{tex.name}">'
-            if any(list(tex.cubefiles)) or len(tex.data):
-                self.lose(where, "cube-face files and embedded data of textures are not kept")
+            if len(tex.data):
+                self.lose(where, "embedded data of textures is not kept")
             kw: dict[str, Any] = {
                 "type": {0: "2d", 1: "cube", 2: "skybox"}[int(tex.type)],
                 "builtin": _enum(tex.builtin, "mjBUILTIN_"),
@@ -148,6 +151,9 @@ class _Reader:
             }
             if tex.file:
                 kw["file"] = self.path(tex.file, spec.texturedir)
+            for key, face in zip(TEXTURE_FILE_ATTRS[1:], tex.cubefiles):
+                if face:
+                    kw[key] = self.path(face, spec.texturedir)
             layout = "".join(tex.gridlayout)
             if layout and tuple(tex.gridsize) != (1, 1):
                 kw["gridlayout"] = layout
@@ -293,7 +299,8 @@ class _Reader:
             if gtype in ("capsule", "cylinder"):
                 size[1] = half
             elif gtype in ("box", "ellipsoid"):
-                size[2] = half
+                # MuJoCo's compiler: the two cross-section half-sizes both become size[0].
+                size[1], size[2] = size[0], half
         kw: dict[str, Any] = {
             "size": size,
             "pos": pos,
@@ -333,6 +340,7 @@ class _Reader:
             raise ThingXMLError(
                 f"{self.source}: {where} refers to mesh {meshname!r}, which is not defined"
             )
+        self.used_meshes.add(meshname)
         kw: dict[str, Any] = {
             "mesh": meshname,
             "scale": sm.scale,
@@ -353,6 +361,16 @@ class _Reader:
                 "mesh normals, texture coordinates, content type and plugins are not kept",
             )
         return kw
+
+    def unused_meshes(self, world: World) -> None:
+        """Meshes no geom uses: MuJoCo still compiles them, so keep them as assets."""
+        for sm in self.spec.meshes:
+            if sm.name in self.used_meshes:
+                continue
+            kw = self.mesh_asset(sm.name, f'<mesh name="{sm.name}">')
+            kw.pop("mesh")
+            kw["inertia"] = kw.pop("meshinertia")
+            world.assets.append(MeshAsset(sm.name or None, **kw))
 
     def hfield_asset(self, name: str, where: str) -> dict[str, Any]:
         sh = self.spec.hfield(name)
@@ -444,7 +462,9 @@ class _Reader:
         return light
 
     # ------------------------------------------------------------------ sections
-    def actuator(self, sa: Any, world: World, carried: dict[str, list[ET.Element]]) -> None:
+    def actuator(
+        self, sa: Any, world: World, carried: dict[str, list[ET.Element]], index: int
+    ) -> None:
         trn = _enum(sa.trntype, "mjTRN_")
         target = self.by_name.get(({"joint": "joint", "site": "site"}.get(trn, ""), sa.target))
         if target is None or sa.slidersite or sa.refsite and trn != "site":
@@ -464,10 +484,16 @@ class _Reader:
         }
         if sa.refsite:
             kw["refsite"] = sa.refsite
-        if sa.inheritrange > 0 and trn == "joint":
-            jr = target.range
-            mid, half = (jr[0] + jr[1]) / 2, (jr[1] - jr[0]) / 2 * sa.inheritrange
-            kw["ctrlrange"] = [mid - half, mid + half]
+        if sa.inheritrange > 0:
+            # Whether and where the joint range is inherited (position servos: ctrlrange,
+            # integrated velocity: actrange; a <motor> under a class whose <position>
+            # default sets inheritrange: neither) is the compiler's decision: take its.
+            model = self.compiled
+            kw["ctrlrange"] = model.actuator_ctrlrange[index]
+            kw["ctrllimited"] = "true" if model.actuator_ctrllimited[index] else "false"
+            if model.actuator_actlimited[index]:
+                kw["actrange"] = model.actuator_actrange[index]
+                kw["actlimited"] = "true"
         lost = [f for f in ("armature", "cranklength", "delay") if getattr(sa, f)]
         lost += [f for f in ("damping", "lengthrange") if np.any(getattr(sa, f))]
         if lost:
@@ -634,12 +660,17 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
     reader.by_name[("body", "world")] = world
     reader.read_assets(world)
     reader.read_body_children(spec.worldbody, world)
+    reader.unused_meshes(world)
     for hfield in spec.hfields:
         if hfield.name not in reader.used_hfields:
             reader.lose(f'<hfield name="{hfield.name}">', "no geom uses it; not kept")
 
     try:
         carried_root = ET.fromstring(spec.to_xml())
+        # to_xml() compiled the spec; the compiled values are what our MJCF must give.
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # to_xml() already showed MuJoCo's warnings
+            reader.compiled = spec.compile()
     except ValueError as exc:
         raise ThingXMLError(f"{source}: MuJoCo rejected the MJCF: {exc}") from None
     carried: dict[str, list[ET.Element]] = {}
@@ -651,9 +682,11 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
     ):
         carried = {"actuator": [], "sensor": []}
     acts, sens = carried["actuator"], carried["sensor"]
+    refine_listed(acts, reader.compiled, "actuator")
+    refine_listed(sens, reader.compiled, "sensor")
     for i, sa in enumerate(spec.actuators):
         carried["actuator"] = [acts[i]] if acts else []
-        reader.actuator(sa, world, carried)
+        reader.actuator(sa, world, carried, i)
     for i, ss in enumerate(spec.sensors):
         carried["sensor"] = [sens[i]] if sens else []
         reader.sensor(ss, world, carried)
@@ -662,6 +695,10 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
         node = carried_root.find(section)
         if node is None or (section != "visual" and len(node) == 0 and not node.attrib):
             continue
+        if section in SECTION_REFINERS:
+            SECTION_REFINERS[section](node, reader.compiled)
+        if section == "size":
+            node = _split_size(node)
         if section in ("contact", "equality", "tendon", "keyframe"):
             for child in node:
                 _carried_class(child)
@@ -693,7 +730,20 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
     return world
 
 
+def _split_size(node: ET.Element) -> ET.Element:
+    """MuJoCo's writer puts ``memory`` and ``njmax``/``nstack`` (read from two ``<size>``
+    elements) into one element, which its schema refuses; write ``memory`` on its own."""
+    if "memory" not in node.attrib or not ({"njmax", "nstack"} & set(node.attrib)):
+        return node
+    memory = ET.Element("size", {"memory": node.attrib.pop("memory")})
+    wrapper = ET.Element("sizes")
+    wrapper.extend([memory, node])
+    return wrapper
+
+
 def _indent(node: ET.Element) -> str:
+    if node.tag == "sizes":  # several top-level elements (see _split_size)
+        return "\n".join(_indent(child) for child in node)
     ET.indent(node, space="  ", level=1)
     return "  " + ET.tostring(node, encoding="unicode").strip()
 

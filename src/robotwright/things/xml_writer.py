@@ -15,10 +15,13 @@ from xml.sax.saxutils import escape
 
 from robotwright._inputs import MJCF_MAX_BODY_DEPTH
 from robotwright.errors import GeneratorError
+from robotwright.things.assets import TEXTURE_FILE_ATTRS
 from robotwright.things.attrs import ThingAttributeError
 from robotwright.things.base import BaseThing
 
 _QUOTE = {'"': "&quot;"}
+#: Attributes holding a file path (rewritten by ``path_for``, e.g. copied on export).
+_FILE_ATTRS = frozenset(TEXTURE_FILE_ATTRS)
 
 
 def _q(text: str) -> str:
@@ -75,7 +78,7 @@ class _Writer:
                 continue
             if isinstance(value, BaseThing):
                 text = self.ref_name(value)
-            elif key == "file":
+            elif key in _FILE_ATTRS:
                 text = self.path_for(value)
             else:
                 text = spec.format(value)
