@@ -38,6 +38,7 @@ from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
 from robotwright.parsers.meshes import MeshConversionError, conversion_note, mesh_store
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
+from robotwright.parsers.visuals import drop_unbuildable_visuals
 from robotwright.parsers.xmlsafe import describe, parse_xml
 
 VISUAL_GROUP = 2
@@ -781,6 +782,9 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
                 rep.warn(f"geom name '{g.geom_name}' repeated: renamed '{new_name}'")
                 table[i] = _replace_name(g, new_name, "geom_name")
     extra = _mimic_extra(mimics, {j.name for j in hrdf_joints}, rep)
+    geoms_mesh, geoms_simple = drop_unbuildable_visuals(
+        geoms_mesh, geoms_simple, reader.store.root, rep
+    )
     tables = (hrdf_bodies, hrdf_joints, geoms_mesh, geoms_simple, sites)
     _rename_world_body(tables, {x.get("name") for x in links.values()}, rep)
     hrdf = HRDF(
