@@ -1,0 +1,115 @@
+"""``robotwright view SOURCE``: serve the browser viewer until Ctrl-C.
+
+Registering the command imports nothing heavy: MuJoCo, numpy and viser are imported
+when the command runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+#: Geom groups accepted by ``--groups`` (MuJoCo has six).
+_GROUPS = range(6)
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number 0..65535, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port number 0..65535, got {value}")
+    return value
+
+
+def _groups(text: str) -> tuple[int, ...]:
+    try:
+        groups = tuple(int(g) for g in text.split(",") if g.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated geom groups 0..5, got {text!r}"
+        ) from None
+    if any(g not in _GROUPS for g in groups):
+        raise argparse.ArgumentTypeError(f"expected geom groups 0..5, got {text!r}")
+    return groups
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "view",
+        help="show a robot, scene or scan in the browser (viser)",
+        description="Serve a web page showing SOURCE: a bundled robot name, an HRDF "
+        "folder, an MJCF or URDF file, a composed scene, a grammar design folder, or a "
+        "scan .npz (with --scene). Meshes and primitives in MuJoCo's colours, body and site "
+        "frames, joint sliders (MuJoCo forward kinematics), scan points by semantic class. "
+        "Prints the URL and runs until Ctrl-C.",
+    )
+    p.add_argument("source", help="robot name, HRDF or design folder, .xml, .urdf or scan .npz")
+    p.add_argument("--scene", type=Path, help="MJCF scene a scan .npz was taken in")
+    p.add_argument(
+        "--port", type=_port, default=8080, help="TCP port (default 8080; next free if taken)"
+    )
+    p.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="address to listen on (default 127.0.0.1, this machine only; 0.0.0.0 for all)",
+    )
+    p.add_argument(
+        "--groups",
+        type=_groups,
+        default=None,
+        help="geom groups shown first, e.g. 0,1,2 (MuJoCo's default) or 3 for collision",
+    )
+    p.add_argument("--frames", action="store_true", help="show body and site frames first")
+    p.add_argument(
+        "--plain",
+        action="store_true",
+        help="default lights only, no environment map or shadows (faster without a GPU)",
+    )
+    p.set_defaults(func=_run)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from robotwright.view.scene import load_source
+    from robotwright.view.server import Viewer, ViewerConfig
+
+    # --asset-root (added by the main parser) is in force around this call.
+    scene = load_source(args.source, scene=args.scene)
+    if getattr(args, "verbose", False):
+        for note in scene.notes:
+            print(f"note: {note}", file=sys.stderr)
+    elif scene.notes:
+        print(
+            f"{len(scene.notes)} conversion note(s) while loading (values the viewer does not "
+            "use, such as actuator limits, are listed with -v)",
+            file=sys.stderr,
+        )
+    options = {} if args.groups is None else {"geom_groups": args.groups}
+    config = ViewerConfig(
+        host=args.host,
+        port=args.port,
+        body_frames=args.frames,
+        site_frames=args.frames,
+        plain=args.plain,
+        **options,
+    )
+    viewer = Viewer(scene, config)
+    m = scene.model
+    print(
+        f"{scene.title}: {m.nbody - 1} bodies, {m.njnt} joints, {viewer.geom_count} geoms shown"
+        + (f", {len(scene.scan.points)} scan points" if scene.scan is not None else "")
+    )
+    for line in viewer.skipped:
+        print(f"note: {line}", file=sys.stderr)
+    print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        print("stopped")
+    finally:
+        viewer.stop()
+    return 0

@@ -1,0 +1,234 @@
+"""What a compiled MuJoCo model looks like: one triangle mesh per geom, its colour, and
+the frames of bodies and sites.
+
+Everything here reads the compiled ``mujoco.MjModel`` (no viewer library), so it is
+what MuJoCo itself draws: geom poses are in their body's frame (``geom_pos``,
+``geom_quat``), mesh vertices are MuJoCo's compiled ones (in the mesh frame the geom
+pose refers to), colours follow MuJoCo's rule (the material's colour unless the geom's
+``rgba`` differs from MuJoCo's default), and lengths are metres. Primitives are
+tessellated with trimesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import mujoco
+import numpy as np
+
+__all__ = [
+    "DEFAULT_GEOM_GROUPS",
+    "GeomShape",
+    "SiteFrame",
+    "body_poses",
+    "geom_rgba",
+    "geom_shapes",
+    "site_frames",
+]
+
+#: Geom groups MuJoCo's own viewer shows by default (``mjvOption.geomgroup``).
+DEFAULT_GEOM_GROUPS: tuple[int, ...] = (0, 1, 2)
+
+#: MuJoCo's default geom colour: a geom with this ``rgba`` takes its material's colour.
+_DEFAULT_RGBA = np.array([0.5, 0.5, 0.5, 1.0], dtype=np.float32)
+
+
+@dataclass(frozen=True)
+class GeomShape:
+    """One geom as a triangle mesh in its body's frame.
+
+    Attributes:
+        geom_id: MuJoCo geom id.
+        body_id: id of the body carrying it (0 = world).
+        name: geom name (``geom <id>`` when unnamed).
+        group: MuJoCo geom group (0..5).
+        rgba: colour drawn, 4 floats in [0, 1].
+        pos: geom origin in the body frame [m], shape ``(3,)``.
+        quat: geom orientation in the body frame (w, x, y, z), shape ``(4,)``.
+        vertices: ``(V, 3)`` vertices in the geom frame [m].
+        faces: ``(F, 3)`` vertex indices of the triangles.
+    """
+
+    geom_id: int
+    body_id: int
+    name: str
+    group: int
+    rgba: np.ndarray
+    pos: np.ndarray
+    quat: np.ndarray
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+@dataclass(frozen=True)
+class SiteFrame:
+    """A site's frame in its body's frame: ``pos`` [m], ``quat`` (w, x, y, z)."""
+
+    site_id: int
+    body_id: int
+    name: str
+    pos: np.ndarray
+    quat: np.ndarray
+
+
+def geom_rgba(model: mujoco.MjModel, geom_id: int) -> np.ndarray:
+    """The colour MuJoCo draws geom ``geom_id`` with: the geom's ``rgba`` when it differs
+    from MuJoCo's default (0.5, 0.5, 0.5, 1), else its material's colour, else the
+    default."""
+    rgba = np.array(model.geom_rgba[geom_id], dtype=np.float32)
+    matid = int(model.geom_matid[geom_id])
+    if matid >= 0 and np.array_equal(rgba, _DEFAULT_RGBA):
+        return np.array(model.mat_rgba[matid], dtype=np.float32)
+    return rgba
+
+
+def _name(model: mujoco.MjModel, kind: mujoco.mjtObj, idx: int, label: str) -> str:
+    return mujoco.mj_id2name(model, kind, idx) or f"{label} {idx}"
+
+
+@lru_cache(maxsize=64)
+def _unit(kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """Unit primitives, tessellated once: sphere of radius 1, cylinder of radius 1 and
+    height 2 (along z, centred)."""
+    import trimesh
+
+    if kind == "sphere":
+        mesh = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
+    else:
+        mesh = trimesh.creation.cylinder(radius=1.0, height=2.0, sections=32)
+    return np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.int32)
+
+
+def _primitive(
+    model: mujoco.MjModel, gtype: int, size: np.ndarray
+) -> tuple[np.ndarray, np.ndarray] | None:
+    import trimesh
+
+    G = mujoco.mjtGeom
+    if gtype == G.mjGEOM_BOX:
+        mesh = trimesh.creation.box(extents=2.0 * size)
+        return np.asarray(mesh.vertices, np.float32), np.asarray(mesh.faces, np.int32)
+    if gtype in (G.mjGEOM_SPHERE, G.mjGEOM_ELLIPSOID):
+        v, f = _unit("sphere")
+        radii = np.full(3, size[0]) if gtype == G.mjGEOM_SPHERE else size[:3]
+        return v * radii.astype(np.float32), f
+    if gtype == G.mjGEOM_CYLINDER:
+        v, f = _unit("cylinder")
+        return v * np.array([size[0], size[0], size[1]], np.float32), f
+    if gtype == G.mjGEOM_CAPSULE:
+        mesh = trimesh.creation.capsule(height=2.0 * size[1], radius=size[0], count=[24, 24])
+        return np.asarray(mesh.vertices, np.float32), np.asarray(mesh.faces, np.int32)
+    if gtype == G.mjGEOM_PLANE:
+        # A plane of size 0 is infinite in MuJoCo; drawn as a square 10 times the model's
+        # extent (MuJoCo's own renderer also draws a finite patch).
+        far = 10.0 * max(float(model.stat.extent), 1.0)
+        hx = size[0] if size[0] > 0 else far
+        hy = size[1] if size[1] > 0 else far
+        v = np.array([[-hx, -hy, 0], [hx, -hy, 0], [hx, hy, 0], [-hx, hy, 0]], np.float32)
+        return v, np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+    return None
+
+
+def _mesh(model: mujoco.MjModel, mesh_id: int) -> tuple[np.ndarray, np.ndarray]:
+    v0, nv = int(model.mesh_vertadr[mesh_id]), int(model.mesh_vertnum[mesh_id])
+    f0, nf = int(model.mesh_faceadr[mesh_id]), int(model.mesh_facenum[mesh_id])
+    return (
+        np.asarray(model.mesh_vert[v0 : v0 + nv], dtype=np.float32),
+        np.asarray(model.mesh_face[f0 : f0 + nf], dtype=np.int32),
+    )
+
+
+def _hfield(model: mujoco.MjModel, hid: int) -> tuple[np.ndarray, np.ndarray]:
+    """The top surface of a height field: ``size`` = (x half, y half, top, bottom) [m];
+    MuJoCo's rows run along y from -y to +y, columns along x."""
+    nrow, ncol = int(model.hfield_nrow[hid]), int(model.hfield_ncol[hid])
+    rx, ry, top = (float(s) for s in model.hfield_size[hid][:3])
+    adr = int(model.hfield_adr[hid])
+    z = np.asarray(model.hfield_data[adr : adr + nrow * ncol], np.float32).reshape(nrow, ncol)
+    xs = np.linspace(-rx, rx, ncol, dtype=np.float32)
+    ys = np.linspace(-ry, ry, nrow, dtype=np.float32)
+    gx, gy = np.meshgrid(xs, ys)
+    vertices = np.stack([gx, gy, z * top], axis=-1).reshape(-1, 3)
+    r, c = np.meshgrid(np.arange(nrow - 1), np.arange(ncol - 1), indexing="ij")
+    a = (r * ncol + c).reshape(-1)
+    b, d, e = a + 1, a + ncol, a + ncol + 1
+    faces = np.concatenate([np.stack([a, b, e], 1), np.stack([a, e, d], 1)]).astype(np.int32)
+    return vertices, faces
+
+
+def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> list[GeomShape]:
+    """Every geom MuJoCo could draw, as a triangle mesh in its body's frame.
+
+    Geoms of every group are returned (the viewer shows groups 0-2 first, as MuJoCo
+    does). Fully transparent geoms (alpha 0) and geom types without a surface to draw
+    here (SDF plugins) are left out; when ``skipped`` is a list, a line naming each is
+    appended to it.
+    """
+    G = mujoco.mjtGeom
+    out: list[GeomShape] = []
+    for g in range(model.ngeom):
+        name = _name(model, mujoco.mjtObj.mjOBJ_GEOM, g, "geom")
+        rgba = geom_rgba(model, g)
+        gtype = int(model.geom_type[g])
+        if rgba[3] <= 0.0:
+            if skipped is not None:
+                skipped.append(f"geom '{name}': fully transparent (alpha 0), not drawn")
+            continue
+        if gtype == G.mjGEOM_MESH:
+            shape = _mesh(model, int(model.geom_dataid[g]))
+        elif gtype == G.mjGEOM_HFIELD:
+            shape = _hfield(model, int(model.geom_dataid[g]))
+        else:
+            shape = _primitive(model, gtype, np.asarray(model.geom_size[g], dtype=np.float64))
+        if shape is None:
+            if skipped is not None:
+                skipped.append(f"geom '{name}': type {G(gtype).name} is not drawn")
+            continue
+        out.append(
+            GeomShape(
+                geom_id=g,
+                body_id=int(model.geom_bodyid[g]),
+                name=name,
+                group=int(model.geom_group[g]),
+                rgba=rgba,
+                pos=np.array(model.geom_pos[g], dtype=np.float64),
+                quat=np.array(model.geom_quat[g], dtype=np.float64),
+                vertices=shape[0],
+                faces=shape[1],
+            )
+        )
+    return out
+
+
+def site_frames(model: mujoco.MjModel) -> list[SiteFrame]:
+    """Every site's frame in its body's frame."""
+    return [
+        SiteFrame(
+            site_id=s,
+            body_id=int(model.site_bodyid[s]),
+            name=_name(model, mujoco.mjtObj.mjOBJ_SITE, s, "site"),
+            pos=np.array(model.site_pos[s], dtype=np.float64),
+            quat=np.array(model.site_quat[s], dtype=np.float64),
+        )
+        for s in range(model.nsite)
+    ]
+
+
+def body_poses(
+    model: mujoco.MjModel, data: mujoco.MjData, qpos: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """World poses of all bodies after MuJoCo forward kinematics (``mj_kinematics``).
+
+    Args:
+        qpos: joint positions to set first (``model.nq`` values); ``None`` keeps
+            ``data.qpos``.
+
+    Returns:
+        ``(xpos, xquat)``: ``(nbody, 3)`` positions [m] and ``(nbody, 4)`` orientations
+        (w, x, y, z), copies.
+    """
+    if qpos is not None:
+        data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    return data.xpos.copy(), data.xquat.copy()

@@ -1,0 +1,443 @@
+"""The browser page: a viser server drawing a :class:`~robotwright.view.scene.ViewScene`.
+
+Scene layout (viser node names): ``/bodies/b<id>`` is a frame per MuJoCo body placed at
+its world pose; each geom is a mesh under its body (``/bodies/b<id>/g<id>``) at its
+pose in the body frame, and each site a frame (``/bodies/b<id>/s<id>``). Meshes are
+sent once, when a geom group is first shown; moving a joint slider runs
+``mujoco.mj_kinematics`` and sends only the body poses that changed. A scan is one
+point cloud (``/scan/points``) in the world frame, coloured by class, with a legend.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import html
+import io
+import threading
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import mujoco
+import numpy as np
+
+from robotwright.view.geometry import (
+    DEFAULT_GEOM_GROUPS,
+    GeomShape,
+    body_poses,
+    geom_shapes,
+    site_frames,
+)
+from robotwright.view.scene import ViewError, ViewScene
+
+if TYPE_CHECKING:
+    import viser
+
+__all__ = ["CLASS_COLORS", "Viewer", "ViewerConfig", "class_color"]
+
+#: Point colours by semantic class id, the same as the scan pictures'
+#: (:func:`robotwright.sensors.plot.plot_scan`): class 0 (unknown) is grey.
+CLASS_COLORS: tuple[str, ...] = (
+    "#9e9e9e",
+    "#8c6d31",
+    "#d62728",
+    "#1f77b4",
+    "#2ca02c",
+    "#9467bd",
+    "#ff7f0e",
+    "#17becf",
+    "#e377c2",
+)
+
+#: Slider range of a joint without limits: a full turn for a hinge [rad], +-1 m for a
+#: slide. Only the slider's range; the model is not changed.
+UNLIMITED_HINGE = (-np.pi, np.pi)
+UNLIMITED_SLIDE = (-1.0, 1.0)
+#: Joint types that get a slider (one coordinate each).
+_SLIDER_JOINTS = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+
+
+def class_color(class_id: int) -> tuple[int, int, int]:
+    """RGB (0-255) of a semantic class id (the palette repeats after 9 classes)."""
+    h = CLASS_COLORS[class_id % len(CLASS_COLORS)].lstrip("#")
+    return (int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16))
+
+
+@dataclass(frozen=True)
+class ViewerConfig:
+    """How the page starts.
+
+    Attributes:
+        host: address the server listens on; ``127.0.0.1`` (default) serves this
+            machine only, ``0.0.0.0`` every network interface.
+        port: TCP port; when taken, the next free one is used (the handle's ``url``
+            says which); 0 picks any free port.
+        geom_groups: MuJoCo geom groups shown first (MuJoCo's viewer shows 0, 1, 2).
+        body_frames: show the body frames (axes) first.
+        site_frames: show the site frames first.
+        point_size: size of a scan point [m].
+        grid: draw a ground grid at z = 0 when the model has no plane.
+        plain: light with the default lights only, no environment map and no shadows:
+            much faster where the browser draws without a GPU (software WebGL).
+        verbose: let viser print its own banner and connection messages.
+    """
+
+    host: str = "127.0.0.1"
+    port: int = 8080
+    geom_groups: tuple[int, ...] = DEFAULT_GEOM_GROUPS
+    body_frames: bool = False
+    site_frames: bool = False
+    point_size: float = 0.02
+    grid: bool = True
+    plain: bool = False
+    verbose: bool = False
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.port, int) or not 0 <= self.port <= 65535:
+            raise ViewError(f"port: expected an integer in 0..65535, got {self.port!r}")
+        if not self.host or not isinstance(self.host, str):
+            raise ViewError(f"host: expected an address, got {self.host!r}")
+        bad = [g for g in self.geom_groups if not (isinstance(g, int) and 0 <= g < 6)]
+        if bad:
+            raise ViewError(f"geom_groups: expected MuJoCo groups 0..5, got {bad}")
+        if not (np.isfinite(self.point_size) and self.point_size > 0):
+            raise ViewError(f"point_size: expected a positive size [m], got {self.point_size}")
+
+
+class Viewer:
+    """A running page for one scene; returned by :func:`robotwright.view.show`.
+
+    Attributes:
+        scene: what is shown.
+        server: the ``viser.ViserServer`` (add your own scene nodes or controls to it).
+        data: the ``mujoco.MjData`` whose ``qpos`` the sliders set.
+    """
+
+    def __init__(self, scene: ViewScene, config: ViewerConfig | None = None) -> None:
+        import viser
+
+        self.scene = scene
+        self.config = config or ViewerConfig()
+        self.model = scene.model
+        self.data = mujoco.MjData(self.model)
+        self.skipped: list[str] = []
+        self._lock = threading.Lock()
+        self._shapes: dict[int, list[GeomShape]] = {}
+        for shape in geom_shapes(self.model, skipped=self.skipped):
+            self._shapes.setdefault(shape.group, []).append(shape)
+        self._geom_nodes: dict[int, Any] = {}
+        self._shown_groups: set[int] = set()
+        self._sliders: dict[int, Any] = {}
+        self._group_boxes: dict[int, Any] = {}
+        # viser prints a banner on start; the caller prints the URL instead.
+        quiet = contextlib.nullcontext() if self.config.verbose else _quiet_stdout()
+        with quiet:
+            self.server: viser.ViserServer = viser.ViserServer(
+                host=self.config.host,
+                port=self.config.port,
+                label=f"robotwright: {scene.title}",
+                verbose=self.config.verbose,
+            )
+        try:
+            self._build()
+        except BaseException:
+            self.server.stop()
+            raise
+
+    # -- public -------------------------------------------------------------------------
+    @property
+    def url(self) -> str:
+        """The page's address (``localhost`` when serving every interface)."""
+        host = self.server.get_host()
+        if host in ("0.0.0.0", "::", ""):
+            host = "localhost"
+        elif ":" in host:
+            host = f"[{host}]"
+        return f"http://{host}:{self.server.get_port()}"
+
+    @property
+    def geom_count(self) -> int:
+        """Geoms drawn so far (meshes sent to the page)."""
+        return len(self._geom_nodes)
+
+    def joint_names(self) -> list[str]:
+        """Names of the joints that have a slider (hinge and slide joints)."""
+        return [self._joint_label(j) for j in self._sliders]
+
+    def set_joint(self, name: str, value: float) -> None:
+        """Move joint ``name`` to ``value`` (rad for a hinge, m for a slide), as its
+        slider does."""
+        jid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if jid < 0 or jid not in self._sliders:
+            raise ViewError(f"joint '{name}': no slider for it; sliders: {self.joint_names()}")
+        self._sliders[jid].value = float(value)  # runs the slider's callback
+        self._set_qpos_value(jid, float(value))
+
+    def set_qpos(self, qpos: np.ndarray) -> None:
+        """Show the configuration ``qpos`` (``model.nq`` values)."""
+        qpos = np.asarray(qpos, dtype=np.float64).reshape(-1)
+        if qpos.shape != (self.model.nq,):
+            raise ViewError(f"qpos: expected {self.model.nq} values, got {qpos.shape[0]}")
+        with self._lock:
+            self.data.qpos[:] = qpos
+        for jid, slider in self._sliders.items():
+            slider.value = float(qpos[self.model.jnt_qposadr[jid]])
+        self._update_poses()
+
+    def show_groups(self, groups: set[int] | tuple[int, ...]) -> None:
+        """Show the geoms of exactly these MuJoCo groups (meshes sent on first show)."""
+        wanted = set(groups)
+        for group in sorted(set(self._shapes) | self._shown_groups):
+            on = group in wanted
+            if on and group not in self._shown_groups:
+                self._add_group(group)
+            for shape in self._shapes.get(group, []):
+                node = self._geom_nodes.get(shape.geom_id)
+                if node is not None:
+                    node.visible = on
+        self._shown_groups |= wanted & set(self._shapes)
+        self._visible_groups = wanted
+        for group, box in self._group_boxes.items():
+            if box.value != (group in wanted):
+                box.value = group in wanted
+
+    def stop(self) -> None:
+        """Stop the server (the page stops updating)."""
+        with contextlib.nullcontext() if self.config.verbose else _quiet_stdout():
+            self.server.stop()
+
+    def __enter__(self) -> Viewer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -- building the page ----------------------------------------------------------------
+    def _build(self) -> None:
+        server, model = self.server, self.model
+        if self.config.plain:
+            server.scene.configure_environment_map(hdri=None)
+            server.scene.configure_default_lights(True, cast_shadow=False)
+        self.data.qpos[:] = self.scene.initial_qpos()
+        xpos, xquat = body_poses(model, self.data)
+        extent = max(float(model.stat.extent), 0.1)
+        axes = 0.15 * extent if model.nbody > 1 else 0.2
+        self._body_nodes = [
+            server.scene.add_frame(
+                f"/bodies/b{b}",
+                show_axes=self.config.body_frames and b > 0,
+                axes_length=axes,
+                axes_radius=axes * 0.04,
+                wxyz=xquat[b],
+                position=xpos[b],
+            )
+            for b in range(model.nbody)
+        ]
+        self._site_nodes = [
+            server.scene.add_frame(
+                f"/bodies/b{s.body_id}/s{s.site_id}",
+                show_axes=self.config.site_frames,
+                axes_length=axes * 0.6,
+                axes_radius=axes * 0.025,
+                wxyz=s.quat,
+                position=s.pos,
+            )
+            for s in site_frames(model)
+        ]
+        self._visible_groups: set[int] = set()
+        self.show_groups(set(self.config.geom_groups))
+        has_plane = bool(np.any(model.geom_type == int(mujoco.mjtGeom.mjGEOM_PLANE)))
+        if self.config.grid and not has_plane:
+            server.scene.add_grid("/grid", width=4 * extent, height=4 * extent, cell_size=0.1)
+        if self.scene.scan is not None:
+            self._add_scan()
+        self._frame_camera()
+        self._add_controls()
+
+    def _add_group(self, group: int) -> None:
+        with self.server.atomic():
+            for s in self._shapes.get(group, []):
+                rgb = tuple(int(round(255 * c)) for c in s.rgba[:3])
+                self._geom_nodes[s.geom_id] = self.server.scene.add_mesh_simple(
+                    f"/bodies/b{s.body_id}/g{s.geom_id}",
+                    vertices=s.vertices,
+                    faces=s.faces,
+                    color=rgb,
+                    opacity=float(s.rgba[3]) if s.rgba[3] < 1.0 else None,
+                    side="double" if len(s.faces) <= 2 else "front",
+                    wxyz=s.quat,
+                    position=s.pos,
+                )
+
+    def _add_scan(self) -> None:
+        scan = self.scene.scan
+        assert scan is not None
+        palette = np.array([class_color(i) for i in range(len(scan.class_names))], np.uint8)
+        colors = palette[scan.labels] if len(scan.labels) else np.zeros((0, 3), np.uint8)
+        self._scan_node = self.server.scene.add_point_cloud(
+            "/scan/points",
+            points=scan.points.astype(np.float32),
+            colors=colors,
+            point_size=self.config.point_size,
+            point_shape="circle",
+        )
+        if np.isfinite(scan.sensor_pos).all():
+            self.server.scene.add_frame(
+                "/scan/sensor",
+                axes_length=0.2,
+                axes_radius=0.008,
+                wxyz=scan.sensor_quat,
+                position=scan.sensor_pos,
+            )
+
+    def _frame_camera(self) -> None:
+        """Look at the robot (the bodies other than the world) from the front-left,
+        far enough to see all of it; a scan without a robot is framed by its points."""
+        model = self.model
+        pts = [self.data.xpos[1:]] if model.nbody > 1 else []
+        if model.nbody <= 1 and self.scene.scan is not None and len(self.scene.scan.points):
+            pts.append(self.scene.scan.points)
+        if pts:
+            cloud = np.concatenate(pts)
+            lo, hi = cloud.min(axis=0), cloud.max(axis=0)
+            centre = 0.5 * (lo + hi)
+            radius = max(float(np.linalg.norm(hi - lo)) * 0.5, 0.5 * float(model.stat.extent))
+        else:
+            centre, radius = np.zeros(3), 1.0
+        radius = max(radius, 0.2)
+        direction = np.array([1.0, -1.0, 0.6])
+        direction /= np.linalg.norm(direction)
+        self.server.initial_camera.look_at = tuple(centre)
+        self.server.initial_camera.position = tuple(centre + 2.2 * radius * direction)
+        self.camera_target = centre
+
+    def _add_controls(self) -> None:
+        gui, model = self.server.gui, self.model
+        gui.configure_theme(show_share_button=False, dark_mode=False)
+        gui.add_markdown(self._summary_markdown())
+        with gui.add_folder("Show"):
+            bodies = gui.add_checkbox("Body frames", initial_value=self.config.body_frames)
+            sites = gui.add_checkbox("Site frames", initial_value=self.config.site_frames)
+            sites.disabled = not self._site_nodes
+
+            @bodies.on_update
+            def _(_: Any) -> None:
+                for b, node in enumerate(self._body_nodes):
+                    node.show_axes = bodies.value and b > 0
+
+            @sites.on_update
+            def _(_: Any) -> None:
+                for node in self._site_nodes:
+                    node.show_axes = sites.value
+
+            for group in sorted(self._shapes):
+                box = gui.add_checkbox(
+                    f"Geom group {group} ({len(self._shapes[group])})",
+                    initial_value=group in self._visible_groups,
+                )
+
+                def toggle(_: Any, group: int = group, box: Any = box) -> None:
+                    groups = set(self._visible_groups)
+                    if box.value == (group in groups):
+                        return  # set by show_groups itself
+                    (groups.add if box.value else groups.discard)(group)
+                    self.show_groups(groups)
+
+                box.on_update(toggle)
+                self._group_boxes[group] = box
+        if self.scene.scan is not None:
+            with gui.add_folder("Scan"):
+                gui.add_html(self._legend_html())
+                points = gui.add_checkbox("Points", initial_value=True)
+
+                @points.on_update
+                def _(_: Any) -> None:
+                    self._scan_node.visible = points.value
+
+        joints = [j for j in range(model.njnt) if int(model.jnt_type[j]) in _SLIDER_JOINTS]
+        if joints:
+            with gui.add_folder("Joints"):
+                reset = gui.add_button("Reset pose")
+                for j in joints:
+                    self._sliders[j] = self._add_slider(j)
+
+                @reset.on_click
+                def _(_: Any) -> None:
+                    self.set_qpos(self.scene.initial_qpos())
+
+    def _joint_label(self, j: int) -> str:
+        return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint {j}"
+
+    def _add_slider(self, j: int) -> Any:
+        model = self.model
+        hinge = int(model.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_HINGE)
+        if model.jnt_limited[j]:
+            lo, hi = (float(x) for x in model.jnt_range[j])
+        else:
+            lo, hi = UNLIMITED_HINGE if hinge else UNLIMITED_SLIDE
+        value = float(np.clip(self.data.qpos[model.jnt_qposadr[j]], lo, hi))
+        slider = self.server.gui.add_slider(
+            self._joint_label(j),
+            min=lo,
+            max=hi,
+            step=max((hi - lo) / 500.0, 1e-6),
+            initial_value=value,
+            hint=f"{'hinge [rad]' if hinge else 'slide [m]'}"
+            + ("" if model.jnt_limited[j] else ", no limits in the model"),
+        )
+
+        @slider.on_update
+        def _(_: Any) -> None:
+            self._set_qpos_value(j, float(slider.value))
+
+        return slider
+
+    def _set_qpos_value(self, j: int, value: float) -> None:
+        with self._lock:
+            self.data.qpos[self.model.jnt_qposadr[j]] = value
+        self._update_poses()
+
+    def _update_poses(self) -> None:
+        """Forward kinematics, then send the pose of every body that moved."""
+        with self._lock:
+            old = self.data.xpos.copy(), self.data.xquat.copy()
+            xpos, xquat = body_poses(self.model, self.data)
+        moved = np.flatnonzero(
+            (np.abs(xpos - old[0]).max(axis=1) > 0) | (np.abs(xquat - old[1]).max(axis=1) > 0)
+        )
+        with self.server.atomic():
+            for b in moved:
+                node = self._body_nodes[b]
+                node.position = xpos[b]
+                node.wxyz = xquat[b]
+
+    def _summary_markdown(self) -> str:
+        m = self.model
+        lines = [
+            f"**{_md(self.scene.title)}** ({self.scene.kind})",
+            f"{m.nbody - 1} bodies, {m.njnt} joints, {m.nu} actuators, {m.ngeom} geoms, "
+            f"{m.nsite} sites",
+        ]
+        if self.skipped:
+            lines.append(f"not drawn: {len(self.skipped)} geom(s)")
+        return "  \n".join(lines)
+
+    def _legend_html(self) -> str:
+        scan = self.scene.scan
+        assert scan is not None
+        rows = [
+            f'<div><span style="display:inline-block;width:0.9em;height:0.9em;'
+            f'background:{CLASS_COLORS[i % len(CLASS_COLORS)]};margin-right:0.4em"></span>'
+            f"{i}: {html.escape(name)} ({count} points)</div>"
+            for i, (name, count) in enumerate(scan.class_counts().items())
+        ]
+        head = f"<div><b>{len(scan.points)} hits of {scan.num_rays} rays</b></div>"
+        return f'<div style="font-size:0.85em">{head}{"".join(rows)}</div>'
+
+
+def _quiet_stdout() -> contextlib.AbstractContextManager[object]:
+    return contextlib.redirect_stdout(io.StringIO())
+
+
+def _md(text: str) -> str:
+    """Escape Markdown's special characters in a name."""
+    return "".join("\\" + c if c in "\\`*_{}[]()#+-.!|<>" else c for c in text)
