@@ -31,6 +31,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.generators.cli",
     "robotwright.things.cli",
     "robotwright.view.cli",
+    "robotwright.render.cli",
 )
 
 #: Commands that read robots from files: they take ``--asset-root DIR`` (see
@@ -44,6 +45,7 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "roundtrip",
     "things",
     "view",
+    "render",
 )
 
 
@@ -141,6 +143,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except RobotwrightError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        # Ctrl-C on long work (grammar enumeration, search): a line, not a traceback.
+        print("interrupted", file=sys.stderr)
+        return 130
     except OSError as exc:
         # The file system refused a path the user gave (permissions, disk full, a file
         # where a folder is needed): name the path, no traceback.

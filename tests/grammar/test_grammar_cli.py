@@ -134,6 +134,10 @@ def test_show_prints_tree_dh_and_dot(tmp_path, capsys):
         (["sample", "-n", "0", "-o", "OUT"], "-n: expected an integer >= 1, got 0"),
         (["sample", "--max-links", "-2", "-o", "OUT"], "expected an integer >= 0, got -2"),
         (["count", "--max-links", "x"], "--max-links: expected an integer, got 'x'"),
+        # A bound, named in the message, instead of minutes of counting (docs/grammar.md).
+        (["count", "--max-links", "200"], "--max-links: expected at most 50"),
+        (["sample", "--max-links", "51", "-o", "OUT"], "--max-links: expected at most 50"),
+        (["search", "--max-links", "1000"], "--max-links: expected at most 50"),
     ],
 )
 def test_bad_numbers_are_usage_errors(tmp_path, capsys, argv, expected):
@@ -166,5 +170,34 @@ def test_export_and_search_never_replace_a_file_or_a_foreign_folder(tmp_path, ca
     assert "is a file; expected a folder" in capsys.readouterr().err
     assert keep.read_text(encoding="utf-8") == "mine"
     assert [p.name for p in foreign.iterdir()] == ["a.jpg"]
-    # An earlier design folder is still replaced in place.
-    assert main(["grammar", "export", str(design), "-o", str(design.parent)]) == 0
+    # An earlier design folder is replaced in place with --overwrite only.
+    assert main(["grammar", "export", str(design), "-o", str(design.parent)]) == 2
+    assert "give --overwrite to replace it" in capsys.readouterr().err
+    assert main(["grammar", "export", str(design), "-o", str(design.parent), "--overwrite"]) == 0
+
+
+def test_long_work_is_announced_and_shows_progress_with_time_left(capsys, monkeypatch):
+    from robotwright.grammar import cli as gcli
+
+    progress = gcli.Progress(10, "designs done", every=0.0)
+    progress.update(0)  # nothing done: no estimate yet
+    progress.update(4, ", best reach 0.5")
+    progress.update(10)  # the end is reported by the command itself
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and err[1].startswith("  4/10 designs done, best reach 0.5 (")
+    assert "left)" in err[1] and "left" not in err[0]
+    # Work estimated over a minute is announced before it runs; short work is not.
+    gcli._warn_long(gcli.LONG_WORK_S + 1, "enumerating 7 designs")
+    gcli._warn_long(gcli.LONG_WORK_S - 1, "enumerating 3 designs")
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("warning: enumerating 7 designs will take about 61 s")
+        and "3 designs" not in err
+    )
+    assert gcli._duration(3 * 3600) == "3 h" and gcli._duration(90) == "90 s"
+    # The command: every design passes through the progress; a slow rate makes the warning.
+    monkeypatch.setattr(gcli, "LONG_WORK_S", 0.0)
+    assert main(["grammar", "count", "--max-links", "2", "--enumerate"]) == 0
+    captured = capsys.readouterr()
+    assert "equal to count: True" in captured.out
+    assert captured.err.startswith("warning: enumerating 4800 designs will take about")

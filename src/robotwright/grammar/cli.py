@@ -9,8 +9,16 @@ import time
 from pathlib import Path
 
 from robotwright._atomic import check_output_path
-from robotwright._inputs import MAX_YAML_BYTES, read_text
+from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import GrammarError, InputFileError, Problem
+
+#: Largest ``--max-links`` the commands accept. Exact counting grows with the cube of
+#: the link count (bundled grammar: 50 links about 5 s, 100 links 40 s, 200 links
+#: minutes), and a limb of more than 50 links is no supernumerary limb. The Python API
+#: (robotwright.grammar.count, sample, ...) takes any size.
+MAX_LINKS = 50
+#: Work estimated to take longer than this [s] is announced with a warning first.
+LONG_WORK_S = 60.0
 
 
 def _int_at_least(low: int):
@@ -29,11 +37,75 @@ def _int_at_least(low: int):
     return parse
 
 
-def _check_design_dir(out: Path) -> None:
+def _max_links(text: str) -> int:
+    """``--max-links``: an integer from 0 to :data:`MAX_LINKS` (usage error, exit 2)."""
+    value = _int_at_least(0)(text)
+    if value > MAX_LINKS:
+        raise argparse.ArgumentTypeError(
+            f"expected at most {MAX_LINKS} (the limit of --max-links: counting and sampling "
+            f"grow with the cube of the link count), got {value}"
+        )
+    return value
+
+
+_MAX_LINKS_HELP = f"largest number of links in a design (0 to {MAX_LINKS})"
+
+
+def _duration(seconds: float) -> str:
+    """``42 s``, ``3.5 min``, ``2.1 h``, ``4.0 days``, ``1.2e+03 years``."""
+    for unit, size in (("years", 365.25 * 86400), ("days", 86400), ("h", 3600), ("min", 60)):
+        if seconds >= 2 * size:
+            value = seconds / size
+            return f"{value:.3g} {unit}" if value < 1e4 else f"{value:.2g} {unit}"
+    return f"{seconds:.0f} s"
+
+
+class Progress:
+    """Progress of ``total`` steps on stderr: at most one line every ``every`` seconds,
+    with the rate and the estimated time left."""
+
+    def __init__(self, total: int, what: str, every: float = 5.0) -> None:
+        self.total, self.what, self.every = total, what, every
+        self.t0 = time.perf_counter()
+        self._last = self.t0
+
+    def eta(self, done: int) -> float | None:
+        """Estimated seconds left after ``done`` steps (None before the first)."""
+        if done <= 0:
+            return None
+        elapsed = time.perf_counter() - self.t0
+        return elapsed / done * max(self.total - done, 0)
+
+    def update(self, done: int, extra: str = "") -> None:
+        now = time.perf_counter()
+        if now - self._last < self.every or done >= self.total:
+            return
+        self._last = now
+        left = self.eta(done)
+        eta = "" if left is None else f", about {_duration(left)} left"
+        print(
+            f"  {done}/{self.total} {self.what}{extra} ({_duration(now - self.t0)}{eta})",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+def _warn_long(estimate_s: float, what: str) -> None:
+    if estimate_s > LONG_WORK_S:
+        print(
+            f"warning: {what} will take about {_duration(estimate_s)} (estimated); "
+            "progress follows, Ctrl-C stops",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+def _check_design_dir(out: Path, overwrite: bool) -> None:
     """Refuse an output that would replace something that is not a design folder.
 
-    The design commands replace an earlier design folder in place; a file, or a
-    non-empty folder without ``design.txt``, is the user's data and is never replaced.
+    With ``--overwrite`` the design commands replace an earlier design folder; a file,
+    or a non-empty folder without ``design.txt``, is the user's data and is never
+    replaced.
     """
     check_output_path(out, folder=True)
     if out.exists() and not out.is_dir():
@@ -48,13 +120,16 @@ def _check_design_dir(out: Path) -> None:
                 )
             ]
         )
+    check_overwrite(out, overwrite)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "grammar",
         help="generate robot limbs (SRLs) from a graph grammar",
-        description="Check grammars, count, enumerate, sample and search limb designs.",
+        description="Check grammars, count, enumerate, sample and search limb designs, "
+        "show and export them. Without --grammar/--library the bundled SRL grammar and "
+        "component library are used.",
     )
     gsub = p.add_subparsers(dest="grammar_command", metavar="ACTION", required=True)
 
@@ -62,46 +137,107 @@ def register(sub: argparse._SubParsersAction) -> None:
         q.add_argument(
             "--grammar", type=Path, default=None, help="grammar YAML (default: bundled SRL grammar)"
         )
-        q.add_argument("--library", type=Path, default=None, help="component library YAML")
+        q.add_argument(
+            "--library",
+            type=Path,
+            default=None,
+            help="component library YAML (default: the grammar's, else the bundled library)",
+        )
 
-    q = gsub.add_parser("check", help="validate a grammar file and summarise it")
+    def seed(q: argparse.ArgumentParser, what: str) -> None:
+        q.add_argument(
+            "--seed",
+            type=int,
+            default=0,
+            help=f"random seed: the same seed gives the same {what} (default 0)",
+        )
+
+    q = gsub.add_parser(
+        "check",
+        help="validate a grammar file and summarise it",
+        description="Load a grammar YAML (and its component library), print every problem "
+        "found, or its symbols, rules and the number of designs of 0 to 3 links.",
+    )
     q.add_argument("file", type=Path, help="grammar YAML")
     q.add_argument("--library", type=Path, default=None, help="component library YAML")
     q.set_defaults(func=_check)
 
-    q = gsub.add_parser("count", help="exact number of designs up to a size")
-    common(q)
-    q.add_argument(
-        "--max-links", type=_int_at_least(0), required=True, help="largest number of links"
+    q = gsub.add_parser(
+        "count",
+        help="exact number of designs up to a size",
+        description="Count the designs with at most --max-links links exactly (total and "
+        "per link count); --enumerate also generates each one and reports the rate.",
     )
+    common(q)
+    q.add_argument("--max-links", type=_max_links, required=True, help=_MAX_LINKS_HELP)
     q.add_argument(
-        "--enumerate", action="store_true", help="also enumerate them and report the rate"
+        "--enumerate",
+        action="store_true",
+        help="also enumerate every design and check the count (slow beyond 4 links: "
+        "progress and an estimate are printed)",
     )
     q.set_defaults(func=_count)
 
-    q = gsub.add_parser("sample", help="draw designs uniformly and write their files")
+    q = gsub.add_parser(
+        "sample",
+        help="draw designs uniformly and write their files",
+        description="Draw -n designs uniformly at random among those with at most "
+        "--max-links links; write each one's MJCF, URDF, design text/JSON, tree and picture "
+        "into OUT/<number>_<hash>/.",
+    )
     common(q)
-    q.add_argument("--seed", type=int, default=0)
-    q.add_argument("-n", type=_int_at_least(1), default=1, help="number of designs")
-    q.add_argument("--max-links", type=_int_at_least(0), default=4)
+    seed(q, "designs")
+    q.add_argument(
+        "-n", type=_int_at_least(1), default=1, help="number of designs to draw (default 1)"
+    )
+    q.add_argument("--max-links", type=_max_links, default=4, help=f"{_MAX_LINKS_HELP}; default 4")
     q.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     q.add_argument("--no-picture", action="store_true", help="skip the PNG pictures")
+    add_overwrite_flag(q)
     q.set_defaults(func=_sample)
 
-    q = gsub.add_parser("search", help="search designs for an objective")
+    q = gsub.add_parser(
+        "search",
+        help="search designs for an objective",
+        description="Search the designs with at most --max-links links for the best value "
+        "of an objective under constraints; print the best design (and write its files "
+        "with -o).",
+    )
     common(q)
-    q.add_argument("--objective", default="reach", choices=["reach", "workspace", "mass", "dof"])
+    q.add_argument(
+        "--objective",
+        default="reach",
+        choices=["reach", "workspace", "mass", "dof"],
+        help="reach: farthest end point [m] (default); workspace: reachable volume "
+        "estimate [m^3]; mass: lightest [kg]; dof: most joints",
+    )
     q.add_argument(
         "--constraint",
         action="append",
         default=None,
-        help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable",
+        help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; "
+        "repeatable",
     )
-    q.add_argument("--budget", type=_int_at_least(1), default=100, help="designs to evaluate")
-    q.add_argument("--method", default="beam", choices=["beam", "mcts", "random"])
-    q.add_argument("--beam-width", type=_int_at_least(1), default=4)
-    q.add_argument("--max-links", type=_int_at_least(0), default=4)
-    q.add_argument("--seed", type=int, default=0)
+    q.add_argument(
+        "--budget",
+        type=_int_at_least(1),
+        default=100,
+        help="number of designs to evaluate (default 100)",
+    )
+    q.add_argument(
+        "--method",
+        default="beam",
+        choices=["beam", "mcts", "random"],
+        help="beam search (default), Monte Carlo tree search, or uniform random sampling",
+    )
+    q.add_argument(
+        "--beam-width",
+        type=_int_at_least(1),
+        default=4,
+        help="beam: partial designs kept per step (default 4)",
+    )
+    q.add_argument("--max-links", type=_max_links, default=4, help=f"{_MAX_LINKS_HELP}; default 4")
+    seed(q, "search")
     q.add_argument(
         "--workers",
         type=_int_at_least(1),
@@ -111,18 +247,30 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument(
         "-o", "--out", type=Path, default=None, help="write the best design's files here"
     )
+    add_overwrite_flag(q)
     q.set_defaults(func=_search)
 
-    q = gsub.add_parser("show", help="print a design: steps, tree, DH table per branch")
+    q = gsub.add_parser(
+        "show",
+        help="print a design: steps, tree, DH table per branch",
+        description="Print a design's derivation steps, its tree, its DoF and mass, and a "
+        "modified-DH table (Craig) per branch; --dot prints the tree as Graphviz DOT.",
+    )
     common(q)
     q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
     q.add_argument("--dot", action="store_true", help="print the design tree as Graphviz DOT only")
     q.set_defaults(func=_show)
 
-    q = gsub.add_parser("export", help="write the files of a design given as text or JSON")
+    q = gsub.add_parser(
+        "export",
+        help="write the files of a design given as text or JSON",
+        description="Build a design (design.txt or design.json, as sample and search write) "
+        "and write its MJCF, URDF, design text/JSON, tree and picture into a folder.",
+    )
     common(q)
     q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
-    q.add_argument("-o", "--out", type=Path, required=True)
+    q.add_argument("-o", "--out", type=Path, required=True, help="output folder")
+    add_overwrite_flag(q)
     q.set_defaults(func=_export)
 
 
@@ -162,17 +310,23 @@ def _check(args: argparse.Namespace) -> int:
 def _count(args: argparse.Namespace) -> int:
     from robotwright.grammar.derive import count, count_by_links, enumerate_designs
 
-    if args.max_links < 0:
-        print(f"error: --max-links must be >= 0, got {args.max_links}", file=sys.stderr)
-        return 2
     g = _grammar(args)
     total = count(g, args.max_links)
-    print(f"designs with at most {args.max_links} link(s): {total}")
-    print(f"by number of links: {count_by_links(g, args.max_links)}")
+    print(f"designs with at most {args.max_links} link(s): {total}", flush=True)
+    print(f"by number of links: {count_by_links(g, args.max_links)}", flush=True)
     if args.enumerate:
         t0 = time.perf_counter()
-        n = sum(1 for _ in enumerate_designs(g, args.max_links))
-        dt = time.perf_counter() - t0
+        progress = Progress(total, "designs enumerated")
+        calibrate = min(total, 2000)  # the rate of the first designs sets the estimate
+        n = 0
+        for _ in enumerate_designs(g, args.max_links):
+            n += 1
+            if n == calibrate:
+                left = progress.eta(n)
+                _warn_long(left or 0.0, f"enumerating {total} designs")
+            if not n % 1000:
+                progress.update(n)
+        dt = max(time.perf_counter() - t0, 1e-9)
         print(
             f"enumerated: {n} in {dt:.2f} s ({n / dt:.0f} designs/s); equal to count: {n == total}"
         )
@@ -190,31 +344,33 @@ def _sample(args: argparse.Namespace) -> int:
     check_output_path(args.out, folder=True)
     if args.out.exists() and not args.out.is_dir():
         raise GrammarError([Problem(str(args.out), "is a file; expected a folder for the designs")])
+    check_overwrite(args.out, args.overwrite)
     args.out.mkdir(parents=True, exist_ok=True)
+    progress = Progress(args.n, "designs written")
     for k in range(args.n):
         d = sample(g, args.max_links, rng, counter)
         folder = export_design(
             g, d, args.out / f"{k:03d}_{d.hash()}", picture=not args.no_picture, overwrite=True
         )
-        print(f"{folder}: {d}")
+        print(f"{folder}: {d}", flush=True)
+        if k == 0:
+            _warn_long((progress.eta(1) or 0.0), f"writing {args.n} designs")
+        progress.update(k + 1)
     return 0
 
 
-def _search_progress(budget: int, name: str, t0: float):
-    """A callback printing ``evaluated/budget, best`` to stderr at most twice a second."""
-    last = [0.0]
+def _search_progress(budget: int, name: str):
+    """A callback printing ``evaluated/budget, best, time left`` to stderr every 2 s at
+    most, with a warning once the first evaluations show the search will take long."""
+    progress = Progress(budget, "designs evaluated")
+    warned = [False]
 
     def show(n: int, best) -> None:
-        now = time.perf_counter()
-        if now - last[0] < 0.5 and n < budget:
-            return
-        last[0] = now
+        if not warned[0] and n >= min(budget, 8):
+            warned[0] = True
+            _warn_long(progress.eta(n) or 0.0, f"evaluating {budget} designs")
         score = "-" if best is None else f"{best.values[name]:.4f}"
-        print(
-            f"  {n}/{budget} designs evaluated, best {name} {score} ({now - t0:.1f} s)",
-            file=sys.stderr,
-            flush=True,
-        )
+        progress.update(n, f", best {name} {score}")
 
     return show
 
@@ -226,7 +382,7 @@ def _search(args: argparse.Namespace) -> int:
 
     g = _grammar(args)
     if args.out:
-        _check_design_dir(args.out)
+        _check_design_dir(args.out, args.overwrite)
     try:
         constraints = [make_constraint(c) for c in (args.constraint or ["no-self-collision"])]
     except ValueError as exc:
@@ -239,7 +395,7 @@ def _search(args: argparse.Namespace) -> int:
         max_links=args.max_links,
         seed=args.seed,
         workers=args.workers,
-        progress=_search_progress(args.budget, objective.name, t0),
+        progress=_search_progress(args.budget, objective.name),
     )
     if args.method == "beam":
         res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
@@ -263,6 +419,7 @@ def _search(args: argparse.Namespace) -> int:
 
 
 def _read_design(path: Path):
+    from robotwright._inputs import MAX_YAML_BYTES, read_text
     from robotwright.grammar.design import Design
 
     try:
@@ -316,7 +473,7 @@ def _export(args: argparse.Namespace) -> int:
     from robotwright.grammar.export import export_design
 
     g = _grammar(args)
-    _check_design_dir(args.out)
+    _check_design_dir(args.out, args.overwrite)
     d = _read_design(args.design)
     export_design(g, d, args.out, overwrite=True)
     print(f"{args.out}: {d.hash()}")

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from robotwright._atomic import check_output_path
+from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import ConversionError, SensorError
 from robotwright.sensors._names import PATTERN_NAMES
 
@@ -56,6 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--engine", choices=("mujoco", "warp"), default="mujoco", help="ray engine (default mujoco)"
     )
+    add_overwrite_flag(p)
     p.set_defaults(func=run)
 
 
@@ -81,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
             check_output_path(out)
             if not out.parent.is_dir():
                 raise SensorError(f"{out}: folder {out.parent} does not exist")
+    check_overwrite([args.output, args.png], args.overwrite)
     try:
         # MuJoCo's own parser expands XML entities: refuse them first (entity bombs).
         parse_xml(args.scene)
