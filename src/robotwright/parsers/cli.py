@@ -27,7 +27,17 @@ def _options(args: argparse.Namespace) -> dict:
             opts[name] = True
     if getattr(args, "actuators", None):
         opts["actuators"] = args.actuators
+    if getattr(args, "xacro_arg", None):
+        opts["xacro_args"] = dict(args.xacro_arg)
     return opts
+
+
+def _xacro_arg(text: str) -> tuple[str, str]:
+    """``name:=value`` (xacro's own syntax) of ``--xacro-arg``."""
+    name, sep, value = text.partition(":=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected NAME:=VALUE")
+    return name.strip(), value
 
 
 def _source_args(p: argparse.ArgumentParser) -> None:
@@ -43,6 +53,13 @@ def _source_args(p: argparse.ArgumentParser) -> None:
         choices=("none", "motor"),
         help="URDF sources: none (default; URDF has no actuators) or one torque motor per "
         "moving joint with an effort limit (peak torque = effort)",
+    )
+    p.add_argument(
+        "--xacro-arg",
+        action="append",
+        type=_xacro_arg,
+        metavar="NAME:=VALUE",
+        help=".xacro sources: value of $(arg NAME) (repeat for several)",
     )
     p.add_argument(
         "--root-body",
@@ -85,7 +102,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Convert SRC to DST; the type comes from the extension (.urdf, .xml = "
         "MJCF) or is an HRDF folder. Every dropped or approximated element is printed.",
     )
-    p.add_argument("src", help="source .urdf, .xml (MJCF) or HRDF folder")
+    p.add_argument("src", help="source .urdf, .xml (MJCF), HRDF folder or bundled robot name")
     p.add_argument(
         "-o",
         "--output",
@@ -131,10 +148,16 @@ def _convert(args: argparse.Namespace) -> int:
 
     logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
     check_overwrite(args.output, args.overwrite)
+    source = Path(args.src)
+    if not source.exists() and source.suffix.lower() not in (".urdf", ".xml"):
+        # Not a file: a robot name (bundled or under $HURODES_ASSETS_PATH), as export takes.
+        from robotwright.hrdf.assets import resolve_robot
+
+        source = resolve_robot(args.src)
     # An existing empty folder holds nothing to lose: the rule lets it be written into.
     overwrite = args.overwrite or Path(args.output).is_dir()
     messages = convert(
-        args.src, args.output, strict=args.strict, overwrite=overwrite, **_options(args)
+        source, args.output, strict=args.strict, overwrite=overwrite, **_options(args)
     )
     # Reported like every command's losses: one summary line, each with -v.
     for m in messages:

@@ -1,0 +1,189 @@
+"""The ``robotwright`` entry point: start-up imports, --version, notes, overwrite rule,
+names, format from the file name."""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+import robotwright
+from robotwright.cli import build_parser, main
+from robotwright.generators import MJCFHumanoidGenerator
+from robotwright.hrdf import HRDF
+
+HEAVY = ("mujoco", "numpy", "trimesh", "matplotlib", "warp", "mujoco_warp", "torch", "scipy")
+
+
+def test_building_the_parser_imports_no_heavy_library() -> None:
+    # In a fresh interpreter: `robotwright --help` must not pay for MuJoCo or numpy.
+    code = (
+        "import sys\n"
+        "import robotwright.cli as cli\n"
+        "parser = cli.build_parser()\n"
+        "for command in parser._subparsers._group_actions[0].choices.values():\n"
+        "    command.format_help()\n"
+        f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == "[]"
+
+
+def test_every_option_has_help(capsys) -> None:
+    parser = build_parser()
+    from robotwright.cli import _all_parsers
+
+    missing = [
+        f"{p.prog} {'/'.join(a.option_strings) or a.dest}"
+        for p in _all_parsers(parser)
+        for a in p._actions
+        if not a.help and not isinstance(a, argparse._SubParsersAction)
+    ]
+    assert missing == []
+
+
+def test_version(capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"robotwright {robotwright.__version__} (MuJoCo {mujoco.__version__}")
+
+
+def test_misspelt_command_and_choice_suggest_the_close_name(capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["exprot", "arm6"])
+    assert exc.value.code == 2
+    assert "did you mean 'export'?" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["grammar", "search", "--objective", "reac"])
+    assert "did you mean 'reach'?" in capsys.readouterr().err
+
+
+def test_unknown_robot_suggests_the_close_name(capsys) -> None:
+    assert main(["info", "mini_humanoi"]) == 2
+    err = capsys.readouterr().err
+    assert "no robot named 'mini_humanoi'" in err and "did you mean 'mini_humanoid'?" in err
+    assert "Traceback" not in err
+
+
+def test_notes_one_summary_line_and_every_note_with_v(tmp_path: Path, capsys) -> None:
+    argv = ["export", "mini_humanoid", "--format", "urdf", "--copy-meshes"]
+    assert main([*argv, "-o", str(tmp_path / "a.urdf")]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("wrote ")
+    (line,) = captured.err.splitlines()
+    count = int(line.split()[0])
+    assert count > 40 and "joint.csv armature" in line and "-v lists each" in line
+    # `-v` before or after the command: each note on its own line, then the same summary.
+    for verbose in (["-v", *argv], [*argv, "--verbose"]):
+        out = tmp_path / f"{len(verbose[0])}.urdf"
+        assert main([*verbose, "-o", str(out)]) == 0
+        err = capsys.readouterr().err.splitlines()
+        assert sum(e.startswith("note: ") for e in err) == count == int(err[-1].split()[0])
+
+
+def test_format_follows_the_output_extension(tmp_path: Path, capsys) -> None:
+    assert main(["export", "arm6", "-o", str(tmp_path / "arm.urdf")]) == 0
+    assert "(urdf, robot 'arm6'" in capsys.readouterr().out
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "arm.urdf"))
+    hrdf = HRDF.from_robot_name("arm6")
+    assert model.njnt == len(hrdf.joints)
+    assert np.isclose(model.body_mass.sum(), hrdf.total_mass)
+    assert main(["compose", "arm6", "-o", str(tmp_path / "scene.mjcf")]) == 0
+    assert "(mjcf, robots: arm6)" in capsys.readouterr().out
+    assert main(["export", "arm6", "-o", str(tmp_path / "arm.sdf")]) == 2
+    assert "cannot tell the format from '.sdf'" in capsys.readouterr().err
+
+
+def test_things_takes_a_bundled_robot_name(tmp_path: Path, capsys) -> None:
+    assert main(["things", "arm6", str(tmp_path / "arm.xml")]) == 0
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "arm.xml"))
+    reference = MJCFHumanoidGenerator.from_robot_name("arm6").to_model()
+    assert model.nu == reference.nu and model.njnt == reference.njnt
+    assert np.allclose(model.body_mass, reference.body_mass)
+    assert np.allclose(model.body_inertia, reference.body_inertia)
+    assert main(["things", "arm7", str(tmp_path / "x.xml")]) == 2
+    assert "did you mean 'arm6'?" in capsys.readouterr().err
+
+
+def _scene(tmp_path: Path) -> Path:
+    scene = tmp_path / "scene.xml"
+    assert main(["compose", "mini_humanoid", "-o", str(scene)]) == 0
+    return scene
+
+
+def test_lidar_unknown_sensor_suggests_the_prefixed_site(tmp_path: Path, capsys) -> None:
+    scene = _scene(tmp_path)
+    argv = ["lidar", str(scene), "--sensor", "head_lidar", "-o", str(tmp_path / "s.npz")]
+    assert main(argv) == 2
+    assert "did you mean 'mini_humanoid_head_lidar'?" in capsys.readouterr().err
+    assert not (tmp_path / "s.npz").exists()
+
+
+def _cases(tmp_path: Path) -> list[tuple[list[str], Path]]:
+    """(argv, output) of every command that writes one output."""
+    scene = _scene(tmp_path)
+    design = tmp_path / "design.txt"
+    design.write_text("# grammar=srl\n", encoding="utf-8")
+    return [
+        (["export", "arm6", "-o", "{out}.xml"], Path("{out}.xml")),
+        (["compose", "arm6", "mini_humanoid", "-o", "{out}.xml"], Path("{out}.xml")),
+        (["convert", "arm6", "-o", "{out}.urdf"], Path("{out}.urdf")),
+        (["convert", "arm6", "-o", "{out}"], Path("{out}")),
+        (["things", "arm6", "{out}.xml"], Path("{out}.xml")),
+        (["things", "arm6", "{out}"], Path("{out}")),
+        (
+            ["lidar", str(scene), "--sensor", "mini_humanoid_head_lidar", "--pattern", "grid"]
+            + ["-o", "{out}.npz"],
+            Path("{out}.npz"),
+        ),
+        (["grammar", "sample", "--no-picture", "--max-links", "2", "-o", "{out}"], Path("{out}")),
+    ]
+
+
+def test_one_overwrite_rule_for_every_command(tmp_path: Path, capsys) -> None:
+    for i, (argv, output) in enumerate(_cases(tmp_path)):
+        out = str(tmp_path / f"out{i}")
+        argv = [a.replace("{out}", out) for a in argv]
+        target = Path(str(output).replace("{out}", out))
+        # A file (or a non-empty folder) is kept as it is, with exit 2 naming the flag.
+        if target.suffix:
+            target.write_text("mine", encoding="utf-8")
+        else:
+            target.mkdir()
+            (target / "mine.txt").write_text("mine", encoding="utf-8")
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert f"{target}: " in err and "give --overwrite to replace it" in err, err
+        kept = target if target.suffix else target / "mine.txt"
+        assert kept.read_text(encoding="utf-8") == "mine"
+        # --overwrite replaces it.
+        assert main([*argv, "--overwrite"]) == 0, (argv, capsys.readouterr().err)
+        capsys.readouterr()
+        if target.suffix:
+            assert target.read_bytes() != b"mine"
+        # An empty folder holds nothing to lose: it is written into.
+        if not target.suffix:
+            empty = tmp_path / f"empty{i}"
+            empty.mkdir()
+            assert main([a.replace(out, str(empty)) for a in argv]) == 0, argv
+            assert any(empty.iterdir())
+            capsys.readouterr()
+
+
+def test_interrupt_is_one_line_and_exit_130(monkeypatch, capsys) -> None:
+    from robotwright.hrdf import cli as hrdf_cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(hrdf_cli, "_info", interrupted)
+    assert main(["info", "arm6"]) == 130
+    assert capsys.readouterr().err == "interrupted\n"
