@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterable
 
 __all__ = ["close_names", "did_you_mean"]
@@ -12,6 +11,8 @@ def close_names(name: str, candidates: Iterable[str], n: int = 3) -> list[str]:
     """Up to ``n`` candidates close to ``name``: those that contain it or end with it
     (``head_lidar`` -> ``mini_humanoid_head_lidar``, the prefixed name a composite
     writes), then difflib's close matches; case-insensitive, in that order."""
+    import difflib  # only when a name is unknown: not on every start-up
+
     names = sorted({c for c in candidates if c})
     key = name.lower()
     if not key:

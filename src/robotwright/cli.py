@@ -12,7 +12,6 @@ import importlib
 import platform
 import sys
 from collections.abc import Iterator, Sequence
-from importlib import metadata
 from typing import Any
 
 from robotwright import __version__
@@ -62,12 +61,24 @@ class _Parser(argparse.ArgumentParser):
             )
 
 
-def _version() -> str:
-    try:
-        mujoco = metadata.version("mujoco")
-    except metadata.PackageNotFoundError:
-        mujoco = "not installed"
-    return f"robotwright {__version__} (MuJoCo {mujoco}, Python {platform.python_version()})"
+class _VersionAction(argparse.Action):
+    """``--version``: robotwright's, MuJoCo's and Python's versions (read when asked:
+    importlib.metadata costs start-up time every other command would pay)."""
+
+    def __init__(self, option_strings: list[str], dest: str = argparse.SUPPRESS, **kw: Any):
+        kw.setdefault("help", "print the versions of robotwright, MuJoCo and Python and exit")
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kw)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: Any) -> None:
+        from importlib import metadata
+
+        try:
+            mujoco = metadata.version("mujoco")
+        except metadata.PackageNotFoundError:
+            mujoco = "not installed"
+        version = f"robotwright {__version__} (MuJoCo {mujoco}, Python {platform.python_version()})"
+        print(version)
+        parser.exit()
 
 
 def _all_parsers(parser: argparse.ArgumentParser) -> Iterator[argparse.ArgumentParser]:
@@ -87,7 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Describe, generate, compose and sense robots for simulation.",
         epilog="Run 'robotwright COMMAND --help' for a command's options.",
     )
-    parser.add_argument("--version", action="version", version=_version())
+    parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for module_name in _COMMAND_MODULES:
         importlib.import_module(module_name).register(sub)

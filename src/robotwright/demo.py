@@ -19,9 +19,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from robotwright._notes import notes_of
-from robotwright.hrdf.cli import format_info
-from robotwright.hrdf.io import HRDFWarning
-from robotwright.hrdf.model import HRDF
 
 if TYPE_CHECKING:  # MuJoCo and Things load when the demo runs, not with `robotwright --help`
     from robotwright.things import World
@@ -41,6 +38,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def step_hrdf(out: Path, ctx: dict[str, Any]) -> str:
+    from robotwright.hrdf.cli import format_info
+    from robotwright.hrdf.io import HRDFWarning
+    from robotwright.hrdf.model import HRDF
+
     lines = []
     for name in ("mini_humanoid", "arm6"):
         with warnings.catch_warnings():
@@ -142,6 +143,11 @@ def step_lidar(out: Path, ctx: dict[str, Any]) -> str:
     from robotwright.sensors import scan_to_files
 
     (out / "lidar").mkdir(parents=True, exist_ok=True)
+    # The mapping is saved so that `robotwright lidar ... --mapping classes.json` labels
+    # the same scene exactly as the demo does (labels come from the mapping alone).
+    (out / "lidar" / "classes.json").write_text(
+        json.dumps(DEMO_CLASSES, indent=2) + "\n", encoding="utf-8"
+    )
     summary = scan_to_files(
         ctx["scene_model"],
         ctx["scene_data"],

@@ -5,16 +5,21 @@
 >>> gen.export("out/robot.xml")                                     # doctest: +SKIP
 """
 
-from robotwright.generators.base import GeneratorBase
-from robotwright.generators.composite import MJCFGeneratorComposite
-from robotwright.generators.composite_urdf import URDFGeneratorComposite
-from robotwright.generators.mixin import HRDFMixin
-from robotwright.generators.mjcf import MJCFHumanoidGenerator
-from robotwright.generators.mjcf_base import DEFAULT_SCENE, MJCFGeneratorBase, SceneDefaults
-from robotwright.generators.placement import Placement
-from robotwright.generators.tasks import compose_scene, export_robot
-from robotwright.generators.urdf import URDFHumanoidGenerator
-from robotwright.generators.urdf_base import URDFGeneratorBase
+from typing import TYPE_CHECKING
+
+from robotwright._lazy import attach
+
+if TYPE_CHECKING:
+    from robotwright.generators.base import GeneratorBase
+    from robotwright.generators.composite import MJCFGeneratorComposite
+    from robotwright.generators.composite_urdf import URDFGeneratorComposite
+    from robotwright.generators.mixin import HRDFMixin
+    from robotwright.generators.mjcf import MJCFHumanoidGenerator
+    from robotwright.generators.mjcf_base import DEFAULT_SCENE, MJCFGeneratorBase, SceneDefaults
+    from robotwright.generators.placement import Placement
+    from robotwright.generators.tasks import compose_scene, export_robot
+    from robotwright.generators.urdf import URDFHumanoidGenerator
+    from robotwright.generators.urdf_base import URDFGeneratorBase
 
 __all__ = [
     "DEFAULT_SCENE",
@@ -31,3 +36,5 @@ __all__ = [
     "compose_scene",
     "export_robot",
 ]
+
+attach(__name__, __file__)

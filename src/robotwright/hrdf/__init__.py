@@ -1,27 +1,32 @@
 """HRDF: the folder-based robot description (hurodes-compatible, extended)."""
 
-from robotwright.hrdf.model import (
-    ACTUATOR_TYPES,
-    FORMAT_VERSION,
-    FRAME_OBJTYPES,
-    HRDF,
-    JOINT_TYPES,
-    SENSOR_OBJTYPES,
-    SIMPLE_GEOM_TYPES,
-    Actuator,
-    Body,
-    BodyNameConfig,
-    Geom,
-    GroundConfig,
-    ImuConfig,
-    Joint,
-    MeshGeom,
-    Meta,
-    Sensor,
-    SimpleGeom,
-    SimulatorConfig,
-    Site,
-)
+from typing import TYPE_CHECKING
+
+from robotwright._lazy import attach
+
+if TYPE_CHECKING:
+    from robotwright.hrdf.model import (
+        ACTUATOR_TYPES,
+        FORMAT_VERSION,
+        FRAME_OBJTYPES,
+        HRDF,
+        JOINT_TYPES,
+        SENSOR_OBJTYPES,
+        SIMPLE_GEOM_TYPES,
+        Actuator,
+        Body,
+        BodyNameConfig,
+        Geom,
+        GroundConfig,
+        ImuConfig,
+        Joint,
+        MeshGeom,
+        Meta,
+        Sensor,
+        SimpleGeom,
+        SimulatorConfig,
+        Site,
+    )
 
 __all__ = [
     "ACTUATOR_TYPES",
@@ -45,3 +50,5 @@ __all__ = [
     "SimulatorConfig",
     "Site",
 ]
+
+attach(__name__, __file__)

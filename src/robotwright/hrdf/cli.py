@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import argparse
 import warnings
+from typing import TYPE_CHECKING
 
-from robotwright.hrdf.assets import resolve_robot
-from robotwright.hrdf.io import HRDFWarning
-from robotwright.hrdf.model import HRDF
-from robotwright.hrdf.validate import validate_dir
+if TYPE_CHECKING:  # the readers load when a command runs, not with `robotwright --help`
+    from robotwright.hrdf.model import HRDF
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -31,6 +30,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _validate(args: argparse.Namespace) -> int:
+    from robotwright.hrdf.assets import resolve_robot
+    from robotwright.hrdf.validate import validate_dir
+
     path = resolve_robot(args.path)
     problems = validate_dir(path)
     errors = [p for p in problems if p.severity == "error"]
@@ -96,6 +98,10 @@ def format_info(hrdf: HRDF) -> str:
 
 
 def _info(args: argparse.Namespace) -> int:
+    from robotwright.hrdf.assets import resolve_robot
+    from robotwright.hrdf.io import HRDFWarning
+    from robotwright.hrdf.model import HRDF
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HRDFWarning)
         hrdf = HRDF.from_dir(resolve_robot(args.robot))
