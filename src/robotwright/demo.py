@@ -162,6 +162,14 @@ def step_lidar(out: Path, ctx: dict[str, Any]) -> str:
     return f"{summary['num_hits']} of {summary['num_rays']} rays hit: {counts}"
 
 
+def step_pictures(out: Path, ctx: dict[str, Any]) -> str:
+    """Shaded pictures of each robot, of the furnished scene, and of the scene with the
+    LiDAR points drawn in it (robotwright.render; no display needed)."""
+    from robotwright.render.demo import demo_pictures
+
+    return demo_pictures(out / "pictures", ctx, out / "lidar" / "scan.npz", DEMO_CLASSES)
+
+
 #: The seed's default classes, plus the other robot in the scene.
 DEMO_CLASSES: dict[str, list[str]] = {
     "terrain": ["ground", "wall", "floor", "plane"],
@@ -229,6 +237,7 @@ STEPS: list[tuple[str, Callable[[Path, dict[str, Any]], str]]] = [
     ("grow a limb with the grammar and mount it", step_limb),
     ("compose a scene and furnish it (composite + Things)", step_scene),
     ("semantic LiDAR scan (sensors)", step_lidar),
+    ("pictures of the robots and the scene (render)", step_pictures),
 ]
 
 

@@ -48,11 +48,12 @@ def save_png(
     # Text size [pt] follows the picture: 1/45 of its smaller side (about 10 pt at 600 px).
     size = max(6.0, min(w, h) / 45 * 72 / _DPI)
     if title:
+        # Top left: a free camera centres the robot, so the corner is the emptiest place.
         fig.text(
-            0.5,
+            0.012,
             1.0 - 0.012,
             title,
-            ha="center",
+            ha="left",
             va="top",
             fontsize=size * 1.15,
             bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none", "pad": 3},

@@ -9,7 +9,7 @@ import numpy as np
 
 from robotwright._atomic import atomic_open
 
-__all__ = ["plot_scan"]
+__all__ = ["class_color", "plot_scan"]
 
 # Fixed colours so the same class looks the same in every picture (class 0 = unknown).
 _COLORS = [
@@ -23,6 +23,11 @@ _COLORS = [
     "#17becf",
     "#e377c2",
 ]
+
+
+def class_color(cls_id: int) -> str:
+    """The colour (hex) of semantic class ``cls_id`` in every scan picture."""
+    return _COLORS[cls_id % len(_COLORS)]
 
 
 def plot_scan(
