@@ -57,14 +57,36 @@ def quat_to_rpy(q: Quat) -> Vec3:
 @lru_cache(maxsize=4096)
 def inertia_tensor(diag: Vec3, q: Quat) -> tuple[float, float, float, float, float, float]:
     """Full inertia tensor ``R diag(I) R^T`` of principal moments ``diag`` in frame ``q``,
-    as URDF's ``(ixx, ixy, ixz, iyy, iyz, izz)``."""
+    as URDF's ``(ixx, ixy, ixz, iyy, iyz, izz)``.
+
+    Moments on the edge of the triangle inequality (``A + B == C``, a rod, a flat plate:
+    common in musculoskeletal models) come back from a reader's diagonalisation of the
+    rotated tensor as ``A + B < C`` by rounding (~1e-18), which MuJoCo refuses. Such a
+    tensor gets ``1e-14 * max(diag)`` added on its diagonal (each moment raised by that
+    much), so that it stays physical through any reader's rounding.
+    """
     r = quat_to_matrix(q)
     a, b, c = diag
+    big = max(a, b, c)
+    rotated = any(abs(r[i][j]) not in (0.0, 1.0) for i in range(3) for j in range(3))
+    pad = 0.0
+    if rotated and min(a + b - c, b + c - a, c + a - b) <= _EDGE_RTOL * big:
+        pad = _PAD_RTOL * big
 
     def e(i: int, j: int) -> float:
-        return r[i][0] * a * r[j][0] + r[i][1] * b * r[j][1] + r[i][2] * c * r[j][2]
+        return (
+            r[i][0] * a * r[j][0]
+            + r[i][1] * b * r[j][1]
+            + r[i][2] * c * r[j][2]
+            + (pad if i == j else 0.0)
+        )
 
     return (e(0, 0), e(0, 1), e(0, 2), e(1, 1), e(1, 2), e(2, 2))
+
+
+#: Triangle slack (relative) below which a rotated tensor is padded, and the padding.
+_EDGE_RTOL = 1e-12
+_PAD_RTOL = 1e-14
 
 
 class URDFGeneratorBase(GeneratorBase):

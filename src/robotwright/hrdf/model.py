@@ -122,7 +122,8 @@ class Body:
         parent: index of the parent body in ``HRDF.bodies``; -1 for the root.
         pos: position of the body frame in the parent frame (m).
         quat: orientation of the body frame in the parent frame (w, x, y, z).
-        mass: mass (kg), > 0.
+        mass: mass (kg), >= 0. MuJoCo's rule applies: a body with joints needs mass and
+            inertia (>= 1e-15) itself or in a body welded to it (no joint between them).
         inertial_pos: centre of mass in the body frame (m).
         inertial_quat: orientation of the principal inertia frame in the body frame.
         diag_inertia: principal moments of inertia about the centre of mass (kg m^2).

@@ -27,7 +27,8 @@ def diagonalize(tensor: np.ndarray) -> tuple[Vec3, Quat]:
     """Principal moments and principal-frame orientation of a symmetric 3x3 tensor.
 
     The eigenvector matrix is made a proper rotation (determinant +1) so that it maps to
-    a quaternion. Eigenvalues are returned as computed: a non-physical tensor (negative
+    a quaternion. Eigenvalues are returned as computed, except round-off around zero
+    (below 16 eps times the largest) which is zero: a non-physical tensor (negative
     moment, triangle inequality violated) is not altered here; callers decide.
     """
     sym = 0.5 * (np.asarray(tensor, dtype=float) + np.asarray(tensor, dtype=float).T)
@@ -38,6 +39,9 @@ def diagonalize(tensor: np.ndarray) -> tuple[Vec3, Quat]:
         d = np.diag(sym)
         return (float(d[0]), float(d[1]), float(d[2])), (1.0, 0.0, 0.0, 0.0)
     values, vectors = np.linalg.eigh(sym)
+    # A zero moment (a rod, a point) comes out of eigh as +-1e-22 or so: round-off of the
+    # size eps * |I|, which would read as a negative moment; it is zero.
+    values[np.abs(values) <= 16 * np.finfo(float).eps * np.abs(values).max()] = 0.0
     if np.linalg.det(vectors) < 0:
         vectors[:, 2] = -vectors[:, 2]
     return (float(values[0]), float(values[1]), float(values[2])), mat_to_quat(vectors)
