@@ -338,3 +338,54 @@ def test_urdf_floating_base_option_names_the_joint_alike(tmp_path: Path) -> None
     URDFHumanoidGenerator.from_hrdf(hrdf).export(tmp_path / "out.urdf")
     out = ET.parse(tmp_path / "out.urdf").getroot()
     assert [j.get("name") for j in out.iter("joint")] == ["floating_base"]
+
+
+# -- 10. tendons and actuators through sites of the world -----------------------------------
+ARM_MUSCLES = """<mujoco model="arm26ish">
+  <compiler angle="radian"/>
+  <worldbody>
+    <site name="origin_a" pos="0.01 0.02 0.9" quat="0.9 0.1 0.3 0.2"/>
+    <site name="origin_b" pos="-0.02 0.01 1.1"/>
+    <body name="thorax" pos="0 0 1" quat="0.8 0 0.6 0">
+      <geom type="sphere" size=".05" mass="2"/>
+      <body name="upper" pos="0 0 -.05"><joint name="shoulder" axis="0 1 0" range="-1 2"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -.3" size=".03"/>
+        <site name="insert_a" pos="0.02 0 -.2"/>
+        <body name="lower" pos="0 0 -.3"><joint name="elbow" axis="0 1 0" range="0 2"/>
+          <geom type="capsule" fromto="0 0 0 0 0 -.25" size=".025"/>
+          <site name="insert_b" pos="-0.02 0 -.1"/></body></body></body>
+    <body name="target" pos="1 0 1"><geom type="sphere" size=".02" mass=".1"/></body>
+  </worldbody>
+  <tendon>
+    <spatial name="flexor" width=".005"><site site="origin_a"/><site site="insert_a"/></spatial>
+    <spatial name="biceps" width=".005"><site site="origin_b"/><site site="insert_b"/></spatial>
+  </tendon>
+  <actuator>
+    <muscle name="flexor" tendon="flexor" lengthrange=".1 .5"/>
+    <muscle name="biceps" tendon="biceps" lengthrange=".1 .5"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_world_sites_of_muscles_kept_on_a_fixed_root(tmp_path: Path) -> None:
+    """A musculoskeletal arm whose muscles start at sites of the world: with
+    root_body='thorax' (the world also holds a target) every tendon and muscle is kept,
+    and the round trip is exact (tendon lengths, muscle parameters, site FK)."""
+    path = tmp_path / "arm.xml"
+    path.write_text(ARM_MUSCLES)
+    result = mjcf_to_hrdf_with_warnings(path, root_body="thorax")
+    sites = {s.name: s.body for s in result.hrdf.sites}
+    assert sites["origin_a"] == sites["origin_b"] == "thorax"
+    assert sum("site of the world kept" in w for w in _warnings(result)) == 2
+    report = roundtrip(path, configs=20, root_body="thorax", urdf=False)
+    assert report.ok, report.table()
+    assert "tendons 2" in report.table()
+
+
+def test_world_sites_dropped_with_reason_when_the_root_moves(tmp_path: Path) -> None:
+    path = tmp_path / "arm.xml"
+    path.write_text(ARM_MUSCLES.replace('quat="0.8 0 0.6 0">', 'quat="0.8 0 0.6 0"><freejoint/>'))
+    result = mjcf_to_hrdf_with_warnings(path, root_body="thorax")
+    lost = [w for w in _warnings(result) if "but the robot's root moves" in w]
+    assert len(lost) == 2

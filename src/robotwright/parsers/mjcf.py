@@ -692,18 +692,62 @@ def _geoms(
     return meshes, simple
 
 
-def _sites(model: mujoco.MjModel, kept: set[int], frames: set[int], rep: Reporter) -> list[Site]:
-    """Sites of the robot's bodies, and one per frame body turned into a site."""
+def _routing_sites(model: mujoco.MjModel) -> set[int]:
+    """Sites that tendons (path points, side sites) and actuators (site transmission,
+    reference site) go through."""
+    out: set[int] = set()
+    for w in range(model.nwrap):
+        if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_SITE:
+            out.add(int(model.wrap_objid[w]))
+        elif model.wrap_type[w] in (mujoco.mjtWrap.mjWRAP_SPHERE, mujoco.mjtWrap.mjWRAP_CYLINDER):
+            side = int(model.wrap_prm[w])
+            if side >= 0:
+                out.add(side)
+    for a in range(model.nu):
+        if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_SITE:
+            out.update(int(x) for x in model.actuator_trnid[a] if x >= 0)
+    return out
+
+
+def _sites(
+    model: mujoco.MjModel, kept: set[int], frames: set[int], root_id: int, rep: Reporter
+) -> list[Site]:
+    """Sites of the robot's bodies, and one per frame body turned into a site. A site of
+    the world that a tendon or actuator goes through (muscle origins) is kept on the
+    root body when the root is fixed to the world (the same place, as it never moves)."""
     sites: list[Site] = []
+    routing = _routing_sites(model) if model.site_bodyid.size else set()
+    fixed_root = int(model.body_jntnum[root_id]) == 0 and model.body_parentid[root_id] == 0
     for s in range(model.nsite):
         b = int(model.site_bodyid[s])
         sname = model.site(s).name or f"site_{s}"
-        if b == 0 or b not in kept:
-            rep.warn("site outside the robot dropped", f'<site name="{sname}">')
+        if b == 0 and s in routing and fixed_root:
+            # World frame -> root frame: p' = R^T (p - p_root), q' = q_root^-1 q.
+            rq = model.body_quat[root_id]
+            inv = np.array([rq[0], -rq[1], -rq[2], -rq[3]])
+            rot = inr.quat_to_mat(rq)
+            pos = _t3(rot.T @ (model.site_pos[s] - model.body_pos[root_id]))
+            quat = _t4(inr.mul_quat(inv, model.site_quat[s]))
+            rep.warn(
+                f"site of the world kept on the root body '{body_name(model, root_id)}' (a "
+                "tendon or actuator goes through it; the root is fixed, so it is the same "
+                "place)",
+                f'<site name="{sname}">',
+            )
+            b, site_pos, site_quat = root_id, pos, quat
+        elif b == 0 or b not in kept:
+            why = (
+                " (a tendon or actuator goes through it, but the robot's root moves)"
+                if b == 0 and s in routing
+                else ""
+            )
+            rep.warn(f"site outside the robot dropped{why}", f'<site name="{sname}">')
             continue
+        else:
+            site_pos, site_quat = model.site_pos[s], model.site_quat[s]
         if not model.site(s).name:
             rep.warn(f"unnamed site named '{sname}'", f"site #{s}")
-        owner, pos, quat = _reparent(model, b, model.site_pos[s], model.site_quat[s], frames)
+        owner, pos, quat = _reparent(model, b, site_pos, site_quat, frames)
         sites.append(
             Site(
                 name=sname,
@@ -854,7 +898,7 @@ def parse_mjcf(
     joints = _joints(model, kept, root_id, path, rep)
     store = mesh_store(opt.work_dir, opt.join_obj_objects)
     meshes, simple = _geoms(model, spec, kept, path, store, frames, rep)
-    sites = _sites(model, kept, frames, rep)
+    sites = _sites(model, kept, frames, root_id, rep)
     names = {
         "joint": {j.name for j in joints if j.name},
         "tendon": {model.tendon(t).name for t in range(model.ntendon) if model.tendon(t).name},
