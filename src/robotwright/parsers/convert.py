@@ -20,14 +20,18 @@ from robotwright.hrdf.model import HRDF
 def file_kind(path: Path, *, existing: bool) -> str:
     """``"urdf"``, ``"mjcf"`` or ``"hrdf"`` from the extension (a folder is HRDF)."""
     ext = path.suffix.lower()
-    if ext == ".urdf":
+    if ext in (".urdf", ".xacro"):  # .xacro / .urdf.xacro: expanded to URDF first
         return "urdf"
     if ext in (".xml", ".mjcf"):
         return "mjcf"
     if (existing and path.is_dir()) or (not existing and ext == ""):
         return "hrdf"
     raise ConversionError(
-        [Problem(str(path), "expected a .urdf file, a .xml (MJCF) file or an HRDF folder")]
+        [
+            Problem(
+                str(path), "expected a .urdf or .xacro file, a .xml (MJCF) file or an HRDF folder"
+            )
+        ]
     )
 
 

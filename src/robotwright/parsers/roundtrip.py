@@ -35,6 +35,7 @@ from robotwright.parsers.reference import (
     urdf_yourdfpy_view,
     view_from_model,
 )
+from robotwright.parsers.xacro import is_xacro, xacro_as_urdf
 
 TOL_EXACT = 1e-9
 TOL_URDF = 1e-6
@@ -596,8 +597,8 @@ def _check_input(path: Path, configs: int) -> None:
         raise ConversionError(
             [Problem(str(path), f"configs: expected at least 1 configuration, got {configs}")]
         )
-    if path.suffix.lower() not in (".urdf", ".xml", ".mjcf"):
-        raise ConversionError([Problem(str(path), "expected a .urdf or .xml (MJCF) file")])
+    if path.suffix.lower() not in (".urdf", ".xml", ".mjcf", ".xacro"):
+        raise ConversionError([Problem(str(path), "expected a .urdf, .xacro or .xml (MJCF) file")])
     if not path.is_file():
         what = (
             "is a folder"
@@ -615,6 +616,8 @@ def _roundtrip(
 ) -> RoundTripReport:
     report = RoundTripReport(str(path), "")
     try:
+        if is_xacro(path):  # the references read a URDF file: expand it into work_dir
+            path, options = xacro_as_urdf(path, options)
         result = parse_source(path, **options)
     except Exception as exc:  # the table reports any failure with its reason
         report.error = f"parse failed: {type(exc).__name__}: {exc}"

@@ -39,7 +39,8 @@ from robotwright.parsers.meshes import MeshConversionError, conversion_note, mes
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
 from robotwright.parsers.visuals import drop_unbuildable_visuals
-from robotwright.parsers.xmlsafe import describe, parse_xml
+from robotwright.parsers.xacro import read_robot_xml
+from robotwright.parsers.xmlsafe import describe
 
 VISUAL_GROUP = 2
 #: Joints from a root link named "world" that stay on its child when the root is dropped.
@@ -78,6 +79,8 @@ class URDFOptions:
             the loss is reported).
         asset_roots: folders outside the robot folder that relative and ``file://``
             mesh paths may point into (trusted explicitly; see :mod:`robotwright._paths`).
+        xacro_args: ``{"name": "value"}`` for the ``$(arg name)`` of a ``.xacro`` source
+            (see :mod:`robotwright.parsers.xacro`).
     """
 
     fixed_joints: FixedPolicy = "keep"
@@ -91,6 +94,7 @@ class URDFOptions:
     floating_base: bool = False
     join_obj_objects: bool = False
     asset_roots: tuple[str | os.PathLike, ...] = ()
+    xacro_args: Mapping[str, str] | None = None
 
     def __post_init__(self) -> None:
         if self.fixed_joints not in FIXED_POLICIES:
@@ -595,7 +599,7 @@ def parse_urdf(
 
 def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     rep = Reporter(str(path))
-    root = parse_xml(path)
+    root = read_robot_xml(path, opt, rep)  # a .xacro file is expanded first
     if root.tag != "robot":
         raise ConversionError([Problem(str(path), f"root element <{root.tag}>: expected <robot>")])
     reader = _URDFReader(path, opt, rep)
