@@ -19,9 +19,9 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
         text=True,
     )
     assert run.returncode == 0, run.stderr
-    assert "[6/6] semantic LiDAR scan" in run.stdout
+    assert "[6/7] semantic LiDAR scan" in run.stdout
     summary = json.loads((out / "summary.json").read_text())
-    assert len(summary) == 6
+    assert len(summary) == 7
 
     for name, nu in (("mini_humanoid", 20), ("arm6", 6)):
         model = mujoco.MjModel.from_xml_path(str(out / "robots" / f"{name}.xml"))
@@ -48,6 +48,18 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
     hit = np.isfinite(dist)
     assert (scan["mesh_ids"][hit] >= 0).all() and (labels[~hit] == 0).all()
     assert (out / "lidar" / "scan.png").stat().st_size > 20_000
+    # Shaded pictures of each robot and of the scene, with and without the scan's points.
+    import matplotlib.image as mpimg
+
+    pictures = {}
+    for name in ("mini_humanoid", "arm6", "humanoid_with_limb", "scene", "scene_lidar"):
+        pictures[name] = mpimg.imread(out / "pictures" / f"{name}.png")[..., :3]
+        assert pictures[name].shape == (480, 640, 3)
+        assert pictures[name].std() > 0.05  # not a blank picture
+    # The points change the scene picture where they are drawn, not everywhere.
+    changed = np.abs(pictures["scene_lidar"] - pictures["scene"]).max(axis=2) > 0.1
+    assert 0.02 < changed.mean() < 0.9
+    assert "renderer" in summary["pictures of the robots and the scene (render)"]
     rt = (out / "robots" / "roundtrip_mini_humanoid_urdf.txt").read_text()
     assert "result:    PASS" in rt and "FAIL" not in rt
 

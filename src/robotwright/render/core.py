@@ -290,6 +290,9 @@ def render_model(
     image: np.ndarray | None = None
     backend = "software"
     if opts.backend in ("auto", "gl"):
+        # No skybox: both renderers draw the same plain sky behind the model, and the
+        # depth buffer tells the model from the background.
+        scene.flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         try:
             gl = render_gl(model, scene, opts.width, opts.height)
         except GLUnavailable as exc:
@@ -300,9 +303,8 @@ def render_model(
             backend = f"gl-{gl.platform}"
             image, depth, ss = gl.rgb.astype(np.float64) / 255.0, gl.depth, 1
             view = _view(scene, opts.width, opts.height)
-            if not _has_skybox(model):
-                bg = ~np.isfinite(depth)
-                image[bg] = _sky(opts.height, opts.width)[bg]
+            bg = ~np.isfinite(depth)
+            image[bg] = _sky(opts.height, opts.width)[bg]
     if image is None:
         image, depth, view, ss = _software(model, scene, opts, notes)
     if pts is not None:
@@ -313,10 +315,6 @@ def render_model(
         depth = depth.reshape(h, ss, w, ss).min(axis=(1, 3))
     rgb = np.clip(np.round(image * 255.0), 0, 255).astype(np.uint8)
     return Picture(rgb, backend, spec.text, notes, depth)
-
-
-def _has_skybox(model: mujoco.MjModel) -> bool:
-    return bool((np.asarray(model.tex_type) == mujoco.mjtTexture.mjTEXTURE_SKYBOX).any())
 
 
 def _check_points(
