@@ -170,7 +170,7 @@ def step_pictures(out: Path, ctx: dict[str, Any]) -> str:
     return demo_pictures(out / "pictures", ctx, out / "lidar" / "scan.npz", DEMO_CLASSES)
 
 
-#: The seed's default classes, plus the other robot in the scene.
+#: The default classes, plus the other robot in the scene (saved as lidar/classes.json).
 DEMO_CLASSES: dict[str, list[str]] = {
     "terrain": ["ground", "wall", "floor", "plane"],
     "dynamic_obstacle": ["cracker_box", "sugar_box", "tomato_soup_can"],

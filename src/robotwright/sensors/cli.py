@@ -49,7 +49,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--mapping",
         type=Path,
-        help="JSON file: {class name: [keywords]} (default: the seed's mapping)",
+        help="JSON file {class name: [keywords]} (default: terrain, dynamic_obstacle and "
+        "valuable with their keywords, see docs/sensors.md); a robot is unknown unless a "
+        "class names it",
     )
     p.add_argument(
         "--include-robot", action="store_true", help="let rays hit the robot carrying the sensor"
