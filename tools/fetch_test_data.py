@@ -13,11 +13,17 @@ hurodes 0.1.9, the peer tool whose folders we must read and which must read ours
 installed into its own virtual environment ``.testdata/hurodes-venv`` (it needs
 ``numpy<2.4``); the compatibility tests find it there (or through ``$HURODES_PYTHON``).
 
+The viewer's browser test (``tests/view``) loads the page in headless Chromium:
+Debian's ``chromium`` package is installed with ``apt-get`` where it is absent and this
+runs as root; elsewhere that test skips and says why (the rest does not need it).
+
 Idempotent: does nothing when the data is already there. Exits non-zero on failure.
 """
 
 from __future__ import annotations
 
+import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -131,12 +137,37 @@ def make_hurodes_venv() -> Path:
     return python
 
 
+#: Names a Chromium executable goes by (tests/view/browser.py looks for the same).
+CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
+
+
+def install_chromium() -> None:
+    """Debian's ``chromium`` for the viewer's browser test, where absent and allowed."""
+    if any(shutil.which(name) for name in CHROMIUM_NAMES):
+        print("chromium already installed")
+        return
+    if not hasattr(os, "geteuid") or os.geteuid() != 0 or shutil.which("apt-get") is None:
+        print(
+            "chromium absent and not installable here (needs apt-get as root): "
+            "the viewer's browser test will skip"
+        )
+        return
+    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+    print("installing Debian's chromium with apt-get (for the viewer's browser test)")
+    for cmd in (["apt-get", "update", "-qq"], ["apt-get", "install", "-y", "-qq", "chromium"]):
+        if subprocess.run(cmd, env=env).returncode != 0:
+            break
+    if not any(shutil.which(name) for name in CHROMIUM_NAMES):
+        print("apt-get could not install chromium: the viewer's browser test will skip")
+
+
 def main() -> int:
     TESTDATA.mkdir(exist_ok=True)
     fetch_mjlab()
     for name in WHEEL_CORPORA:
         fetch_wheel_data(name)
     make_hurodes_venv()
+    install_chromium()
     return 0
 
 

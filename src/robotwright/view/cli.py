@@ -73,20 +73,21 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from robotwright._notes import notes_of, summary_line
     from robotwright.view.scene import load_source
     from robotwright.view.server import Viewer, ViewerConfig
 
     # --asset-root (added by the main parser) is in force around this call.
     scene = load_source(args.source, scene=args.scene)
-    if getattr(args, "verbose", False):
-        for note in scene.notes:
-            print(f"note: {note}", file=sys.stderr)
-    elif scene.notes:
-        print(
-            f"{len(scene.notes)} conversion note(s) while loading (values the viewer does not "
-            "use, such as actuator limits, are listed with -v)",
-            file=sys.stderr,
-        )
+    # The page runs until Ctrl-C, so what the loaders could not carry is told now, in
+    # the command line's usual form, rather than when the command ends.
+    notes = [n for message in scene.notes for n in notes_of(message)]
+    if notes and getattr(args, "verbose", False):
+        for n in notes:
+            print(f"note: {n.text}", file=sys.stderr)
+    if notes:
+        hint = "listed above" if getattr(args, "verbose", False) else "-v lists each"
+        print(summary_line(notes, hint), file=sys.stderr)
     options = {} if args.groups is None else {"geom_groups": args.groups}
     config = ViewerConfig(
         host=args.host,

@@ -1,0 +1,154 @@
+"""What the viewer draws, checked against MuJoCo's own scene (``mjv_updateScene``) and
+compiled model: one drawn mesh per visible geom, colours, sizes, poses."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from robotwright.view.geometry import body_poses, geom_rgba, geom_shapes, site_frames
+
+PRIMITIVES = """
+<mujoco>
+  <compiler angle="radian"/>
+  <asset>
+    <material name="red" rgba="0.9 0.1 0.1 1"/>
+    <mesh name="tet" vertex="0 0 0  0.3 0 0  0 0.2 0  0 0 0.1"/>
+  </asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="2 3 0.1"/>
+    <body name="base" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2">
+      <joint name="j0" type="hinge" axis="0 1 0"/>
+      <geom name="box" type="box" size="0.1 0.2 0.3" pos="0.05 0 0" euler="0.3 0.2 0.1"/>
+      <geom name="ball" type="sphere" size="0.07" pos="0 0.3 0" material="red"/>
+      <geom name="pill" type="capsule" size="0.04 0.12" pos="0 0 0.4" material="red"
+            rgba="0 1 0 1"/>
+      <site name="tip" pos="0.2 0 0" quat="0 1 0 0"/>
+      <body name="child" pos="0.3 0 0">
+        <joint name="j1" type="slide" axis="1 0 0" range="-0.2 0.2"/>
+        <geom name="can" type="cylinder" size="0.05 0.1"/>
+        <geom name="egg" type="ellipsoid" size="0.03 0.05 0.08" pos="0 0 0.2"/>
+        <geom name="tet" type="mesh" mesh="tet" pos="0 0.2 0"/>
+        <geom name="hidden" type="box" size="0.1 0.1 0.1" rgba="1 1 1 0"/>
+        <geom name="collision" type="sphere" size="0.2" group="3"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.fixture
+def model() -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_string(PRIMITIVES)
+
+
+def _mjv_geoms(model: mujoco.MjModel, data: mujoco.MjData) -> dict[int, mujoco.MjvGeom]:
+    """MuJoCo's own drawn geoms (default visual options: groups 0-2), by geom id."""
+    mujoco.mj_forward(model, data)
+    scn = mujoco.MjvScene(model, maxgeom=10_000)
+    mujoco.mjv_updateScene(
+        model,
+        data,
+        mujoco.MjvOption(),
+        None,
+        mujoco.MjvCamera(),
+        int(mujoco.mjtCatBit.mjCAT_ALL),
+        scn,
+    )
+    return {
+        scn.geoms[i].objid: scn.geoms[i]
+        for i in range(scn.ngeom)
+        if scn.geoms[i].objtype == int(mujoco.mjtObj.mjOBJ_GEOM)
+    }
+
+
+def _world(shape, xpos: np.ndarray, xquat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A shape's geom pose in the world from its body's world pose."""
+    rb, rg = np.zeros(9), np.zeros(9)
+    mujoco.mju_quat2Mat(rb, xquat[shape.body_id])
+    mujoco.mju_quat2Mat(rg, shape.quat)
+    rb, rg = rb.reshape(3, 3), rg.reshape(3, 3)
+    return xpos[shape.body_id] + rb @ shape.pos, rb @ rg
+
+
+def test_every_geom_but_the_transparent_one_is_drawn(model: mujoco.MjModel) -> None:
+    skipped: list[str] = []
+    shapes = geom_shapes(model, skipped=skipped)
+    names = {s.name for s in shapes}
+    assert len(shapes) == model.ngeom - 1
+    assert "hidden" not in names and any("'hidden'" in line for line in skipped)
+    assert {s.group for s in shapes if s.name == "collision"} == {3}
+
+
+def test_colours_follow_mujoco(model: mujoco.MjModel) -> None:
+    data = mujoco.MjData(model)
+    drawn = _mjv_geoms(model, data)
+    shapes = {s.name: s for s in geom_shapes(model)}
+    # material colour where the geom keeps MuJoCo's default rgba, the geom's own otherwise
+    np.testing.assert_allclose(shapes["ball"].rgba, [0.9, 0.1, 0.1, 1.0], atol=1e-6)
+    np.testing.assert_allclose(shapes["pill"].rgba, [0.0, 1.0, 0.0, 1.0], atol=1e-6)
+    for s in shapes.values():
+        if s.geom_id in drawn:
+            np.testing.assert_allclose(s.rgba, drawn[s.geom_id].rgba, atol=1e-6, err_msg=s.name)
+
+
+def test_sizes_match_mujoco_bounding_boxes(model: mujoco.MjModel) -> None:
+    """Tessellated vertices span the geom's own bounding box (``geom_aabb``, geom frame);
+    an infinite-looking plane keeps its half-sizes here (2 x 3 m)."""
+    for s in geom_shapes(model):
+        centre, half = model.geom_aabb[s.geom_id][:3], model.geom_aabb[s.geom_id][3:]
+        lo, hi = s.vertices.min(axis=0), s.vertices.max(axis=0)
+        if model.geom_type[s.geom_id] == int(mujoco.mjtGeom.mjGEOM_PLANE):
+            np.testing.assert_allclose(hi[:2], [2.0, 3.0])
+            continue
+        # Sphere-like tessellations reach the true surface within 2 %.
+        np.testing.assert_allclose(0.5 * (hi + lo), centre, atol=0.02 * half.max(), err_msg=s.name)
+        np.testing.assert_allclose(0.5 * (hi - lo), half, rtol=0.02, err_msg=s.name)
+        assert s.faces.max() < len(s.vertices)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_poses_match_mujoco_at_random_configurations(model: mujoco.MjModel, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    data = mujoco.MjData(model)
+    qpos = rng.uniform(-0.2, 0.2, model.nq)
+    xpos, xquat = body_poses(model, data, qpos)
+    drawn = _mjv_geoms(model, data)  # mj_forward at the same qpos
+    for s in geom_shapes(model):
+        pos, mat = _world(s, xpos, xquat)
+        np.testing.assert_allclose(pos, data.geom_xpos[s.geom_id], atol=1e-9, err_msg=s.name)
+        np.testing.assert_allclose(mat.reshape(-1), data.geom_xmat[s.geom_id], atol=1e-9)
+        if s.geom_id in drawn:
+            np.testing.assert_allclose(pos, drawn[s.geom_id].pos, atol=1e-5)
+    for site in site_frames(model):
+        rb = np.zeros(9)
+        mujoco.mju_quat2Mat(rb, xquat[site.body_id])
+        world = xpos[site.body_id] + rb.reshape(3, 3) @ site.pos
+        np.testing.assert_allclose(world, data.site_xpos[site.site_id], atol=1e-9)
+
+
+@pytest.mark.realdata
+def test_unitree_g1_meshes(testdata_dir: Path) -> None:
+    """The mjlab G1: every mesh geom drawn with MuJoCo's compiled vertices and colours."""
+    path = testdata_dir / "mjlab/mjlab/asset_zoo/robots/unitree_g1/xmls/g1.xml"
+    if not path.is_file():
+        pytest.skip(f"mjlab G1 absent: {path} (run tools/fetch_test_data.py)")
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    drawn = _mjv_geoms(model, data)
+    shapes = geom_shapes(model)
+    meshes = [s for s in shapes if model.geom_type[s.geom_id] == int(mujoco.mjtGeom.mjGEOM_MESH)]
+    assert len(meshes) == int((model.geom_type == int(mujoco.mjtGeom.mjGEOM_MESH)).sum())
+    visible = [s for s in shapes if s.group in (0, 1, 2)]
+    assert {s.geom_id for s in visible} == set(drawn)
+    for s in meshes:
+        mesh_id = model.geom_dataid[s.geom_id]
+        assert len(s.vertices) == model.mesh_vertnum[mesh_id]
+        assert len(s.faces) == model.mesh_facenum[mesh_id]
+    for s in visible:
+        np.testing.assert_allclose(s.rgba, drawn[s.geom_id].rgba, atol=1e-6)
+        np.testing.assert_allclose(s.rgba, geom_rgba(model, s.geom_id))
