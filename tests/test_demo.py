@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -62,6 +63,24 @@ def test_demo_writes_every_part(tmp_path: Path) -> None:
     assert "renderer" in summary["pictures of the robots and the scene (render)"]
     rt = (out / "robots" / "roundtrip_mini_humanoid_urdf.txt").read_text()
     assert "result:    PASS" in rt and "FAIL" not in rt
+
+    # The notes the steps announce are the lines of the notes file: one per value.
+    announced = sum(int(n) for n in re.findall(r"(\d+) conversion note\(s\)", run.stdout))
+    listed = (out / "conversion_notes.txt").read_text(encoding="utf-8").splitlines()
+    assert announced == len([line for line in listed if line]) > 40
+
+    # One labelling rule: the command line with the demo's saved mapping labels the
+    # demo's scene exactly as the demo did (the arm as `robot`, the wearer not scanned).
+    from robotwright.cli import main
+
+    again = tmp_path / "again.npz"
+    argv = ["lidar", str(out / "scene" / "semantic_scene.xml"), "--sensor", "h_head_lidar"]
+    assert main([*argv, "--mapping", str(out / "lidar" / "classes.json"), "-o", str(again)]) == 0
+    cli_scan = np.load(again)
+    assert list(cli_scan["class_names"]) == list(scan["class_names"])
+    assert "robot" in list(scan["class_names"])
+    assert np.array_equal(cli_scan["labels"], labels)
+    assert np.array_equal(cli_scan["mesh_ids"], scan["mesh_ids"])
 
 
 def test_demo_output_that_is_a_file_is_a_clear_error(tmp_path: Path, capsys) -> None:

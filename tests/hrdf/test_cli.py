@@ -20,10 +20,21 @@ def test_info_table() -> None:
     out = run("info", "arm6")
     assert out.returncode == 0, out.stderr
     assert (
-        "robot arm6: 7 bodies, 6 joints, 6 actuators, 6 DoF, total mass 7.70000 kg, fixed base"
+        "robot arm6: 7 bodies, 6 joints, 6 actuators, 6 DoF, total mass 7.700 kg, fixed base"
         in out.stdout
     )
-    assert "shoulder_pan_servo   position  shoulder_pan_joint   60" in out.stdout
+    # Limits carry their units; masses use one format (3 decimals) in every table.
+    assert "shoulder_pan_servo   position  shoulder_pan_joint   60 N m" in out.stdout
+    assert "3 rad/s" in out.stdout and "[-2.9, 2.9] rad" in out.stdout
+    assert "base_link       -               2.000" in out.stdout
+
+
+def test_info_names_unnamed_actuators_and_units() -> None:
+    out = run("info", "mini_humanoid")
+    assert out.returncode == 0, out.stderr
+    rows = [line for line in out.stdout.splitlines() if "knee_joint" in line and "motor" in line]
+    assert len(rows) == 2 and all(r.startswith("(unnamed)") and "80 N m" in r for r in rows)
+    assert "pelvis" in out.stdout and "3.000" in out.stdout and "28.200 kg" in out.stdout
 
 
 def test_info_unknown_robot_is_clear_error() -> None:

@@ -56,33 +56,53 @@ def _table(headers: list[str], rows: list[list[str]]) -> str:
 
 
 def format_info(hrdf: HRDF) -> str:
-    """A readable multi-table summary of a robot."""
+    """A readable multi-table summary of a robot: masses in kg (3 decimals everywhere),
+    joint ranges in rad (hinge, ball) or m (slide), actuator limits with their units."""
     s = hrdf.summary()
     head = (
         f"robot {s['name']}: {s['bodies']} bodies, {s['joints']} joints, "
-        f"{s['actuators']} actuators, {s['dof']} DoF, total mass {s['total_mass']:.5f} kg, "
+        f"{s['actuators']} actuators, {s['dof']} DoF, total mass {s['total_mass']:.3f} kg, "
         f"{'floating' if s['floating_base'] else 'fixed'} base"
     )
     bodies = [
         [
             b.name,
             hrdf.bodies[b.parent].name if b.parent >= 0 else "-",
-            f"{b.mass:.4g}",
+            f"{b.mass:.3f}",
             ", ".join(f"{j.name or '(free)'}:{j.type}" for j in hrdf.joints_of(b.name)) or "-",
         ]
         for b in hrdf.bodies
     ]
+    joint_types = {j.name: j.type for j in hrdf.joints}
+
+    def unit(j_type: str | None) -> str:
+        return "m" if j_type == "slide" else "rad"
+
     joints = [
         [
             j.name or "(free)",
             j.type,
             j.body,
-            "-" if j.range is None else f"[{j.range[0]:.4g}, {j.range[1]:.4g}]",
+            "-" if j.range is None else f"[{j.range[0]:.4g}, {j.range[1]:.4g}] {unit(j.type)}",
         ]
         for j in hrdf.joints
     ]
+
+    def limit(value: float | None, joint: str, per: str) -> str:
+        if value is None:
+            return "-"
+        slide = joint_types.get(joint) == "slide"
+        return f"{value:g} {('N' if slide else 'N m') if per == 'force' else unit(joint_types.get(joint)) + '/s'}"
+
     acts = [
-        [a.name or "-", a.type, a.joint, "-" if a.peak_torque is None else f"{a.peak_torque:g}"]
+        [
+            # hurodes writes unnamed actuators; they stay unnamed in the MJCF we write.
+            a.name or "(unnamed)",
+            a.type,
+            a.joint,
+            limit(a.peak_torque, a.joint, "force"),
+            limit(a.peak_velocity, a.joint, "speed"),
+        ]
         for a in hrdf.actuators
     ]
     parts = [
@@ -93,7 +113,10 @@ def format_info(hrdf: HRDF) -> str:
         _table(["joint", "type", "body", "range"], joints),
     ]
     if acts:
-        parts += ["", _table(["actuator", "type", "joint", "peak torque"], acts)]
+        parts += [
+            "",
+            _table(["actuator", "type", "joint", "peak torque/force", "peak velocity"], acts),
+        ]
     return "\n".join(parts)
 
 
