@@ -116,8 +116,9 @@ def test_convert_and_roundtrip_commands_take_join_obj_objects(tmp_path: Path, ca
     assert main(["roundtrip", str(path), "--configs", "2"]) == 1
     assert main(["roundtrip", str(path), "--configs", "2", "--join-obj-objects"]) == 0
     out = tmp_path / "out.xml"
-    assert main(["convert", str(path), "-o", str(out), "--join-obj-objects"]) == 0
-    assert "joined into one STL" in capsys.readouterr().out
+    assert main(["convert", str(path), "-o", str(out), "--join-obj-objects", "-v"]) == 0
+    captured = capsys.readouterr()  # conversion notes go to stderr
+    assert "joined into one STL" in captured.out + captured.err
     assert mujoco.MjModel.from_xml_path(str(out)).mesh_facenum[0] == 4
 
 
@@ -136,3 +137,38 @@ def test_mjcf_source_with_split_obj_reported_and_joined_by_option(tmp_path: Path
     )
     assert any("two.obj': 2 objects (faces [4, 4])" in str(w) for w in warnings)
     assert our_mjcf_model(hrdf).mesh_facenum[0] == 8
+
+
+def test_staging_folder_lives_as_long_as_a_robot_holds_it(probe: Path, tmp_path: Path) -> None:
+    """Without work_dir the meshes are staged in a temporary folder that the parsed
+    robot holds: copies made with dataclasses.replace keep it, and it is removed once no
+    robot holds it (it used to stay in /tmp forever)."""
+    import gc
+    from dataclasses import replace
+
+    from robotwright.generators import MJCFHumanoidGenerator
+
+    hrdf = mjcf_to_hrdf_with_warnings(probe).hrdf
+    folder = hrdf.root_dir
+    assert folder is not None and (folder / hrdf.meshes[0].file).is_file()
+    copy = replace(hrdf, name="copy")
+    del hrdf
+    gc.collect()
+    assert folder.is_dir()
+    # An export outside the staging folder copies the meshes, so it outlives it.
+    out = tmp_path / "out" / "probe.xml"
+    MJCFHumanoidGenerator.from_hrdf(copy).export(out)
+    del copy
+    gc.collect()
+    assert not folder.exists()
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1
+
+
+def test_work_dir_is_kept(probe: Path, tmp_path: Path) -> None:
+    import gc
+
+    hrdf = mjcf_to_hrdf_with_warnings(probe, work_dir=tmp_path / "stage").hrdf
+    assert hrdf.temp_assets is None
+    del hrdf
+    gc.collect()
+    assert any((tmp_path / "stage" / "meshes").iterdir())

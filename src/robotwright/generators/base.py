@@ -146,7 +146,9 @@ class GeneratorBase(ABC):
         relative to the file's folder when ``relative_mesh_path`` is true (the default),
         so the file loads as is. With ``copy_meshes=True`` the meshes are first copied
         under ``<folder>/meshes/<robot>/`` and the file references the copies, giving a
-        self-contained folder.
+        self-contained folder. Meshes a parser staged in a temporary folder (a robot read
+        from MJCF/URDF, see :mod:`robotwright.parsers.meshes`) are always copied: that
+        folder goes away with the robot.
 
         Args:
             file_path: where to write, or ``None`` to only return the string.
@@ -154,6 +156,8 @@ class GeneratorBase(ABC):
             **kwargs: passed to ``generate``.
         """
         self._require_loaded("export")
+        if file_path is not None and self._uses_temporary_meshes():
+            copy_meshes = True
         if copy_meshes and file_path is None:
             raise GeneratorError("export(copy_meshes=True) needs a file_path to copy next to")
         path = Path(file_path).resolve() if file_path is not None else None
@@ -180,6 +184,17 @@ class GeneratorBase(ABC):
         finally:
             self.output_dir, self._mesh_copy = saved_dir, saved_copy
         return text
+
+    def _uses_temporary_meshes(self) -> bool:
+        """Whether a robot of this generator (or of its members) has its meshes in a
+        parser's temporary staging folder."""
+        hrdf = getattr(self, "hrdf", None)
+        if hrdf is not None and getattr(hrdf, "temp_assets", None) is not None:
+            return True
+        members = getattr(self, "generators", None)
+        return isinstance(members, dict) and any(
+            g._uses_temporary_meshes() for g in members.values()
+        )
 
     # -- mesh paths ---------------------------------------------------------------------
     def _mesh_file(self, src: str) -> str:

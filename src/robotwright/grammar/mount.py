@@ -167,6 +167,7 @@ def mount_on(
         meta=meta,
         mjcf_extra=robot.mjcf_extra,
         root_dir=robot.root_dir,
+        temp_assets=robot.temp_assets,  # keeps a parsed robot's staged meshes alive
         # The limb's meshes keep their absolute paths in its folder: trusted here.
         asset_roots=tuple(
             dict.fromkeys(

@@ -453,6 +453,9 @@ class HRDF:
     mjcf_extra: str | None = None
     root_dir: Path | None = None
     asset_roots: tuple[Path, ...] = field(default=(), compare=False, repr=False)
+    #: The temporary folder ``root_dir`` lies in when a parser staged the meshes there
+    #: (removed when no HRDF holds it; ``dataclasses.replace`` carries it). None otherwise.
+    temp_assets: object | None = field(default=None, compare=False, repr=False)
 
     # -- loading and saving -------------------------------------------------------------
     @classmethod

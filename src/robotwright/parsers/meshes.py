@@ -16,6 +16,11 @@ under unique names, so that two source files with the same base name never colli
   MuJoCo refuses). With ``join_obj_objects`` it is converted the same way, every
   object's triangles kept in one file; without it, it is linked and its object face
   counts are recorded so that callers can report the loss.
+
+Without a ``work_dir`` the staging folder is a :class:`TempFolder`: the parsed HRDF holds
+it (``HRDF.temp_assets``, carried by ``dataclasses.replace``), and the folder is removed
+once no HRDF holds it any more, or when the interpreter exits. Save the robot
+(``HRDF.save``) to keep its meshes.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ import os
 import re
 import shutil
 import tempfile
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -67,6 +73,20 @@ class StagedMesh:
     obj_objects: tuple[int, ...] = ()
 
 
+class TempFolder:
+    """A temporary folder that lives as long as this object (and is removed at exit at
+    the latest). Whoever needs the folder's files holds the object."""
+
+    def __init__(self, prefix: str = "robotwright-mesh-") -> None:
+        self.path = Path(tempfile.mkdtemp(prefix=prefix))
+        # The callback holds the path only, never self, so the object can be collected.
+        self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.path), True)
+
+    def remove(self) -> None:
+        """Remove the folder now."""
+        self._finalizer()
+
+
 @dataclass
 class MeshStore:
     """Stages mesh files into ``root/meshes``; one entry per distinct source (and mirror).
@@ -74,12 +94,17 @@ class MeshStore:
     ``join_obj_objects``: convert OBJ files holding several objects into one mesh with
     all their triangles (MuJoCo reads the first object only)."""
 
-    root: Path = field(default_factory=lambda: Path(tempfile.mkdtemp(prefix="robotwright-mesh-")))
+    root: Path | None = None
     join_obj_objects: bool = False
     staged: dict[str, StagedMesh] = field(default_factory=dict)
     _used: set[str] = field(default_factory=set)
+    #: The temporary folder when ``root`` was not given (None otherwise).
+    lifetime: TempFolder | None = None
 
     def __post_init__(self) -> None:
+        if self.root is None:
+            self.lifetime = TempFolder()
+            self.root = self.lifetime.path
         self.root = Path(self.root)
         (self.root / "meshes").mkdir(parents=True, exist_ok=True)
 

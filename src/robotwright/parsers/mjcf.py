@@ -968,6 +968,7 @@ def parse_mjcf(
         meta=Meta(simulator_config=sim, body_name_config=None),
         mjcf_extra=extra,
         root_dir=store.root,
+        temp_assets=store.lifetime,
     )
     warn_massless_moving(hrdf, rep, '<body name="{}">')
     warnings = rep.finish(strict)

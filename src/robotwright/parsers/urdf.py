@@ -802,6 +802,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         meta=Meta(simulator_config=None, body_name_config=None),
         mjcf_extra=extra,
         root_dir=reader.store.root,
+        temp_assets=reader.store.lifetime,
     )
     warn_massless_moving(hrdf, rep, '<link name="{}">')
     warnings = rep.finish(strict)
