@@ -108,3 +108,41 @@ def test_scan_points_coloured_by_class(tmp_path: Path) -> None:
         for name, count in scene.scan.class_counts().items():
             assert f"{name} ({count} points)" in legend
         assert scene.scan.class_counts()["valuable"] > 0
+
+
+@pytest.mark.realdata
+def test_unitree_g1_sends_meshes_once_then_poses_only(testdata_dir: Path) -> None:
+    """The G1's 35 visual meshes go to the page once; a slider then sends only the poses
+    of the bodies that moved (no mesh), so the page does not freeze."""
+    path = testdata_dir / "mjlab/mjlab/asset_zoo/robots/unitree_g1/xmls/g1.xml"
+    if not path.is_file():
+        pytest.skip(f"mjlab G1 absent: {path} (run tools/fetch_test_data.py)")
+    with show(path, port=0) as viewer:
+        model = viewer.model
+        visual = int(np.isin(model.geom_group, (0, 1, 2)).sum())
+        assert viewer.geom_count == visual == 35
+        sent: list[str] = []
+        ws = viewer.server._websock_server
+        queue = ws.queue_message
+        ws.queue_message = lambda msg: (sent.append(type(msg).__name__), queue(msg))[1]
+        try:
+            viewer.set_joint("left_knee_joint", 1.0)
+        finally:
+            ws.queue_message = queue
+        assert "MeshMessage" not in sent
+        assert set(sent) <= {"SetPositionMessage", "SetOrientationMessage", "GuiUpdateMessage"}
+        below_knee = [b for b in range(model.nbody) if _is_below(model, b, "left_knee_link")]
+        # the knee link turns about its origin, the ankle links also move: one orientation
+        # each, positions only where they changed
+        assert sent.count("SetOrientationMessage") == len(below_knee) == 3
+        assert sent.count("SetPositionMessage") == 2
+        assert viewer.geom_count == visual
+
+
+def _is_below(model: mujoco.MjModel, body: int, name: str) -> bool:
+    top = model.body(name).id
+    while body > 0:
+        if body == top:
+            return True
+        body = model.body_parentid[body]
+    return False
