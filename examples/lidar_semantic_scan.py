@@ -45,7 +45,7 @@ def main(out_dir: Path) -> None:
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
 
-    # The seed's API: default mapping (terrain / dynamic_obstacle / valuable), Mid-360 pattern.
+    # Default class mapping (terrain / dynamic_obstacle / valuable), Mid-360-like pattern.
     cfg = SemanticLidarCfg(prim_path="lidar", pattern_cfg=LivoxPatternCfg(), max_distance=40.0)
     lidar = SemanticLidarSensor(cfg, model, data)
     lidar.update()
@@ -64,7 +64,9 @@ def main(out_dir: Path) -> None:
     summary = scan_to_files(
         model, data, "lidar", "mid360", out_dir / "room.npz", out_dir / "room.png"
     )
-    print(summary)
+    counts = ", ".join(f"{name} {n}" for name, n in summary["class_counts"].items())
+    print(f"{summary['num_hits']} of {summary['num_rays']} rays hit ({counts})")
+    print(f"wrote {summary['npz']} (distances, points, labels, geom ids) and {summary['png']}")
 
 
 if __name__ == "__main__":
