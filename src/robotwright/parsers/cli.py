@@ -29,7 +29,21 @@ def _options(args: argparse.Namespace) -> dict:
         opts["actuators"] = args.actuators
     if getattr(args, "xacro_arg", None):
         opts["xacro_args"] = dict(args.xacro_arg)
+    if getattr(args, "actuator_gain", None):
+        opts["actuator_gains"] = dict(args.actuator_gain)
     return opts
+
+
+def _actuator_gain(text: str) -> tuple[str, tuple[float, float]]:
+    """``PATTERN=KP,KV`` (or ``PATTERN=KP``) of ``--actuator-gain``."""
+    pattern, sep, values = text.rpartition("=")
+    try:
+        gains = tuple(float(v) for v in values.split(","))
+    except ValueError:
+        gains = ()
+    if not sep or not pattern or len(gains) not in (1, 2) or min(gains) < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected PATTERN=KP,KV (numbers >= 0)")
+    return pattern, (gains[0], gains[1] if len(gains) == 2 else 0.0)
 
 
 def _xacro_arg(text: str) -> tuple[str, str]:
@@ -50,9 +64,19 @@ def _source_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--actuators",
-        choices=("none", "motor"),
-        help="URDF sources: none (default; URDF has no actuators) or one torque motor per "
-        "moving joint with an effort limit (peak torque = effort)",
+        choices=("none", "motor", "position", "velocity", "auto"),
+        help="URDF sources: none (default; URDF has no actuators), one torque motor per "
+        "moving joint with an effort limit (motor), PD or velocity servos with "
+        "--actuator-gain (position, velocity), or the type each <transmission> / "
+        "ros2_control command_interface declares (auto)",
+    )
+    p.add_argument(
+        "--actuator-gain",
+        action="append",
+        type=_actuator_gain,
+        metavar="PATTERN=KP,KV",
+        help="URDF --actuators position/velocity/auto: servo gains for the joints whose "
+        "name matches PATTERN (fnmatch; first match wins; repeat for several)",
     )
     p.add_argument(
         "--xacro-arg",

@@ -17,7 +17,7 @@ from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -34,6 +34,7 @@ from robotwright.hrdf.model import (
     Site,
 )
 from robotwright.parsers import inertia as inr
+from robotwright.parsers import urdf_actuators as acts
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
 from robotwright.parsers.meshes import MeshConversionError, conversion_note, mesh_store
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
@@ -65,7 +66,12 @@ class URDFOptions:
         work_dir: folder where meshes are staged/converted (default: a new temp folder).
         actuators: ``"none"`` (default; URDF has no actuators) or ``"motor"`` (one torque
             motor per moving joint with an effort limit: peak_torque = effort,
-            peak_velocity = velocity, ctrl_range = +-effort).
+            peak_velocity = velocity, ctrl_range = +-effort); ``"position"`` (PD servos),
+            ``"velocity"`` or ``"auto"`` (the type each joint's ``<transmission>`` /
+            ros2_control ``<command_interface>`` declares): see
+            :mod:`robotwright.parsers.urdf_actuators`.
+        actuator_gains: ``{"joint name pattern": (kp, kv)}`` for position/velocity
+            servos (first matching ``fnmatch`` pattern wins).
         balance_inertia: repair A + B < C principal moments as MuJoCo's
             ``balanceinertia`` does (each repaired link is reported).
         bound_mass: raise body masses below this (kg) to it, as MuJoCo's ``boundmass``.
@@ -87,7 +93,8 @@ class URDFOptions:
     package_map: Mapping[str, str | os.PathLike] | None = None
     mesh_root: Path | None = None
     work_dir: Path | None = None
-    actuators: Literal["none", "motor"] = "none"
+    actuators: Literal["none", "motor", "position", "velocity", "auto"] = "none"
+    actuator_gains: Mapping[str, Any] | None = None
     balance_inertia: bool = False
     bound_mass: float | None = None
     bound_inertia: float | None = None
@@ -101,8 +108,9 @@ class URDFOptions:
             raise ValueError(
                 f"fixed_joints={self.fixed_joints!r}: expected one of {list(FIXED_POLICIES)}"
             )
-        if self.actuators not in ("none", "motor"):
-            raise ValueError(f"actuators={self.actuators!r}: expected 'none' or 'motor'")
+        if self.actuators not in acts.ACTUATOR_MODES:
+            raise ValueError(f"actuators={self.actuators!r}: expected one of {acts.ACTUATOR_MODES}")
+        object.__setattr__(self, "actuator_gains", acts.parse_gains(self.actuator_gains))
         for name in ("bound_mass", "bound_inertia"):
             value = getattr(self, name)
             if value is not None and not value >= 0:
@@ -608,7 +616,8 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         rgba = reader._material(mat, describe(mat))
         if rgba is not None and mat.get("name"):
             reader.materials[mat.get("name")] = rgba
-    dropped = Counter(child.tag for child in root if child.tag not in _KNOWN_TOP)
+    reads = acts.INTERFACE_TAGS if opt.actuators in acts.MODES else ()  # read below
+    dropped = Counter(c.tag for c in root if c.tag not in _KNOWN_TOP and c.tag not in reads)
     for tag, count in sorted(dropped.items()):
         rep.warn(f"{count} top-level <{tag}> element(s) dropped (not robot structure)")
 
@@ -755,6 +764,11 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
             dropped_limits.append(joint.name)
         if mimic is not None:
             mimics.append(mimic)
+    if opt.actuators in acts.MODES:
+        actuators, kept = acts.make_actuators(
+            root, hrdf_joints, opt.actuators, opt.actuator_gains, rep
+        )
+        dropped_limits = [n for n in dropped_limits if n not in kept]
     if dropped_limits:
         rep.warn(
             f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept (HRDF joints "
