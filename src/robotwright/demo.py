@@ -33,7 +33,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Export the bundled robots, compose a scene, grow a limb with the "
         "grammar, scan the scene with a semantic LiDAR, and save it all in one folder.",
     )
-    p.add_argument("-o", "--out", type=Path, default=DEFAULT_OUT, help="output folder")
+    p.add_argument(
+        "-o",
+        "--out",
+        type=Path,
+        default=DEFAULT_OUT,
+        help=f"output folder (default ./{DEFAULT_OUT}; an earlier demo output is refreshed)",
+    )
     p.set_defaults(func=_run)
 
 

@@ -39,6 +39,8 @@ def test_text_is_readable():
     d = derive.sample(default_grammar(), 1, random.Random(0))
     text = d.to_text()
     assert text.splitlines()[1].startswith("r1 @0: B=base(diameter=")
+    # A design.txt read on its own says what "@0" means.
+    assert "RULE @NODE: CHOICES, NODE = id of the node grown" in text.splitlines()[0]
     assert "P=pinned()" in text and "L=link(" in text
 
 

@@ -129,7 +129,12 @@ class Design:
         return cls.from_dict(data, source)
 
     def to_text(self) -> str:
-        lines = [f"# {FORMAT} grammar={self.grammar} hash={self.hash()}"]
+        # The header says how to read a step, for readers of a design.txt on its own.
+        lines = [
+            f"# {FORMAT} grammar={self.grammar} hash={self.hash()} "
+            "(one step per line: RULE @NODE: CHOICES, NODE = id of the node grown, "
+            "ids in creation order)"
+        ]
         lines += [str(s) for s in self.steps]
         return "\n".join(lines) + "\n"
 
