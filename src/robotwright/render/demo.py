@@ -18,7 +18,7 @@ __all__ = ["demo_pictures"]
 SIZE = (640, 480)
 #: The scene is seen from above the south-east corner, close enough that the robots
 #: are not lost in the room (its far walls are cut by the frame).
-SCENE_CAMERA = "135,-45,7.5"
+SCENE_CAMERA = "135,-50,7.5"
 
 
 def demo_pictures(
@@ -65,7 +65,7 @@ def demo_pictures(
         out / "scene_lidar.png",
         scene_opts,
         mapping=mapping,
-        title="Semantic LiDAR points in the scene (hidden where a surface is in front)",
+        title="Semantic LiDAR points in the scene (hidden behind surfaces)",
     )
     backends.add(picture.backend)
     written += ["scene.png", "scene_lidar.png"]

@@ -3,13 +3,14 @@ optionally with a title and a legend drawn over it (matplotlib, no display neede
 
 from __future__ import annotations
 
+import io
 import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from robotwright._atomic import atomic_open
+from robotwright._atomic import _make_parents, _remove_empty, atomic_open, check_output_path
 from robotwright.render.core import Picture
 
 __all__ = ["save_png"]
@@ -30,7 +31,7 @@ def save_png(
 
     Args:
         picture: what :func:`~robotwright.render.render_model` returned.
-        path: the PNG file to write.
+        path: the PNG file to write (its folder is created when missing).
         title: a line of text at the top of the picture.
         legend: ``(label, (r, g, b))`` entries in [0, 1], drawn as a box of markers.
     """
@@ -63,16 +64,27 @@ def save_png(
             Line2D([], [], marker="o", linestyle="", markersize=size * 0.8, color=tuple(rgb))
             for _, rgb in legend
         ]
+        # Along the bottom edge, two columns: it hides the least of the picture.
         ax.legend(
             handles,
             [label for label, _ in legend],
-            loc="lower left",
-            fontsize=size,
+            loc="lower center",
+            ncol=2 if len(legend) > 2 else 1,
+            fontsize=size * 0.8,
+            columnspacing=1.0,
             framealpha=0.85,
             borderpad=0.5,
             handletextpad=0.3,
         )
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=_DPI)
     path = Path(path)
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png", dpi=_DPI)
+    check_output_path(path)
+    created = _make_parents(path.parent)  # a missing folder is made (and removed on failure)
+    try:
+        with atomic_open(path, "wb") as fh:
+            fh.write(buffer.getvalue())
+    except BaseException:
+        _remove_empty(created)
+        raise
     return path
