@@ -171,10 +171,10 @@ def _view_from_model(model: mujoco.MjModel, kind: str = "mujoco") -> RobotView:
             v = np.atleast_1d(np.asarray(value, dtype=float))
             data.qpos[a : a + v.size] = v
         mujoco.mj_kinematics(model, data)
-        out = {
-            body_name(model, i): (data.xpos[i].copy(), data.xmat[i].reshape(3, 3).copy())
-            for i in range(1, model.nbody)
-        }
+        # Names looked up once (``bodies``), not per call: a model accessor per body per
+        # configuration dominated round trips of large robots.
+        xpos, xmat = data.xpos.copy(), data.xmat.reshape(-1, 3, 3).copy()
+        out = {name: (xpos[i], xmat[i]) for i, name in enumerate(bodies, start=1)}
         for i, s in enumerate(sites):
             out.setdefault(s, (data.site_xpos[i].copy(), data.site_xmat[i].reshape(3, 3).copy()))
         return out

@@ -30,7 +30,6 @@ from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
     RobotView,
     mimic_map,
-    quat_angle,
     urdf_mujoco_view,
     urdf_yourdfpy_view,
     view_from_model,
@@ -159,11 +158,14 @@ def compare_views(
             owner = b if b in ours.mass else ours.site_body.get(b)
             groups.setdefault(owner, []).append(b)
         worst_m = worst_i = worst_c = 0.0
+        worst_i_body = ""
         for owner, members in groups.items():
+            # Every part with mass or inertia: a massless link may carry inertia (MuJoCo
+            # keeps it), and dropping it must show here.
             parts = [
                 (ref.mass[m], ref.inertia_world[m][0], ref.inertia_world[m][1])
                 for m in members
-                if ref.mass[m] > 0
+                if ref.mass[m] > 0 or np.any(ref.inertia_world[m][1])
             ]
             m_ref, c_ref, i_ref = (
                 inr.combine(parts) if parts else (0.0, np.zeros(3), np.zeros((3, 3)))
@@ -173,11 +175,20 @@ def compare_views(
             worst_m = max(worst_m, _rel(m_ref, m_o))
             if m_ref > 0:
                 worst_c = max(worst_c, float(np.abs(c_ref - c_o).max()))
-                scale = max(np.abs(i_ref).max(), np.abs(i_o).max())
-                if scale > 0:
-                    worst_i = max(worst_i, float(np.abs(i_ref - i_o).max() / scale))
+            scale = max(np.abs(i_ref).max(), np.abs(i_o).max())
+            if scale > 0:
+                err = float(np.abs(i_ref - i_o).max() / scale)
+                if err > worst_i:
+                    worst_i, worst_i_body = err, owner
         rows.append(Row("body masses max rel.err", f"{worst_m:.1e}", worst_m <= tol))
-        rows.append(Row("inertia tensors max rel.err", f"{worst_i:.1e}", worst_i <= tol))
+        rows.append(
+            Row(
+                "inertia tensors max rel.err",
+                f"{worst_i:.1e}",
+                worst_i <= tol,
+                f"worst: {worst_i_body}" if worst_i > tol else "",
+            )
+        )
         rows.append(Row("centres of mass max err (m)", f"{worst_c:.1e}", worst_c <= tol))
 
         ours_j = {j.name: j for j in ours.joints}
@@ -262,14 +273,20 @@ def compare_views(
     # Forward kinematics.
     names = [b for b in ref.bodies if b in our_frames] + [s for s in ref.sites if s in our_frames]
     worst_p = worst_r = 0.0
-    unknown = [j.name for j in ref.joints if j.name not in {o.name for o in ours.joints}]
+    our_joints = {o.name for o in ours.joints}
+    unknown = [j.name for j in ref.joints if j.name not in our_joints]
     for q in random_configs(ref, configs, mimic=mimic):
         a, b = ref.fk(q), ours.fk({k: v for k, v in q.items() if k not in unknown})
-        for n in names:
-            if n not in a:
-                continue
-            worst_p = max(worst_p, float(np.abs(a[n][0] - b[n][0]).max()))
-            worst_r = max(worst_r, quat_angle(a[n][1], b[n][1]))
+        present = [n for n in names if n in a]
+        if not present:
+            continue
+        # One array operation per configuration (not one per frame): large robots.
+        pa = np.array([a[n][0] for n in present])
+        pb = np.array([b[n][0] for n in present])
+        ra = np.array([a[n][1] for n in present])
+        rb = np.array([b[n][1] for n in present])
+        worst_p = max(worst_p, float(np.abs(pa - pb).max()))
+        worst_r = max(worst_r, float(rotation_angles(ra, rb).max()))
     rows.append(
         Row(
             f"FK {len(names)} frames x {configs} configs (m / rad)",
@@ -284,9 +301,10 @@ def compare_views(
 def _geom_records(model: mujoco.MjModel, bodies: set[str], collision_only: bool) -> list:
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
+    names = [model.body(i).name or f"body_{i}" for i in range(model.nbody)]
     out = []
     for g in range(model.ngeom):
-        b = model.body(int(model.geom_bodyid[g])).name or f"body_{int(model.geom_bodyid[g])}"
+        b = names[int(model.geom_bodyid[g])]
         if b not in bodies:
             continue
         if collision_only and model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0:
@@ -303,46 +321,80 @@ def _geom_records(model: mujoco.MjModel, bodies: set[str], collision_only: bool)
                 data.geom_xpos[g].copy(),
                 data.geom_xmat[g].reshape(3, 3).copy(),
                 model.geom(g).name,
+                b,
             )
         )
     return out
 
 
+def rotation_angles(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad) between each pair of rotation matrices (``(n, 3, 3)`` arrays);
+    :func:`~robotwright.parsers.reference.quat_angle` for many pairs at once."""
+    rel = np.einsum("nji,njk->nik", r1, r2)
+    c = (np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0
+    # acos loses precision near 1; the skew part keeps small angles exact
+    skew = np.stack(
+        [rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]],
+        axis=1,
+    )
+    return np.arctan2(np.linalg.norm(skew, axis=1) / 2.0, c)
+
+
+def _errors(rec: tuple, cands: list[tuple]) -> np.ndarray:
+    """Size, position and orientation error of ``rec`` against each candidate record of
+    the same type and vertex count (a sphere has no orientation to compare)."""
+    size = np.abs(np.array([c[2] for c in cands]) - rec[2])
+    err = np.maximum(
+        size.max(axis=1, initial=0.0),
+        np.abs(np.array([c[3] for c in cands]) - rec[3]).max(axis=1),
+    )
+    if rec[0] != 2:
+        rots = np.array([c[4] for c in cands])
+        err = np.maximum(err, rotation_angles(np.broadcast_to(rec[4], rots.shape), rots))
+    return err
+
+
 def compare_geoms(ref: RobotView, ours: RobotView, tol: float, collision_only: bool) -> Row:
     """Each reference geom matched to the closest of ours with the same type (and mesh
-    vertex count): worst size, world position and orientation error at the zero pose."""
-    ref_bodies = set(ref.bodies)
-    our_bodies = set(ours.bodies)
-    a = _geom_records(ref.model, ref_bodies, collision_only)
-    b = _geom_records(ours.model, our_bodies, collision_only)
-    worst, unmatched = 0.0, 0
-    free = list(range(len(b)))
-    by_name = {rec[5]: k for k, rec in enumerate(b) if rec[5]}
+    vertex count): worst size, world position and orientation error at the zero pose.
 
-    def error(x: tuple, y: tuple) -> float | None:
-        if x[0] != y[0] or x[1] != y[1]:
-            return None
-        err = max(float(np.abs(x[2] - y[2]).max(initial=0.0)), float(np.abs(x[3] - y[3]).max()))
-        if x[0] != 2:  # a sphere has no orientation to compare
-            err = max(err, quat_angle(x[4], y[4]))
-        return err
+    Matching looks first at a geom of the same name, then among ours on the same body,
+    then among all of ours of that shape, so a robot of many links costs about linear
+    time (geoms of one body are few)."""
+    a = _geom_records(ref.model, set(ref.bodies), collision_only)
+    b = _geom_records(ours.model, set(ours.bodies), collision_only)
+    worst, unmatched = 0.0, 0
+    taken = [False] * len(b)
+    by_name = {rec[5]: k for k, rec in enumerate(b) if rec[5]}
+    by_body: dict[tuple, list[int]] = {}
+    by_shape: dict[tuple, list[int]] = {}
+    for k, rec in enumerate(b):
+        by_body.setdefault((rec[0], rec[1], rec[6]), []).append(k)
+        by_shape.setdefault((rec[0], rec[1]), []).append(k)
 
     for rec in a:
-        # Same name first; unnamed geoms go to the closest free geom of the same shape.
+        shape = (rec[0], rec[1])
         k = by_name.get(rec[5]) if rec[5] else None
-        if k is not None and k in free and error(rec, b[k]) is not None:
-            best, best_k = error(rec, b[k]), k
+        best_k = None
+        if k is not None and not taken[k] and (b[k][0], b[k][1]) == shape:
+            best_k = k
         else:
-            best, best_k = None, None
-            for k in free:
-                err = error(rec, b[k])
-                if err is not None and (best is None or err < best):
-                    best, best_k = err, k
+            # The same body's geoms first; all of that shape only when none there fits.
+            best = np.inf
+            for pool in (by_body.get((*shape, rec[6]), []), by_shape.get(shape, [])):
+                free = [k for k in pool if not taken[k]]
+                if free:
+                    errs = _errors(rec, [b[k] for k in free])
+                    i = int(np.argmin(errs))
+                    if errs[i] < best:
+                        best_k, best = free[i], float(errs[i])
+                if best <= tol:
+                    break
         if best_k is None:
             unmatched += 1
             continue
-        free.remove(best_k)
-        worst = max(worst, best)
+        taken[best_k] = True
+        worst = max(worst, float(_errors(rec, [b[best_k]])[0]))
     kind = "collision geoms" if collision_only else "geoms"
     return Row(
         f"{kind} (type, size, pose at q0)",
