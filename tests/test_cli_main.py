@@ -102,6 +102,7 @@ def test_format_follows_the_output_extension(tmp_path: Path, capsys) -> None:
     assert "cannot tell the format from '.sdf'" in capsys.readouterr().err
 
 
+@pytest.mark.filterwarnings("ignore::robotwright.errors.ConversionWarning")  # the reference
 def test_things_takes_a_bundled_robot_name(tmp_path: Path, capsys) -> None:
     assert main(["things", "arm6", str(tmp_path / "arm.xml")]) == 0
     model = mujoco.MjModel.from_xml_path(str(tmp_path / "arm.xml"))
