@@ -76,7 +76,7 @@ def warn_massless_moving(hrdf: HRDF, rep: Reporter, element: str) -> None:
         rep.warn(
             "body with joints and no mass or principal inertia >= 1e-15 kg (m^2), itself or "
             "in a body welded to it: MuJoCo refuses it, so generation will fail "
-            "(fixed_joints='merge' folds fixed links into it; bound_mass/bound_inertia "
-            "raise it)",
+            "(fixed_joints='merge', --fixed-joints merge, folds fixed links into it; "
+            "bound_mass/bound_inertia, --bound-mass/--bound-inertia, raise it)",
             element.format(name),
         )
