@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from robotwright._atomic import atomic_open
 
-__all__ = ["class_color", "plot_scan"]
+__all__ = ["class_color", "plot_scan", "upside_down"]
 
 # Fixed colours so the same class looks the same in every picture (class 0 = unknown).
 _COLORS = [
@@ -30,6 +30,28 @@ def class_color(cls_id: int) -> str:
     return _COLORS[cls_id % len(_COLORS)]
 
 
+def upside_down(sensor_quat: np.ndarray | Sequence[float] | None) -> bool:
+    """Whether a sensor with world orientation ``sensor_quat`` (w, x, y, z) is mounted
+    upside down: its z axis (the scan's up) points below the horizon."""
+    if sensor_quat is None:
+        return False
+    w, x, y, z = np.asarray(sensor_quat, dtype=np.float64).reshape(4)
+    n = w * w + x * x + y * y + z * z
+    if not np.isfinite(n) or n == 0:
+        return False
+    # World z component of the sensor's z axis: R[2, 2] of the unit quaternion.
+    return bool(1.0 - 2.0 * (x * x + y * y) / n < 0.0)
+
+
+def _limits(values: np.ndarray, extra: float | None) -> tuple[float, float]:
+    """Axis range covering ``values`` (and ``extra``) with a 4 % margin."""
+    lo, hi = float(values.min()), float(values.max())
+    if extra is not None and np.isfinite(extra):
+        lo, hi = min(lo, extra), max(hi, extra)
+    pad = max(hi - lo, 0.2) * 0.04
+    return lo - pad, hi + pad
+
+
 def plot_scan(
     points: np.ndarray,
     labels: np.ndarray,
@@ -38,67 +60,108 @@ def plot_scan(
     sensor_pos: np.ndarray | None = None,
     title: str | None = None,
     view_radius: float | None = None,
+    *,
+    class_keywords: Mapping[str, Sequence[str]] | None = None,
+    sensor_quat: np.ndarray | Sequence[float] | None = None,
+    side_slice: float | None = 1.0,
 ) -> Path:
-    """Draw hit points (world frame [m]) coloured by class id into a PNG file.
+    """Draw hit points (world frame [m]) coloured by class id into a PNG file: a top
+    view, and a side view of a slice through the sensor (walls in front of and behind
+    the furniture would otherwise cover it).
+
+    Both views are cropped to the drawn hits (and the sensor), with equal scales.
 
     Args:
         points: ``(N, 3)`` points; rows with NaN (misses) are skipped.
         labels: ``(N,)`` class ids indexing ``class_names`` (0 = unknown).
         class_names: names by class id.
         path: the PNG to write (written to a temporary file first, then renamed).
-        sensor_pos: sensor position, drawn as a black cross.
+        sensor_pos: sensor position [m], drawn as a black cross.
         title: figure title.
         view_radius: show only points within this horizontal distance [m] of the sensor
             (of the origin without ``sensor_pos``); ``None`` shows every point. Legend
             counts always cover every point.
+        class_keywords: class name -> keywords that define it (the sensor's
+            ``semantic_class_mapping``): the legend says ``valuable: sofa, table, ...``.
+        sensor_quat: sensor orientation (w, x, y, z) in the world frame; a sensor
+            mounted upside down is named in the title.
+        side_slice: the side view shows points with ``|y - y_sensor|`` at most this
+            [m] (y of the origin without ``sensor_pos``); ``None`` shows every point.
     """
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     labels = np.asarray(labels).reshape(-1)
     keep = np.isfinite(points).all(axis=1)
     points, labels = points[keep], labels[keep]
     counts = [int((labels == i).sum()) for i in range(len(class_names))]
+    centre = np.zeros(3) if sensor_pos is None else np.asarray(sensor_pos, dtype=np.float64)
     if view_radius is not None:
-        centre = np.zeros(3) if sensor_pos is None else np.asarray(sensor_pos, dtype=np.float64)
         near = np.hypot(points[:, 0] - centre[0], points[:, 1] - centre[1]) <= view_radius
         points, labels = points[near], labels[near]
-    fig, axes = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1, 1]})
-    views = (("top view", 0, 1, "x [m]", "y [m]"), ("side view", 0, 2, "x [m]", "z [m]"))
-    for ax, (name, i, j, xl, yl) in zip(axes, views, strict=True):
+    side = np.ones(len(points), dtype=bool)
+    side_name = "side view"
+    if side_slice is not None:
+        side = np.abs(points[:, 1] - centre[1]) <= side_slice
+        side_name = f"side view: slice |y - y_sensor| <= {side_slice:g} m"
+    fig, axes = plt.subplots(1, 2, figsize=(13, 6.2))
+    views = (
+        ("top view", 0, 1, "x [m]", "y [m]", np.ones(len(points), dtype=bool)),
+        (side_name, 0, 2, "x [m]", "z [m]", side),
+    )
+    for ax, (name, i, j, xl, yl, sel_view) in zip(axes, views, strict=True):
+        shown = points[sel_view]
+        # Terrain and unknown first, objects over them: class order puts classes the
+        # user listed first (terrain, in the seed's mapping) below the others.
         for cls_id in range(len(class_names)):
-            sel = labels == cls_id
+            sel = sel_view & (labels == cls_id)
             if not sel.any():
                 continue
-            color = _COLORS[cls_id % len(_COLORS)]
-            ax.scatter(points[sel, i], points[sel, j], s=1.5, c=color, linewidths=0)
+            ax.scatter(points[sel, i], points[sel, j], s=1.5, c=class_color(cls_id), linewidths=0)
         if sensor_pos is not None:
             ax.plot(sensor_pos[i], sensor_pos[j], "kx", markersize=10, mew=2)
-        ax.set_title(name)
+        if len(shown):
+            extra_i = None if sensor_pos is None else float(sensor_pos[i])
+            extra_j = None if sensor_pos is None else float(sensor_pos[j])
+            ax.set_xlim(*_limits(shown[:, i], extra_i))
+            ax.set_ylim(*_limits(shown[:, j], extra_j))
+        ax.set_title(f"{name} ({len(shown)} points)")
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_aspect("equal", adjustable="box")
         ax.grid(True, alpha=0.3)
-    from matplotlib.lines import Line2D
 
     # Legend markers drawn at a readable size (the scatter dots themselves are tiny).
     handles = []
     for cls_id, cls_name in enumerate(class_names):
-        n = counts[cls_id]
-        color = _COLORS[cls_id % len(_COLORS)]
+        words = list((class_keywords or {}).get(cls_name, ()))
+        what = f"{cls_name}: {', '.join(words)}" if words else cls_name
+        if cls_id == 0:
+            what = f"{cls_name} (no keyword matched)"
         handles.append(
             Line2D(
-                [], [], ls="", marker="o", ms=7, color=color, label=f"{cls_id} {cls_name} ({n} pts)"
+                [],
+                [],
+                ls="",
+                marker="o",
+                ms=7,
+                color=class_color(cls_id),
+                label=f"{what} ({counts[cls_id]} pts)",
             )
         )
     if sensor_pos is not None:
         handles.append(Line2D([], [], ls="", marker="x", ms=9, mew=2, color="k", label="sensor"))
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 5), frameon=False)
-    fig.suptitle(title or f"LiDAR scan: {len(points)} points")
-    fig.tight_layout(rect=(0, 0.07, 1, 0.97))
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 3), frameon=False)
+    heading = title or f"LiDAR scan: {len(points)} points"
+    if upside_down(sensor_quat):
+        heading += "\nnote: the sensor is mounted upside down (its z axis points down)"
+    fig.suptitle(heading)
+    rows = (len(handles) + 2) // 3
+    fig.tight_layout(rect=(0, 0.045 * rows + 0.03, 1, 0.97))
     path = Path(path)
     try:
         with atomic_open(path, "wb") as fh:

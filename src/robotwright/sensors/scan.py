@@ -105,6 +105,8 @@ def scan_to_files(
             title=title
             or f"{pattern_name} scan from '{sensor}': {int(lidar.get_hit_mask().sum())} hits",
             view_radius=view_radius,
+            class_keywords=lidar.semantic_class_mapping,
+            sensor_quat=lidar.data.quat_w[0],
         )
     return {
         "sensor": sensor,
