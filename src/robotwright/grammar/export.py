@@ -77,6 +77,7 @@ def export_design(
                 limb,
                 tmp / "picture.png",
                 q=display_pose(limb),
-                title=f"{name} {design.hash()}: {limb.dof} DoF (hinges at +-0.5 rad)",
+                title=f"{name}, design {design.hash()} (revolute at +-0.5 rad, "
+                "prismatic at mid-stroke)",
             )
     return out
