@@ -99,7 +99,12 @@ def step_roundtrip(out: Path, ctx: dict[str, Any]) -> str:
         if not report.ok:
             failed = "; ".join(f"{r.check}: {r.value}" for r in report.failures())
             raise RuntimeError(f"round trip of {source} failed: {report.error or failed}")
-        lines.append(f"{source} -> HRDF -> MJCF/URDF: {len(report.rows)} checks pass")
+        passed = len(report.passed())
+        empty = len(report.rows) - passed  # nothing to compare (e.g. no sensors): not a pass
+        lines.append(
+            f"{source} -> HRDF -> MJCF/URDF: {passed} checks pass"
+            + (f" ({empty} n/a: nothing to compare)" if empty else "")
+        )
     return "; ".join(lines)
 
 

@@ -121,3 +121,30 @@ def test_roundtrip_bad_input_is_exit_2_on_stderr(tmp_path, capsys, name, content
 def test_roundtrip_needs_at_least_one_configuration(probe: Path, capsys) -> None:
     assert main(["roundtrip", str(probe), "--configs", "0"]) == 2
     assert "configs: expected at least 1 configuration, got 0" in capsys.readouterr().err
+
+
+def test_roundtrip_rows_that_compare_nothing_are_not_passes(tmp_path: Path, capsys) -> None:
+    from robotwright.generators import URDFHumanoidGenerator
+
+    urdf = tmp_path / "arm6.urdf"
+    with pytest.warns(UserWarning):  # values URDF cannot hold are reported, as always
+        URDFHumanoidGenerator.from_robot_name("arm6").export(urdf)
+    assert main(["roundtrip", str(urdf), "--configs", "3"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    # arm6 has no tendon, equality, exclude or keyframe: that row is n/a, not ok.
+    (extras,) = [line for line in table if "equality/tendon/contact/keyframe" in line]
+    assert extras.lstrip().startswith("n/a")
+    assert "result:    PASS" in table
+
+
+def test_roundtrip_names_sites_carried_as_urdf_links(tmp_path: Path, capsys) -> None:
+    from robotwright.generators import MJCFHumanoidGenerator
+    from robotwright.parsers.roundtrip import roundtrip
+
+    xml = tmp_path / "arm6.xml"
+    with pytest.warns(UserWarning):
+        MJCFHumanoidGenerator.from_robot_name("arm6").export(xml)
+    report = roundtrip(xml, configs=3)
+    (row,) = [r for r in report.rows if r.check == "URDF: bodies (ref/ours)"]
+    assert row.value == "7/8" and row.ok and "1 site(s) as massless links: ['tool0']" in row.note
+    assert len(report.passed()) < len(report.rows)  # the n/a rows are not counted

@@ -48,6 +48,13 @@ class Row:
     value: str
     ok: bool
     note: str = ""
+    #: How many items the row compared (None: a measurement, always applicable). A row
+    #: that compared nothing (0 of 0 sensors) is shown as "n/a", not counted as passed.
+    compared: int | None = None
+
+    @property
+    def applicable(self) -> bool:
+        return self.compared != 0
 
 
 @dataclass
@@ -67,13 +74,17 @@ class RoundTripReport:
     def failures(self) -> list[Row]:
         return [r for r in self.rows if not r.ok]
 
+    def passed(self) -> list[Row]:
+        """Rows that compared something and agree (``n/a`` rows are not passed checks)."""
+        return [r for r in self.rows if r.ok and r.applicable]
+
     def table(self) -> str:
         lines = [f"source:    {self.source}", f"reference: {self.reference}"]
         if self.error:
             lines.append(f"ERROR: {self.error}")
         width = max((len(r.check) for r in self.rows), default=10)
         for r in self.rows:
-            mark = "ok  " if r.ok else "FAIL"
+            mark = "FAIL" if not r.ok else ("ok  " if r.applicable else "n/a ")
             note = f"  ({r.note})" if r.note else ""
             lines.append(f"  {mark} {r.check:<{width}}  {r.value}{note}")
         lines.append(f"warnings:  {len(self.warnings)}")
@@ -131,7 +142,11 @@ def compare_views(
     as_sites = [b for b in ref.bodies if b not in ours.bodies and b in ours.sites]
     # URDF has no sites: our URDF carries each site as a massless link.
     extra = [b for b in ours.bodies if b not in ref.bodies and b not in ref.sites]
+    site_links = [b for b in ours.bodies if b not in ref.bodies and b in ref.sites]
     note = f"{len(as_sites)} as sites" if as_sites else ""
+    if site_links:
+        # URDF has no sites: ours carries each as a massless link, so ours has more.
+        note = f"{len(site_links)} site(s) as massless links: {site_links[:5]}"
     if missing or extra:
         note = f"missing {missing[:5]} extra {extra[:5]}"
     rows.append(
@@ -256,6 +271,7 @@ def compare_views(
                     f"{len(ref.sites) - len(missing_sites)}/{len(ref.sites)}",
                     not missing_sites,
                     f"missing {missing_sites[:5]}" if missing_sites else "",
+                    compared=len(ref.sites),
                 )
             )
             same = ref.sensors == ours.sensors
@@ -264,6 +280,7 @@ def compare_views(
                     "sensors equal (name, type, object)",
                     f"{len(ref.sensors)}/{len(ours.sensors)}",
                     same,
+                    compared=max(len(ref.sensors), len(ours.sensors)),
                 )
             )
             if ours.model is not None and ref.model is not None:
@@ -401,6 +418,7 @@ def compare_geoms(ref: RobotView, ours: RobotView, tol: float, collision_only: b
         f"{len(a)}/{len(b)} max err {worst:.1e}"
         + (f", {unmatched} unmatched" if unmatched else ""),
         worst <= tol and unmatched == 0 and len(a) == len(b),
+        compared=max(len(a), len(b)),
     )
 
 
@@ -487,7 +505,14 @@ def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
         if sorted(names(m1, sig(m1))) != sorted(names(m2, sig(m2))):
             problems.append("contact excludes differ")
     summary = f"eq {m1.neq}, tendons {m1.ntendon}, excludes {m1.nexclude}, pairs {m1.npair}, keys {m1.nkey}"
-    return Row("equality/tendon/contact/keyframe", summary, not problems, "; ".join(problems))
+    counts = (m1.neq, m1.ntendon, m1.nexclude, m1.npair, m1.nkey)
+    return Row(
+        "equality/tendon/contact/keyframe",
+        summary,
+        not problems,
+        "; ".join(problems),
+        compared=sum(counts) + len(problems),
+    )
 
 
 def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
@@ -496,6 +521,7 @@ def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
             "actuators (order, type, transmission, dyn/gain/bias, ranges)",
             f"{len(ref.actuators)}/{len(ours.actuators)}",
             False,
+            compared=max(len(ref.actuators), len(ours.actuators)),
         )
     bad = []
     for a, b in zip(ref.actuators, ours.actuators, strict=True):
@@ -522,6 +548,7 @@ def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
         f"{len(ref.actuators)}/{len(ours.actuators)}",
         not bad,
         f"differ: {bad[:5]}" if bad else "",
+        compared=len(ref.actuators),
     )
 
 
