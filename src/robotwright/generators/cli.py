@@ -59,7 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="ROBOT",
         help="[KEY=]NAME_OR_PATH[@x,y,z[,yaw]]: a bundled robot name or HRDF folder, "
         "optionally keyed and placed at x, y, z [m] turned by yaw [rad] about z "
-        "(default: robots side by side)",
+        "(default: where its own description puts it)",
     )
     p.add_argument("--format", choices=("mjcf", "urdf"), default=None, help=_FORMAT_HELP)
     p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")
