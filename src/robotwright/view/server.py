@@ -86,7 +86,7 @@ class ViewerConfig:
     geom_groups: tuple[int, ...] = DEFAULT_GEOM_GROUPS
     body_frames: bool = False
     site_frames: bool = False
-    point_size: float = 0.02
+    point_size: float = 0.03
     grid: bool = True
     plain: bool = False
     verbose: bool = False
@@ -220,7 +220,7 @@ class Viewer:
         self.data.qpos[:] = self.scene.initial_qpos()
         xpos, xquat = body_poses(model, self.data)
         extent = max(float(model.stat.extent), 0.1)
-        axes = 0.15 * extent if model.nbody > 1 else 0.2
+        axes = 0.08 * extent if model.nbody > 1 else 0.2
         self._body_nodes = [
             server.scene.add_frame(
                 f"/bodies/b{b}",
@@ -290,25 +290,35 @@ class Viewer:
             )
 
     def _frame_camera(self) -> None:
-        """Look at the robot (the bodies other than the world) from the front-left,
-        far enough to see all of it; a scan without a robot is framed by its points."""
-        model = self.model
-        pts = [self.data.xpos[1:]] if model.nbody > 1 else []
-        if model.nbody <= 1 and self.scene.scan is not None and len(self.scene.scan.points):
-            pts.append(self.scene.scan.points)
-        if pts:
-            cloud = np.concatenate(pts)
-            lo, hi = cloud.min(axis=0), cloud.max(axis=0)
-            centre = 0.5 * (lo + hi)
-            radius = max(float(np.linalg.norm(hi - lo)) * 0.5, 0.5 * float(model.stat.extent))
+        """Look from the front-left (+x, -y, above) at what matters, far enough to see
+        all of it: the robot's geoms (those not on the world body), or for a scan the
+        bulk of its points (2nd to 98th percentile, so a few far hits do not shrink the
+        room)."""
+        model, data = self.model, self.data
+        scan = self.scene.scan
+        if scan is not None and len(scan.points):
+            lo, hi = np.percentile(scan.points, [2, 98], axis=0)
         else:
-            centre, radius = np.zeros(3), 1.0
-        radius = max(radius, 0.2)
+            mujoco.mj_kinematics(model, data)
+            moving = np.flatnonzero(
+                (model.geom_bodyid > 0) & np.isin(model.geom_group, self.config.geom_groups)
+            )
+            if moving.size == 0:
+                moving = np.flatnonzero(model.geom_type != int(mujoco.mjtGeom.mjGEOM_PLANE))
+            if moving.size:
+                r = model.geom_rbound[moving][:, None]
+                lo = (data.geom_xpos[moving] - r).min(axis=0)
+                hi = (data.geom_xpos[moving] + r).max(axis=0)
+            else:
+                lo, hi = -np.ones(3), np.ones(3)
+        centre = 0.5 * (lo + hi)
+        radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.1)
         direction = np.array([1.0, -1.0, 0.6])
         direction /= np.linalg.norm(direction)
+        # The sphere around the box fills most of the (vertical) field of view.
+        distance = 1.3 * radius / np.tan(0.5 * self.server.initial_camera.fov)
         self.server.initial_camera.look_at = tuple(centre)
-        self.server.initial_camera.position = tuple(centre + 2.2 * radius * direction)
-        self.camera_target = centre
+        self.server.initial_camera.position = tuple(centre + distance * direction)
 
     def _add_controls(self) -> None:
         gui, model = self.server.gui, self.model
