@@ -48,7 +48,8 @@ VISUAL_GROUP = 2
 _WORLD_CHILD_JOINTS = ("revolute", "continuous", "prismatic")
 COLLISION_GROUP = 3
 _KNOWN_TOP = {"link", "joint", "material"}
-_JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
+# "spherical" is not in the URDF specification; pybullet and MuJoCo read it as a ball.
+_JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical"}
 
 
 @dataclass(frozen=True)
@@ -491,11 +492,13 @@ def _joint_record(
                     where,
                 )
                 rng = None
+    if jtype == "spherical" and limit is not None and limit.get("lower") is not None:
+        rep.warn("<limit> of a spherical joint dropped (a ball joint, as MuJoCo imports it)", where)
     dyn = j.find("dynamics")
     joint = Joint(
         name=j.get("name"),
         body=body,
-        type="slide" if jtype == "prismatic" else "hinge",
+        type={"prismatic": "slide", "spherical": "ball"}.get(jtype, "hinge"),
         axis=_t(axis),
         range=rng,
         dynamic_friction=_num(dyn, "friction", 0.0, where, rep),
@@ -504,7 +507,7 @@ def _joint_record(
     effort = _num(limit, "effort", 0.0, where, rep)
     velocity = _num(limit, "velocity", 0.0, where, rep)
     actuator = None
-    if opt.actuators == "motor" and effort > 0:
+    if opt.actuators == "motor" and effort > 0 and jtype != "spherical":
         actuator = Actuator(
             joint=joint.name,
             name=joint.name,
