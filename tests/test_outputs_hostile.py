@@ -235,3 +235,32 @@ def _dead_pid() -> int:
             return proc.pid
         time.sleep(0.01)
     pytest.skip("no dead process id to test with")
+
+
+# ---------------------------------------------------------------- demo
+
+
+def test_a_failed_demo_keeps_the_previous_demo_folder(tmp_path: Path, monkeypatch) -> None:
+    from robotwright import demo
+
+    def writes(out: Path, ctx: dict) -> str:
+        (out / "robots").mkdir()
+        (out / "robots" / "a.xml").write_text("<mujoco/>")
+        return "wrote robots/a.xml"
+
+    def fails(out: Path, ctx: dict) -> str:
+        raise RuntimeError("step failed")
+
+    out = tmp_path / "demo"
+    monkeypatch.setattr(demo, "STEPS", [("writes", writes)])
+    assert demo.run_demo(out) == {"writes": "wrote robots/a.xml"}
+    before = _tree(out)
+    assert sorted(before) == ["conversion_notes.txt", "robots/a.xml", "summary.json"]
+    monkeypatch.setattr(demo, "STEPS", [("writes", writes), ("fails", fails)])
+    with pytest.raises(RuntimeError, match="step failed"):
+        demo.run_demo(out)
+    assert _tree(out) == before
+    assert sorted(os.listdir(tmp_path)) == ["demo"]  # no partial folder beside it
+    with pytest.raises(RuntimeError):
+        demo.run_demo(tmp_path / "fresh")
+    assert not (tmp_path / "fresh").exists()

@@ -12,6 +12,7 @@ import argparse
 import json
 import logging
 import math
+import os
 import time
 import warnings
 from collections.abc import Callable
@@ -93,8 +94,10 @@ def step_roundtrip(out: Path, ctx: dict[str, Any]) -> str:
         log.setLevel(level)
     for source, report in reports.items():
         notes = "".join(f"note: {w}\n" for w in report.warnings)
+        # Paths relative to the demo folder: it is built under a temporary name.
+        text = (report.table() + "\n" + notes).replace(f"{out}{os.sep}", "")
         (out / "robots" / f"roundtrip_{source.replace('.', '_')}.txt").write_text(
-            report.table() + "\n" + notes, encoding="utf-8"
+            text, encoding="utf-8"
         )
         if not report.ok:
             failed = "; ".join(f"{r.check}: {r.value}" for r in report.failures())
@@ -253,25 +256,30 @@ STEPS: list[tuple[str, Callable[[Path, dict[str, Any]], str]]] = [
 
 
 def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
-    """Run every demo step into ``out``; return step name -> one-line result."""
-    out.mkdir(parents=True, exist_ok=True)
+    """Run every demo step into ``out``; return step name -> one-line result.
+
+    The folder is built next to ``out`` and replaces it only when every step succeeded:
+    a failed or interrupted run leaves the previous demo folder as it was."""
+    from robotwright._atomic import atomic_dir
+
     ctx: dict[str, Any] = {}
     results: dict[str, str] = {}
     notes: list[str] = []
-    for i, (title, step) in enumerate(STEPS, 1):
-        t0 = time.perf_counter()
-        print(f"[{i}/{len(STEPS)}] {title} ...", flush=True)
-        # Conversion notes (values a format cannot hold) go to a file, not the terminal.
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            results[title] = step(out, ctx)
-        # One note per value or element, the unit the notes file lists (one per line).
-        step_notes = [f"[{title}] {n.text}" for w in caught for n in notes_of(str(w.message))]
-        notes += step_notes
-        note = f", {len(step_notes)} conversion note(s)" if step_notes else ""
-        print(f"      {results[title]} ({time.perf_counter() - t0:.1f} s{note})", flush=True)
-    (out / "summary.json").write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
-    (out / "conversion_notes.txt").write_text("\n".join(notes) + "\n", encoding="utf-8")
+    with atomic_dir(out) as tmp:
+        for i, (title, step) in enumerate(STEPS, 1):
+            t0 = time.perf_counter()
+            print(f"[{i}/{len(STEPS)}] {title} ...", flush=True)
+            # Conversion notes (values a format cannot hold) go to a file, not the terminal.
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                results[title] = step(tmp, ctx)
+            # One note per value or element, the unit the notes file lists (one per line).
+            step_notes = [f"[{title}] {n.text}" for w in caught for n in notes_of(str(w.message))]
+            notes += step_notes
+            note = f", {len(step_notes)} conversion note(s)" if step_notes else ""
+            print(f"      {results[title]} ({time.perf_counter() - t0:.1f} s{note})", flush=True)
+        (tmp / "summary.json").write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
+        (tmp / "conversion_notes.txt").write_text("\n".join(notes) + "\n", encoding="utf-8")
     return results
 
 
