@@ -264,3 +264,22 @@ def test_a_failed_demo_keeps_the_previous_demo_folder(tmp_path: Path, monkeypatc
     with pytest.raises(RuntimeError):
         demo.run_demo(tmp_path / "fresh")
     assert not (tmp_path / "fresh").exists()
+
+
+def test_disk_full_in_any_writer_names_its_output(tmp_path: Path) -> None:
+    """The writers behind lidar scans and pictures (atomic_open) and grammar designs
+    (atomic_dir): a full disk names the output being written."""
+    from robotwright._atomic import atomic_open
+
+    def full(*_args) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    target = tmp_path / "scan.npz"
+    with pytest.raises(OutputPathError, match=str(target)), atomic_open(target, "wb") as fh:
+        fh.write(b"x")
+        full()
+    folder = tmp_path / "design"
+    with pytest.raises(OutputPathError, match=str(folder)), atomic_dir(folder) as tmp:
+        (tmp / "design.json").write_text("{}")
+        full()
+    assert os.listdir(tmp_path) == []
