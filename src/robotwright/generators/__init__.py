@@ -1,4 +1,4 @@
-"""Generators (seed 000): HRDF robots to MJCF and URDF, and multi-robot composites.
+"""Generators: HRDF robots to MJCF and URDF, and multi-robot composites.
 
 >>> from robotwright.generators import MJCFHumanoidGenerator
 >>> gen = MJCFHumanoidGenerator.from_robot_name("mini_humanoid")  # doctest: +SKIP

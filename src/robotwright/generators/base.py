@@ -1,4 +1,4 @@
-"""``GeneratorBase``: the lifecycle shared by every generator (seed 000).
+"""``GeneratorBase``: the lifecycle shared by every generator (hurodes' API).
 
 A generator is constructed without data (``__init__``), loads its input (``load``),
 builds an XML tree on ``xml_root`` (``generate``) and writes it (``export``). ``clean``

@@ -1,10 +1,10 @@
-"""``MJCFGeneratorComposite``: several MJCF generators merged into one scene (seed 000).
+"""``MJCFGeneratorComposite``: several MJCF generators merged into one scene.
 
 Each held generator is generated with its own prefix (its key in ``generators``), its
 top-level sections are merged (``compiler``/``option`` once, identical mesh assets
 de-duplicated, ``worldbody``, ``actuator``, ``sensor``, ``contact``, ``equality``,
 ``tendon``, ...), mesh paths are rebased on their common folder, and the scene is added
-once. Beyond the seed: each robot gets a :class:`Placement` (position + yaw, or a site/
+once. Beyond hurodes: each robot gets a :class:`Placement` (position + yaw, or a site/
 body of another robot to attach at), robots' keyframes merge into scene keyframes, and a
 name used twice is a :class:`GeneratorError` before anything is written.
 """

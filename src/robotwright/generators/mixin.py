@@ -1,4 +1,4 @@
-"""``HRDFMixin``: loads an :class:`~robotwright.hrdf.HRDF` robot into a generator (seed 000).
+"""``HRDFMixin``: loads an :class:`~robotwright.hrdf.HRDF` robot into a generator.
 
 Generators themselves do not depend on HRDF (other producers can feed them); this mixin
 adds the HRDF input: ``load(hrdf)``, ``from_hrdf``, ``from_hrdf_path``, ``from_robot_name``.

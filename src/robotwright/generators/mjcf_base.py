@@ -1,4 +1,4 @@
-"""``MJCFGeneratorBase``: MuJoCo XML output, simulator settings and the scene (seed 000).
+"""``MJCFGeneratorBase``: MuJoCo XML output, simulator settings and the scene.
 
 No ``<default>`` classes are written (seed): every element carries its own values, so a
 generated file reads without resolving class inheritance.

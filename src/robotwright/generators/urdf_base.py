@@ -1,4 +1,4 @@
-"""``URDFGeneratorBase``: URDF output (a flat list of links and joints, seed 000)."""
+"""``URDFGeneratorBase``: URDF output (a flat list of links and joints)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Graph grammar that generates robot limbs (supernumerary robotic limbs, SRLs), seed 001.
+"""Graph grammar that generates robot limbs (supernumerary robotic limbs, SRLs).
 
 G = (N, T, A, R, S): a derivation from the start symbol applies rules from a YAML
 grammar, choosing components and parameters from a YAML component library. A design

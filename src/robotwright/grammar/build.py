@@ -1,6 +1,6 @@
 """Build a design into a kinematic limb (bodies, joints, DH tables) and an HRDF model.
 
-Traversal (the seed's rule): walk the design tree from the root. A connector node is
+Traversal (the original grammar's rule): walk the design tree from the root. A connector node is
 *deferred*: its joint DoFs are remembered, and added to the body of the next link (or
 end part) reached below it, in order from the root. Each link or end part is one body.
 

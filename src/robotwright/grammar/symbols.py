@@ -34,7 +34,7 @@ class Symbol:
 
 @dataclass(frozen=True)
 class NodePattern:
-    """One node of a rule side, parsed from the seed's notation.
+    """One node of a rule side, parsed from the grammar's notation.
 
     ``-X`` (``keep=True``): on a left side, the node has at least one edge; on a right
     side (first node only), the matched node is kept with its component, parameters and

@@ -10,7 +10,7 @@ from robotwright.errors import RobotwrightError
 
 #: Folder of the robots shipped with robotwright.
 BUNDLED_ROBOTS_DIR = Path(__file__).resolve().parents[1] / "robots"
-#: Environment variable naming the assets root (the seed's variable).
+#: Environment variable naming the assets root (as hurodes names it).
 ASSETS_ENV = "HURODES_ASSETS_PATH"
 
 

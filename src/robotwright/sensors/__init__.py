@@ -1,4 +1,4 @@
-"""Semantic LiDAR on MuJoCo (seed 004): scan patterns, batched ray casting, per-ray labels.
+"""Semantic LiDAR on MuJoCo: scan patterns, batched ray casting, per-ray labels.
 
 >>> from robotwright.sensors import SemanticLidarCfg, SemanticLidarSensor, LivoxPatternCfg
 >>> cfg = SemanticLidarCfg(prim_path="base", pattern_cfg=LivoxPatternCfg(), max_distance=40.0)

@@ -1,4 +1,4 @@
-"""Sensor configs: :class:`LidarCfg` and :class:`SemanticLidarCfg` (seed 004 names)."""
+"""Sensor configs: :class:`LidarCfg` and :class:`SemanticLidarCfg` (Isaac Lab-style names)."""
 
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ def _floats(value: object, n: int) -> tuple[float, ...] | None:
     return tuple(float(v) for v in items)
 
 
-#: The seed's default mapping: class ids are 1..K in this order, 0 = miss/unknown.
+#: The default mapping: class ids are 1..K in this order, 0 = miss/unknown.
 DEFAULT_SEMANTIC_CLASS_MAPPING: dict[str, list[str]] = {
     "terrain": ["ground", "wall", "floor", "plane"],
     "dynamic_obstacle": [
@@ -75,7 +75,7 @@ class LidarCfg:
             case-insensitive) matched against geom names, body names and geom paths
             (``/world/.../body/geom``); a body pattern selects all geoms of the bodies it
             matches. ``{ENV_REGEX_NS}`` at the start stands for any prefix, so the
-            seed's ``"{ENV_REGEX_NS}/cracker_box_0/_03_cracker_box"`` and
+            Isaac Lab-style ``"{ENV_REGEX_NS}/cracker_box_0/_03_cracker_box"`` and
             ``"/World/ground"`` work as written. Empty (default): every geom.
         exclude_robot: drop the geoms of the robot carrying the sensor (every body
             under the same root body as the carrier) from the hittable set.
@@ -203,7 +203,7 @@ class LidarCfg:
 
 @dataclass(kw_only=True)
 class SemanticLidarCfg(LidarCfg):
-    """:class:`LidarCfg` plus per-ray semantic classes (seed 004).
+    """:class:`LidarCfg` plus per-ray semantic classes.
 
     Attributes:
         semantic_class_mapping: class name -> keywords. A geom's class is the first

@@ -28,9 +28,9 @@ are left in an included group.
 
 Terrain: mjlab names its terrain geoms ``terrain`` (plane) or ``terrain_<n>`` (boxes and
 heightfields of generated terrain), under the terrain entity's body: their paths are
-``/world/terrain/terrain[_<n>]``, which none of the seed's default terrain keywords
-("ground", "wall", "floor", "plane") matches. The default mapping is kept as the seed
-wrote it; :func:`mjlab_class_mapping` adds the keyword ``/world/terrain/`` to the
+``/world/terrain/terrain[_<n>]``, which none of the default mapping's terrain keywords
+("ground", "wall", "floor", "plane") matches. The default mapping is kept as
+is; :func:`mjlab_class_mapping` adds the keyword ``/world/terrain/`` to the
 terrain class, and the sensor warns when the terrain would read class 0.
 
 This module imports mjlab; ``robotwright.sensors`` never imports it.
@@ -95,9 +95,9 @@ def mjlab_class_mapping(
 ) -> dict[str, list[str]]:
     """A class mapping under which mjlab's terrain geoms belong to ``terrain_class``.
 
-    Returns a copy of ``mapping`` (``None``: the seed's default mapping) with
+    Returns a copy of ``mapping`` (``None``: the default mapping) with
     :data:`MJLAB_TERRAIN_KEYWORD` appended to the keywords of ``terrain_class`` (the class
-    is added last when the mapping lacks it). Keyword matching stays the seed's
+    is added last when the mapping lacks it). Keyword matching stays the default
     case-insensitive substring rule, so nothing else changes class.
     """
     base = DEFAULT_SEMANTIC_CLASS_MAPPING if mapping is None else mapping
@@ -140,7 +140,7 @@ class _TablePattern:
 
 @dataclass(kw_only=True)
 class SemanticLidarSensorCfg(RayCastSensorCfg):
-    """mjlab config of a semantic LiDAR: seed 004's fields on mjlab's ray-cast sensor.
+    """mjlab config of a semantic LiDAR: the SemanticLidarCfg fields on mjlab's ray-cast sensor.
 
     Frames: the pattern is given in the sensor frame (+x forward, +z up), which sits at
     ``offset_pos``/``offset_rot`` in the ``frame`` object's frame; outputs are in the
@@ -159,7 +159,7 @@ class SemanticLidarSensorCfg(RayCastSensorCfg):
         offset_rot: sensor orientation in that frame, quaternion (w, x, y, z).
         semantic_class_mapping: class -> keywords matched case-insensitively in geom
             paths (``/world/<bodies>/<geom>[/<mesh>]``); class ids 1..K in mapping
-            order, 0 = miss/unknown. ``None``: the seed's default mapping (see
+            order, 0 = miss/unknown. ``None``: the default mapping (see
             :func:`mjlab_class_mapping` for mjlab's terrain).
         min_distance, max_distance: hits nearer or further are misses [m].
         range_noise_std: Gaussian range noise on hits [m], clipped to the range.
@@ -526,7 +526,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
     def debug_vis(self, visualizer: Any) -> None:
         """No ray drawing (mjlab's would loop over every ray on the host)."""
 
-    # Seed 004 getters, so the seed's observation code runs on this sensor as written.
+    # Isaac Lab-style getters, so such observation code runs on this sensor as written.
     def get_distances(self) -> torch.Tensor:
         """``(num_envs, num_rays)`` ranges [m]; misses hold ``miss_distance``."""
         return self.data.distances
@@ -580,7 +580,7 @@ def lidar_one_hot_classes(env: Any, sensor_name: str) -> torch.Tensor:
 
 
 def lidar_semantic_obs(env: Any, sensor_name: str) -> torch.Tensor:
-    """The seed's observation: ``(num_envs, num_rays * 2)``, per ray (distance [m], class id)."""
+    """The stacked observation: ``(num_envs, num_rays * 2)``, per ray (distance [m], class id)."""
     s = _sensor(env, sensor_name)
     distances = s.get_distances()
     semantic_labels = s.get_semantic_labels()

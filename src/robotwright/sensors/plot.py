@@ -116,7 +116,7 @@ def plot_scan(
     for ax, (name, i, j, xl, yl, sel_view) in zip(axes, views, strict=True):
         shown = points[sel_view]
         # Terrain and unknown first, objects over them: class order puts classes the
-        # user listed first (terrain, in the seed's mapping) below the others.
+        # user listed first (terrain, in the default mapping) below the others.
         for cls_id in range(len(class_names)):
             sel = sel_view & (labels == cls_id)
             if not sel.any():

@@ -1,7 +1,7 @@
 """``SemanticLidarSensor``: a LiDAR whose every ray carries the class of what it hit.
 
 The ray engines return the id of the hit geom for each ray, so labels are exact per ray
-(the seed's "simplified version" is not needed): a geom's class is decided once, from
+(no simplified per-mesh version is needed): a geom's class is decided once, from
 its path, and a lookup table turns hit geom ids into class ids on every update.
 """
 
@@ -26,7 +26,7 @@ __all__ = ["SemanticLidarData", "SemanticLidarSensor", "classify_path", "geom_cl
 
 def classify_path(path: str, mapping: dict[str, list[str]]) -> int:
     """Class id of a path: the first class (mapping order, ids from 1) one of whose
-    keywords occurs in it, case-insensitively; 0 when none does (seed 004's rule)."""
+    keywords occurs in it, case-insensitively; 0 when none does."""
     lowered = path.lower()
     for cls_id, keywords in enumerate(mapping.values(), start=1):
         if any(k.lower() in lowered for k in keywords):
@@ -48,7 +48,7 @@ def geom_class_table(
 
 @dataclass
 class SemanticLidarData(LidarSensorData):
-    """:class:`LidarSensorData` plus semantic fields (seed 004).
+    """:class:`LidarSensorData` plus semantic fields.
 
     Fields follow ``cfg.output`` like the parent's (numpy, or zero-copy torch/warp views).
 
@@ -129,7 +129,7 @@ class SemanticLidarSensor(LidarSensor):
     def _classify_mesh_path(self, mesh_prim_path: str) -> int:
         """Class id of a path: first class (mapping order) with a keyword in it; 0 if none.
 
-        Matching is case-insensitive substring search, as in the seed.
+        Matching is case-insensitive substring search.
         """
         return classify_path(mesh_prim_path, self.semantic_class_mapping)
 
@@ -148,7 +148,7 @@ class SemanticLidarSensor(LidarSensor):
         )
 
     def _update_buffers_impl(self, env_ids: Sequence[int] | np.ndarray | None) -> None:
-        """Cast (parent), then turn hit geom ids into labels, as in the seed."""
+        """Cast (parent), then turn hit geom ids into labels."""
         super()._update_buffers_impl(env_ids)
         self._compute_semantic_labels(env_ids)
 
