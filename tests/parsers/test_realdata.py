@@ -28,8 +28,8 @@ TESTDATA = Path(__file__).resolve().parents[2] / ".testdata/mjlab/mjlab/asset_zo
 CORPUS_CONFIGS = 10
 
 MASSLESS = (
-    "massless or zero-inertia moving link: HRDF requires mass > 0 and inertia > 0 "
-    "(passes with bound_mass/bound_inertia, see test_repaired_robots_match_yourdfpy)"
+    "moving link without mass or inertia, itself or in a link welded to it: MuJoCo refuses "
+    "it (passes with bound_mass/bound_inertia, see test_repaired_robots_match_yourdfpy)"
 )
 EXPECTED_FAILURES: dict[str, str] = {
     "alex_description/urdf/alex_nub_hands.urdf": "nub.obj holds 4 objects and MuJoCo reads the first only, an open 29-face shell whose volume it refuses, in the source and in our MJCF (passes with join_obj_objects, see test_split_obj_robot_passes_with_join_obj_objects)",
