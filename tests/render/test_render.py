@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import warnings
 
+import matplotlib.image as mpimg
 import mujoco
 import numpy as np
 import pytest
@@ -212,7 +213,7 @@ def test_sources(tmp_path) -> None:
         assert load_model("arm6").model.nu == 6
     bad = tmp_path / "robot.stl"
     bad.write_bytes(b"solid x")
-    with pytest.raises(SourceError, match="cannot draw a '.stl' file"):
+    with pytest.raises(SourceError, match="cannot show a '.stl' file"):
         load_model(bad)
     with pytest.raises(SourceError, match="missing.xml: no such file"):
         load_model(tmp_path / "missing.xml")
@@ -257,3 +258,30 @@ def test_unitree_g1_meshes_are_drawn(testdata_dir) -> None:
     assert 0.05 < drawn.mean() < 0.7  # no floor in this file: what is drawn is the robot
     rows = np.nonzero(drawn.any(axis=1))[0]
     assert rows.max() - rows.min() > 0.6 * SMALL["height"]
+
+
+def test_scan_source_draws_its_points_in_its_scene(tmp_path) -> None:
+    from robotwright.render import render
+    from robotwright.sensors.scan import save_npz
+
+    scene = tmp_path / "scene.xml"
+    scene.write_text(RED_BOX, encoding="utf-8")
+    xs, ys = np.meshgrid(np.linspace(-1.5, 1.5, 40), np.linspace(-1.5, 1.5, 40))
+    points = np.stack([xs.ravel(), ys.ravel(), np.full(xs.size, 0.001)], axis=1)
+    npz = save_npz(
+        tmp_path / "scan.npz",
+        points=points,
+        labels=np.ones(len(points), dtype=np.int64),
+        class_names=np.array(["unknown", "terrain"]),
+    )
+    opts = RenderOptions(backend="software", camera="top", **SMALL)
+    with_points = render(npz, tmp_path / "scan.png", opts, scene=scene)
+    without = render(scene, None, opts)
+    changed = np.abs(with_points.image.astype(int) - without.image.astype(int)).max(axis=2) > 30
+    assert 0.05 < changed.mean() < 0.9
+    # The box hides the floor points under it: its centre is unchanged.
+    h, w = changed.shape
+    assert not changed[h // 2 - 3 : h // 2 + 3, w // 2 - 3 : w // 2 + 3].any()
+    assert mpimg.imread(tmp_path / "scan.png").shape[:2] == (SMALL["height"], SMALL["width"])
+    with pytest.raises(SourceError, match="applies to a scan"):
+        render("arm6", None, opts, scene=scene)

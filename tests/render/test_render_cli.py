@@ -56,3 +56,12 @@ def test_cli_bad_input_exits_2_with_message(tmp_path: Path, capsys, args, messag
 def test_cli_output_must_be_png(tmp_path: Path, capsys) -> None:
     assert main(["render", "arm6", "-o", str(tmp_path / "x.jpg")]) == 2
     assert "x.jpg: expected a .png output file" in capsys.readouterr().err
+
+
+def test_cli_scan_needs_a_scan_for_scene(tmp_path: Path, capsys) -> None:
+    scene = tmp_path / "scene.xml"
+    scene.write_text("<mujoco><worldbody><geom size='1 1 0.1' type='plane'/></worldbody></mujoco>")
+    out = tmp_path / "x.png"
+    assert main(["render", "arm6", "-o", str(out), "--scene", str(scene)]) == 2
+    assert "applies to a scan (.npz), not to 'arm6'" in capsys.readouterr().err
+    assert not out.exists()

@@ -26,14 +26,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "render",
         help="draw a robot or scene to a PNG picture (no display needed)",
         description=(
-            "Draw a bundled robot, an HRDF folder, an MJCF file (robot or composed scene) "
-            "or a URDF file in its first keyframe (else its reference pose) to a PNG. "
+            "Draw a bundled robot, an HRDF folder, an MJCF file (robot or composed scene), "
+            "a URDF file or a grammar design folder in its first keyframe (else its "
+            "reference pose) to a PNG; or a LiDAR scan's points in its scene. "
             "MuJoCo's OpenGL renderer draws when an off-screen GL platform starts (EGL, "
             "OSMesa; MUJOCO_GL picks one), otherwise a built-in software renderer does; "
             "the command says which."
         ),
     )
-    p.add_argument("source", help="robot name, HRDF folder, MJCF (.xml) or URDF (.urdf) file")
+    p.add_argument(
+        "source",
+        help="robot name, HRDF folder, MJCF (.xml) or URDF (.urdf) file, grammar design "
+        "folder, or scan (.npz, with --scene)",
+    )
     p.add_argument("-o", "--output", type=Path, required=True, help="PNG file to write")
     p.add_argument(
         "--camera",
@@ -52,6 +57,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="auto: OpenGL when it starts, else software (default); gl: OpenGL or fail",
     )
     p.add_argument("--title", help="a line of text drawn at the top of the picture")
+    p.add_argument(
+        "--scene",
+        help="the MJCF scene a scan .npz was taken in (its points are drawn in it)",
+    )
     add_overwrite_flag(p)
     p.set_defaults(func=run)
 
@@ -60,9 +69,8 @@ def run(args: argparse.Namespace) -> int:
     from robotwright._atomic import check_output_path
     from robotwright._outputs import check_overwrite
     from robotwright.errors import OutputPathError
-    from robotwright.render.core import RenderOptions, render_model
-    from robotwright.render.png import save_png
-    from robotwright.render.source import load_model
+    from robotwright.render.api import render
+    from robotwright.render.core import RenderOptions
 
     out: Path = args.output
     if out.suffix.lower() != ".png":
@@ -72,9 +80,14 @@ def run(args: argparse.Namespace) -> int:
     width, height = args.size
     # Options are checked before the model is loaded: a typo fails at once.
     options = RenderOptions(width=width, height=height, camera=args.camera, backend=args.backend)
-    loaded = load_model(args.source, asset_roots=tuple(getattr(args, "asset_roots", ()) or ()))
-    picture = render_model(loaded.model, loaded.initial_data(), options)
-    save_png(picture, out, title=args.title)
+    picture = render(
+        args.source,
+        out,
+        options,
+        scene=args.scene,
+        title=args.title,
+        asset_roots=tuple(getattr(args, "asset_roots", ()) or ()),
+    )
     for note in picture.notes:
         print(f"note: {note}", file=sys.stderr)
     print(f"wrote {out} ({width}x{height}, {picture.backend} renderer, camera {picture.camera})")

@@ -284,7 +284,10 @@ def render_model(
     pts, cols = _check_points(points, point_colors)
     spec = opts.camera_spec
     probe = _scene(model, data, mujoco.MjvCamera())
-    cam = make_camera(model, spec, drawn_bounds(model, probe), opts.width / opts.height)
+    corners = drawn_bounds(model, probe)
+    if pts is not None and len(pts):  # the points are framed too (a scan without scene)
+        corners = np.concatenate([corners, pts.min(axis=0)[None], pts.max(axis=0)[None]])
+    cam = make_camera(model, spec, corners, opts.width / opts.height)
     scene = _scene(model, data, cam)
     notes: list[str] = []
     image: np.ndarray | None = None
