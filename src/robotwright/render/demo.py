@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from robotwright.errors import ConversionWarning
 from robotwright.render.core import RenderOptions, render_model
 from robotwright.render.png import save_png
 from robotwright.render.scan import render_scan
@@ -42,7 +44,11 @@ def demo_pictures(
     }
     written, backends = [], set()
     for key, title in titles.items():
-        model = MJCFHumanoidGenerator.from_hrdf(ctx[key]).to_model()
+        with warnings.catch_warnings():
+            # The export step already reported what MJCF cannot hold for these robots;
+            # the same notes again would only double the demo's list.
+            warnings.simplefilter("ignore", ConversionWarning)
+            model = MJCFHumanoidGenerator.from_hrdf(ctx[key]).to_model()
         picture = render_model(model, None, robot_opts)
         name = "humanoid_with_limb.png" if key == "wearer" else f"{key}.png"
         save_png(picture, out / name, title=title)
