@@ -283,3 +283,13 @@ def test_disk_full_in_any_writer_names_its_output(tmp_path: Path) -> None:
         (tmp / "design.json").write_text("{}")
         full()
     assert os.listdir(tmp_path) == []
+
+
+def test_an_old_folder_moved_aside_by_a_killed_run_is_put_back(tmp_path: Path) -> None:
+    # A run killed between "move the old output aside" and "rename the new one in".
+    aside = tmp_path / f".robot.{_dead_pid()}.abcdefgh"
+    (aside / "x").mkdir(parents=True)
+    (aside / "x" / "meta.yaml").write_text("old")
+    with pytest.raises(RuntimeError), atomic_dir(tmp_path / "robot"):
+        raise RuntimeError("this run fails too")
+    assert _tree(tmp_path) == {"robot/meta.yaml": b"old"}

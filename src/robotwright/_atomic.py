@@ -123,6 +123,28 @@ def remove_stale_temporaries(folder: str | os.PathLike[str], target: str) -> Non
                 os.unlink(entry.path)
 
 
+def _restore_moved_aside(target: Path) -> None:
+    """Put back an old ``target`` that a killed :func:`atomic_dir` had moved aside (it is
+    killed between its two renames) before that process's temporaries are removed."""
+    if target.exists() or target.is_symlink():
+        return
+    try:
+        entries = list(os.scandir(target.parent))
+    except OSError:
+        return
+    for entry in entries:
+        match = _TEMP_NAME.match(entry.name)
+        if (
+            match is not None
+            and match["target"] == target.name
+            and entry.is_dir(follow_symlinks=False)
+            and not _running(int(match["pid"]))
+            and os.path.lexists(os.path.join(entry.path, "x"))
+        ):
+            os.replace(os.path.join(entry.path, "x"), target)
+            return
+
+
 def _prefix(name: str) -> str:
     return f".{name}.{os.getpid()}."
 
@@ -328,6 +350,7 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
     target = Path(target)
     check_output_path(target, folder=True)
     created = _make_parents(target.parent)
+    _restore_moved_aside(target)
     remove_stale_temporaries(target.parent, target.name)
     try:
         tmp = Path(tempfile.mkdtemp(prefix=_prefix(target.name), dir=target.parent))
@@ -342,6 +365,7 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
         yield tmp
         if target.exists() or target.is_symlink():
             # Move the old one aside first: os.replace cannot overwrite a non-empty folder.
+            # (Killed between the two renames, the next atomic_dir puts it back.)
             old = Path(tempfile.mkdtemp(prefix=_prefix(target.name), dir=target.parent))
             os.replace(target, old / "x")
             os.replace(tmp, target)
