@@ -98,7 +98,7 @@ def test_convert_urdf_only_option_on_mjcf_source_is_named(probe: Path, tmp_path:
     ("name", "content", "expected"),
     [
         ("missing.urdf", None, "missing.urdf: file not found: expected a .urdf or .xml file"),
-        ("model.txt", "x", "model.txt: expected a .urdf or .xml (MJCF) file"),
+        ("model.txt", "x", "model.txt: expected a .urdf, .xacro or .xml (MJCF) file"),
         ("empty.xml", "", "empty.xml: not well-formed XML: no element found"),
         ("cut.urdf", "<robot name='r'><link name='a'>", "cut.urdf: not well-formed XML"),
         (
