@@ -285,3 +285,21 @@ def test_scan_source_draws_its_points_in_its_scene(tmp_path) -> None:
     assert mpimg.imread(tmp_path / "scan.png").shape[:2] == (SMALL["height"], SMALL["width"])
     with pytest.raises(SourceError, match="applies to a scan"):
         render("arm6", None, opts, scene=scene)
+
+
+def test_transparent_geom_is_blended_over_what_is_behind() -> None:
+    def picture(alpha: float) -> np.ndarray:
+        model = mujoco.MjModel.from_xml_string(
+            f"""<mujoco><worldbody><light pos="0 0 3" dir="0 0 -1"/>
+            <geom type="box" size="0.3 0.3 0.3" rgba="0.9 0.1 0.1 1"/>
+            <geom type="box" pos="0.6 0 0" size="0.02 0.6 0.6" rgba="0.1 0.1 0.9 {alpha}"/>
+            </worldbody></mujoco>"""
+        )
+        opts = RenderOptions(camera="front", backend="software", **SMALL)
+        return render_model(model, None, opts).image.astype(int)
+
+    h, w = SMALL["height"], SMALL["width"]
+    centre = (slice(h // 2 - 3, h // 2 + 3), slice(w // 2 - 3, w // 2 + 3))
+    solid, glass = picture(1.0)[centre].mean((0, 1)), picture(0.4)[centre].mean((0, 1))
+    assert solid[2] > 2 * solid[0]  # an opaque blue pane hides the red box
+    assert glass[0] > 1.5 * solid[0] and glass[2] > 30  # through glass: red and blue

@@ -214,12 +214,25 @@ def _software(
     reach = max(float(model.stat.extent) * 10.0, 10.0)
     tris = scene_triangles(model, scene, plane_reach=reach)
     notes += [f"not drawn: {s}" for s in tris.skipped]
-    frame = rasterise(tris.vertices, view, w, h)
     colours = shade(tris.vertices, tris.rgba, view, *_lights(scene))
+    # Opaque triangles first; then the nearest partly transparent surface in front of
+    # them is blended over by its alpha (one layer: enough for a glass cover or a
+    # see-through marker, not for stacks of them).
+    opaque = tris.rgba[:, 3] >= 0.999
+    ids = np.nonzero(opaque)[0]
+    frame = rasterise(tris.vertices[ids], view, w, h)
+    face = np.where(frame.face >= 0, ids[np.maximum(frame.face, 0)], -1)
     image = _sky(h, w).copy()
-    hit = frame.face >= 0
-    image[hit] = colours[frame.face[hit]]
-    _checker(image, frame.face, frame.depth, view, tris.checker)
+    hit = face >= 0
+    image[hit] = colours[face[hit]]
+    _checker(image, face, frame.depth, view, tris.checker)
+    if not opaque.all():
+        ids = np.nonzero(~opaque)[0]
+        glass = rasterise(tris.vertices[ids], view, w, h)
+        over = (glass.face >= 0) & (glass.depth < frame.depth)
+        top = ids[glass.face[over]]
+        alpha = tris.rgba[top, 3:4]
+        image[over] = alpha * colours[top] + (1.0 - alpha) * image[over]
     return image, frame.depth, view, ss
 
 
