@@ -161,7 +161,7 @@ def plot_scan(
         heading += "\nnote: the sensor is mounted upside down (its z axis points down)"
     fig.suptitle(heading)
     rows = (len(handles) + 2) // 3
-    fig.tight_layout(rect=(0, 0.045 * rows + 0.03, 1, 0.97))
+    fig.tight_layout(rect=(0, 0.06 * rows + 0.03, 1, 0.97))
     path = Path(path)
     try:
         with atomic_open(path, "wb") as fh:
