@@ -146,3 +146,23 @@ def _is_below(model: mujoco.MjModel, body: int, name: str) -> bool:
             return True
         body = model.body_parentid[body]
     return False
+
+
+def test_collision_only_robot_is_still_shown(tmp_path: Path) -> None:
+    """A robot whose geoms are all in collision group 3 (as a URDF with collision
+    elements only may be read): the page shows that group rather than an empty floor,
+    and says so; groups asked for explicitly are kept."""
+    xml = tmp_path / "robot.xml"
+    xml.write_text(
+        '<mujoco><worldbody><geom name="floor" type="plane" size="1 1 0.1"/>'
+        '<body name="link" pos="0 0 0.5"><joint name="j"/>'
+        '<geom type="capsule" size="0.05 0.2" group="3"/>'
+        '<geom type="box" size="0.1 0.1 0.1" pos="0 0 0.3" group="3"/></body>'
+        "</worldbody></mujoco>",
+        encoding="utf-8",
+    )
+    with show(xml, port=0) as viewer:
+        assert set(viewer._geom_nodes) == {0, 1, 2}
+        assert any("showing groups [3]" in n for n in viewer.notes)
+    with show(xml, port=0, geom_groups=(0,)) as viewer:
+        assert set(viewer._geom_nodes) == {0} and not viewer.notes

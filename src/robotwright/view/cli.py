@@ -103,7 +103,7 @@ def _run(args: argparse.Namespace) -> int:
         f"{scene.title}: {m.nbody - 1} bodies, {m.njnt} joints, {viewer.geom_count} geoms shown"
         + (f", {len(scene.scan.points)} scan points" if scene.scan is not None else "")
     )
-    for line in viewer.skipped:
+    for line in [*viewer.notes, *viewer.skipped]:
         print(f"note: {line}", file=sys.stderr)
     print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
     try:

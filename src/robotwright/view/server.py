@@ -120,6 +120,7 @@ class Viewer:
         self.model = scene.model
         self.data = mujoco.MjData(self.model)
         self.skipped: list[str] = []
+        self.notes: list[str] = []
         self._lock = threading.Lock()
         self._shapes: dict[int, list[GeomShape]] = {}
         for shape in geom_shapes(self.model, skipped=self.skipped):
@@ -244,7 +245,7 @@ class Viewer:
             for s in site_frames(model)
         ]
         self._visible_groups: set[int] = set()
-        self.show_groups(set(self.config.geom_groups))
+        self.show_groups(self._first_groups())
         has_plane = bool(np.any(model.geom_type == int(mujoco.mjtGeom.mjGEOM_PLANE)))
         if self.config.grid and not has_plane:
             server.scene.add_grid("/grid", width=4 * extent, height=4 * extent, cell_size=0.1)
@@ -252,6 +253,20 @@ class Viewer:
             self._add_scan()
         self._frame_camera()
         self._add_controls()
+
+    def _first_groups(self) -> set[int]:
+        """The configured groups; when they are MuJoCo's default and hold no geom of the
+        robot (a URDF with collision elements only, read into group 3), every group
+        holding one, so that the robot is not missing from the page."""
+        groups = set(self.config.geom_groups)
+        robot = {s.group for shapes in self._shapes.values() for s in shapes if s.body_id > 0}
+        if self.config.geom_groups == DEFAULT_GEOM_GROUPS and robot and not robot & groups:
+            self.notes.append(
+                f"the robot has no geom in groups {sorted(groups)}: showing groups "
+                f"{sorted(robot)} (its collision geoms) instead"
+            )
+            groups |= robot
+        return groups
 
     def _add_group(self, group: int) -> None:
         with self.server.atomic():
@@ -301,7 +316,7 @@ class Viewer:
         else:
             mujoco.mj_kinematics(model, data)
             moving = np.flatnonzero(
-                (model.geom_bodyid > 0) & np.isin(model.geom_group, self.config.geom_groups)
+                (model.geom_bodyid > 0) & np.isin(model.geom_group, list(self._visible_groups))
             )
             if moving.size == 0:
                 moving = np.flatnonzero(model.geom_type != int(mujoco.mjtGeom.mjGEOM_PLANE))
