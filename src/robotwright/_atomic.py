@@ -292,7 +292,10 @@ class StagedFiles:
         try:
             staged.write_text(text, encoding="utf-8")
         except OSError as exc:
-            raise write_error(self.out_dir / rel, exc) from exc
+            err = write_error(self.out_dir / rel, exc)
+            if err is not exc:
+                raise err from exc
+            raise
 
     def copy(self, src: Path, rel: str | os.PathLike[str]) -> None:
         """Stage a copy of the regular file ``src`` as ``out_dir/rel``."""
