@@ -31,6 +31,10 @@ def _options(args: argparse.Namespace) -> dict:
         opts["xacro_args"] = dict(args.xacro_arg)
     if getattr(args, "actuator_gain", None):
         opts["actuator_gains"] = dict(args.actuator_gain)
+    if getattr(args, "collision_max_faces", None) is not None:
+        opts["collision_max_faces"] = args.collision_max_faces
+    if getattr(args, "convex_decomposition", False):
+        opts["convex_decomposition"] = True
     return opts
 
 
@@ -137,6 +141,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--strict", action="store_true", help="fail instead of dropping anything")
     add_overwrite_flag(p)
     _repair_args(p)
+    p.add_argument(
+        "--collision-max-faces",
+        type=int,
+        metavar="N",
+        help="decimate collision meshes with more than N triangles to N (visual meshes "
+        "untouched; needs the meshfix extra)",
+    )
+    p.add_argument(
+        "--convex-decomposition",
+        action="store_true",
+        help="split each collision mesh into convex parts with CoACD (needs the meshfix extra)",
+    )
     p.set_defaults(func=_convert)
 
     p = sub.add_parser(

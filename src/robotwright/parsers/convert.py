@@ -76,7 +76,9 @@ def convert(
 ) -> list[str]:
     """Convert ``src`` to ``dst``; returns every warning (parser and writer) as text.
 
-    ``options`` go to the parser (see ``URDFOptions`` / ``MJCFOptions``).
+    ``options`` go to the parser (see ``URDFOptions`` / ``MJCFOptions``), except
+    ``collision_max_faces`` and ``convex_decomposition``, which repair the collision
+    meshes afterwards (see :mod:`robotwright.parsers.collision`; each repair reported).
     """
     src_p, dst_p = Path(src), Path(dst)
     out_kind = file_kind(dst_p, existing=False)
@@ -97,8 +99,14 @@ def _convert(
     overwrite: bool,
     options: dict[str, Any],
 ) -> list[str]:
+    from robotwright.parsers.collision import pop_config, repair_collision_meshes
+
+    options = dict(options)
+    repairs = pop_config(options)  # opt-in collision-mesh repairs, after the parse
     hrdf, problems = load_any(src_p, strict=strict, **options)
     messages = [str(p) for p in problems]
+    hrdf, repaired = repair_collision_meshes(hrdf, repairs)
+    messages += [str(r) for r in repaired]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
