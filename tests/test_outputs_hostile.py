@@ -293,3 +293,17 @@ def test_an_old_folder_moved_aside_by_a_killed_run_is_put_back(tmp_path: Path) -
     with pytest.raises(RuntimeError), atomic_dir(tmp_path / "robot"):
         raise RuntimeError("this run fails too")
     assert _tree(tmp_path) == {"robot/meta.yaml": b"old"}
+
+
+def test_cli_export_on_a_full_disk_is_exit_2_naming_the_output(
+    arm: Path, tmp_path: Path, monkeypatch, capsys
+) -> None:
+    from robotwright.cli import main
+
+    out = tmp_path / "out" / "arm.xml"
+    _enospc_after(monkeypatch, 1)
+    assert main(["export", str(arm), "-o", str(out), "--copy-meshes"]) == 2
+    err = capsys.readouterr().err
+    assert str(out.parent / "meshes" / "arm") in err and "No space left" in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "out").exists()
