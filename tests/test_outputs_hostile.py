@@ -307,3 +307,14 @@ def test_cli_export_on_a_full_disk_is_exit_2_naming_the_output(
     assert str(out.parent / "meshes" / "arm") in err and "No space left" in err
     assert "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_disk_full_inside_a_new_folder_names_the_final_path(tmp_path: Path, monkeypatch) -> None:
+    src = tmp_path / "src.bin"
+    src.write_bytes(b"mesh")
+    _enospc_after(monkeypatch, 1)
+    target = tmp_path / "robot"
+    with pytest.raises(OutputPathError) as info, atomic_dir(target) as tmp:
+        copy_file_atomic(src, tmp / "meshes" / "m.bin")
+    assert str(target / "meshes" / "m.bin") in str(info.value)
+    assert sorted(os.listdir(tmp_path)) == ["src.bin"]

@@ -378,6 +378,9 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
     except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
         _remove_empty(created)
+        if isinstance(exc, OutputPathError) and str(tmp) in str(exc):
+            # A file inside the folder failed: name it where the user will look for it.
+            raise OutputPathError(str(exc).replace(str(tmp), str(target))) from exc
         if isinstance(exc, OSError):
             err = write_error(target, exc)
             if err is not exc:
