@@ -123,7 +123,7 @@ class Browser:
         self,
         until: Callable[[np.ndarray], bool] | None = None,
         timeout: float = 90.0,
-        interval: float = 0.5,
+        interval: float = 0.3,
     ) -> np.ndarray:
         """A screenshot once ``until(shot)`` holds and two shots in a row are identical
         (the page has settled)."""
