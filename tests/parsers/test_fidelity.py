@@ -15,6 +15,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+import trimesh
 
 from robotwright.errors import ConversionError
 from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
@@ -170,12 +171,17 @@ def test_flat_visual_mesh_kept_as_shell_pybullet_plane() -> None:
 
 
 @pytest.mark.realdata
-def test_unreadable_visual_mesh_dropped_pybullet_table_square() -> None:
-    """table.obj has out-of-range normal indices: MuJoCo cannot read it (its URDF import
-    discards visuals); ours drops it with a warning and the robot still compiles."""
+def test_unreadable_visual_mesh_rewritten_pybullet_table_square() -> None:
+    """table.obj has out-of-range normal indices: MuJoCo cannot decode it (its URDF import
+    discards visuals); ours keeps the geometry, rewritten by trimesh (reported), and the
+    robot compiles with it."""
     path = _need(PB / "table_square" / "table_square.urdf")
     result = urdf_to_hrdf_with_warnings(path)
-    assert any("table.obj" in w and "dropped" in w for w in _warnings(result))
+    assert any("table.obj" in w and "rewritten with trimesh" in w for w in _warnings(result))
+    (visual,) = [m for m in result.hrdf.meshes if not m.contact_type]
+    src_faces = len(trimesh.load(path.parent / "table.obj", force="mesh", process=False).faces)
+    model = our_mjcf_model(result.hrdf)
+    assert model.nmesh == 1 and int(model.mesh_facenum[0]) == src_faces
     report = roundtrip(path, configs=5, reference="mujoco")
     assert report.ok, report.table()
 

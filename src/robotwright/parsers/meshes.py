@@ -173,6 +173,18 @@ class MeshStore:
         return entry
 
 
+def rewrite_staged(store: MeshStore, rel: str) -> str:
+    """Rewrite the staged file ``rel`` with trimesh (triangles unchanged; normals and
+    texture coordinates dropped) and return the new file's path relative to the store,
+    for a file MuJoCo cannot decode (an OBJ with out-of-range normal indices)."""
+    source = store.root / rel
+    key = f"{source.resolve()}#rewritten"
+    if key not in store.staged:
+        new_rel, faces = store._write(load_triangles(source), _safe_stem(source) + "_rewritten")
+        store.staged[key] = StagedMesh(source, new_rel, "format", faces)
+    return store.staged[key].rel
+
+
 def mesh_store(work_dir: Path | None, join_obj_objects: bool = False) -> MeshStore:
     """A store in ``work_dir`` (a new temporary folder when None)."""
     if work_dir:

@@ -36,7 +36,12 @@ from robotwright.hrdf.model import (
 from robotwright.parsers import inertia as inr
 from robotwright.parsers import urdf_actuators as acts
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
-from robotwright.parsers.meshes import MeshConversionError, conversion_note, mesh_store
+from robotwright.parsers.meshes import (
+    MeshConversionError,
+    conversion_note,
+    mesh_store,
+    rewrite_staged,
+)
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
 from robotwright.parsers.visuals import drop_unbuildable_visuals
@@ -804,7 +809,11 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
                 table[i] = _replace_name(g, new_name, "geom_name")
     extra = _mimic_extra(mimics, {j.name for j in hrdf_joints}, rep)
     geoms_mesh, geoms_simple = drop_unbuildable_visuals(
-        geoms_mesh, geoms_simple, reader.store.root, rep
+        geoms_mesh,
+        geoms_simple,
+        reader.store.root,
+        rep,
+        lambda rel: rewrite_staged(reader.store, rel),
     )
     tables = (hrdf_bodies, hrdf_joints, geoms_mesh, geoms_simple, sites)
     _rename_world_body(tables, {x.get("name") for x in links.values()}, rep)

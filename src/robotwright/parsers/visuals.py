@@ -9,12 +9,15 @@ warning naming it: never an MJCF that does not compile.
 - A primitive with a size MuJoCo needs at 0 (or below) is dropped: it draws nothing.
 - A mesh is compiled alone by MuJoCo. One refused for its volume ("mesh volume is too
   small") is kept with ``inertia="shell"`` (MuJoCo then uses its area; a visual geom
-  carries no mass here, the body's inertial is explicit); one refused otherwise is
-  dropped.
+  carries no mass here, the body's inertial is explicit); one refused otherwise (an OBJ
+  with out-of-range normal indices) is rewritten with trimesh (triangles kept, normals
+  and texture coordinates dropped) when a ``rewrite`` function is given and MuJoCo
+  builds the copy; else it is dropped.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -52,12 +55,27 @@ def _mesh_error(file: Path, scale: tuple[float, float, float], inertia: str | No
     return ""
 
 
+def _buildable(root: Path, file: str, scale, inertia: str | None) -> tuple[str | None, str]:
+    """(inertia mode MuJoCo builds the mesh with, or None when it cannot; its error)."""
+    err = _mesh_error(root / file, scale, inertia)
+    if not err:
+        return inertia or "", ""
+    if "volume" in err and not _mesh_error(root / file, scale, "shell"):
+        return "shell", err
+    return None, err
+
+
 def drop_unbuildable_visuals(
-    meshes: list[MeshGeom], simple: list[SimpleGeom], root: Path, rep: Reporter
+    meshes: list[MeshGeom],
+    simple: list[SimpleGeom],
+    root: Path,
+    rep: Reporter,
+    rewrite: Callable[[str], str] | None = None,
 ) -> tuple[list[MeshGeom], list[SimpleGeom]]:
-    """The geom tables without visual geoms MuJoCo cannot build (each reported), and
-    with ``inertia="shell"`` on visual meshes that MuJoCo builds only so. ``root`` is the
-    folder the mesh files are relative to."""
+    """The geom tables without visual geoms MuJoCo cannot build (each reported), with
+    ``inertia="shell"`` on visual meshes that MuJoCo builds only so, and rewritten files
+    (``rewrite(rel) -> new rel``) for those it cannot decode. ``root`` is the folder the
+    mesh files are relative to."""
     kept_simple = []
     for g in simple:
         used = g.size[: _SIZE_USED.get(g.type, 3)]
@@ -69,7 +87,7 @@ def drop_unbuildable_visuals(
             )
             continue
         kept_simple.append(g)
-    verdicts: dict[tuple[str, tuple[float, float, float]], tuple[bool, str | None, str]] = {}
+    verdicts: dict[tuple[str, tuple[float, float, float]], tuple[str | None, str | None, str]] = {}
     kept_meshes = []
     for g in meshes:
         if not _visual(g) or g.file is None:
@@ -77,22 +95,42 @@ def drop_unbuildable_visuals(
             continue
         key = (g.file, tuple(g.scale))
         if key not in verdicts:
-            err = _mesh_error(root / g.file, g.scale, g.inertia)
-            if not err:
-                verdicts[key] = (True, g.inertia, "")
-            elif "volume" in err and not _mesh_error(root / g.file, g.scale, "shell"):
-                verdicts[key] = (True, "shell", err)
-                rep.warn(
-                    f"visual mesh '{g.file}': {err}; kept with inertia='shell' (a visual "
-                    "mesh carries no mass here)"
-                )
-            else:
-                verdicts[key] = (False, None, err)
-        ok, inertia, err = verdicts[key]
-        if not ok:
+            verdicts[key] = _verdict(g, root, rep, rewrite)
+        file, inertia, err = verdicts[key]
+        if file is None:
             rep.warn(
                 f"visual mesh '{g.file}' on body '{g.body}' dropped: MuJoCo cannot build it ({err})"
             )
             continue
-        kept_meshes.append(g if inertia == g.inertia else replace(g, inertia=inertia))
+        if (file, inertia) != (g.file, g.inertia):
+            g = replace(g, file=file, inertia=inertia)
+        kept_meshes.append(g)
     return kept_meshes, kept_simple
+
+
+def _verdict(
+    g: MeshGeom, root: Path, rep: Reporter, rewrite: Callable[[str], str] | None
+) -> tuple[str | None, str | None, str]:
+    """(file to use or None to drop, inertia mode, MuJoCo's error) for a visual mesh."""
+    mode, err = _buildable(root, g.file, g.scale, g.inertia)
+    if mode is not None:
+        if err:
+            rep.warn(
+                f"visual mesh '{g.file}': {err}; kept with inertia='shell' (a visual mesh "
+                "carries no mass here)"
+            )
+        return g.file, mode or None, err
+    if rewrite is None or "volume" in err:
+        return None, None, err
+    try:
+        new = rewrite(g.file)
+    except Exception as exc:  # noqa: BLE001 - an unreadable file is dropped, reported
+        return None, None, f"{err}; trimesh cannot read it either: {exc}"
+    mode, err2 = _buildable(root, new, g.scale, g.inertia)
+    if mode is None:
+        return None, None, err
+    rep.warn(
+        f"visual mesh '{g.file}': {err}; rewritten with trimesh as '{new}' (triangles kept, "
+        "normals and texture coordinates dropped)" + ("; kept with inertia='shell'" if err2 else "")
+    )
+    return new, mode or None, err
