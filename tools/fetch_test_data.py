@@ -11,7 +11,10 @@ assets and ``pybullet_data`` (about 320 MB of wheels, 780 MB unpacked, ~15 s her
 
 hurodes 0.1.9, the peer tool whose folders we must read and which must read ours, is
 installed into its own virtual environment ``.testdata/hurodes-venv`` (it needs
-``numpy<2.4``); the compatibility tests find it there (or through ``$HURODES_PYTHON``).
+``numpy<2.4``, and trimesh to write meshes); the compatibility tests find it there (or
+through ``$HURODES_PYTHON``). hurodes then converts mjlab's G1 MJCF (and a small
+synthetic robot) into the HRDF folders of ``.testdata/hurodes-fixtures`` and exports its
+own MJCF of the G1 for the equivalence tests (see ``hurodes_fixtures.py``).
 
 The viewer's browser test (``tests/view``) loads the page in headless Chromium:
 Debian's ``chromium`` package is installed with ``apt-get`` where it is absent and this
@@ -29,6 +32,8 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
+
+from hurodes_fixtures import make_hurodes_fixtures
 
 ROOT = Path(__file__).resolve().parents[1]
 TESTDATA = ROOT / ".testdata"
@@ -126,13 +131,17 @@ def make_hurodes_venv() -> Path:
     marker = venv / ".hurodes-0.1.9"
     if marker.exists():
         print(f"hurodes already in {venv}")
+        if not (venv / ".trimesh").exists():  # venvs made before hurodes wrote fixtures
+            subprocess.run([str(python), "-m", "pip", "install", "--quiet", "trimesh"], check=True)
+            (venv / ".trimesh").write_text("")
         return python
     subprocess.run([sys.executable, "-m", "venv", "--clear", str(venv)], check=True)
     print("installing hurodes==0.1.9 into", venv)
     subprocess.run(
-        [str(python), "-m", "pip", "install", "--quiet", "hurodes==0.1.9", "numpy<2.4"],
+        [str(python), "-m", "pip", "install", "--quiet", "hurodes==0.1.9", "numpy<2.4", "trimesh"],
         check=True,
     )
+    (venv / ".trimesh").write_text("")
     marker.write_text("0.1.9")
     return python
 
@@ -166,7 +175,7 @@ def main() -> int:
     fetch_mjlab()
     for name in WHEEL_CORPORA:
         fetch_wheel_data(name)
-    make_hurodes_venv()
+    make_hurodes_fixtures(TESTDATA, make_hurodes_venv())
     install_chromium()
     return 0
 
