@@ -8,9 +8,15 @@ from pathlib import Path
 import pytest
 
 PROJECT_ROOT = Path(__file__).resolve().parents[1]
-SHARED_FIXTURES = PROJECT_ROOT.parent / "shared" / "fixtures"
-HURODES_FIXTURES = SHARED_FIXTURES / "hurodes"
 TESTDATA = PROJECT_ROOT / ".testdata"
+#: HRDF folders written by hurodes 0.1.9 (tools/fetch_test_data.py makes them):
+#: ``g1_29`` (+ ``exported/robot.xml``, hurodes' own MJCF of it), ``synth_baseline_hinge``,
+#: and ``sources/`` with the MJCF files hurodes converted. ``$ROBOTWRIGHT_HURODES_FIXTURES``
+#: points elsewhere.
+HURODES_FIXTURES = Path(
+    os.environ.get("ROBOTWRIGHT_HURODES_FIXTURES") or TESTDATA / "hurodes-fixtures"
+)
+FETCH_HINT = "run python tools/fetch_test_data.py"
 
 
 def _need(path: Path, why: str) -> Path:
@@ -21,15 +27,22 @@ def _need(path: Path, why: str) -> Path:
 
 @pytest.fixture
 def g1_hrdf_dir() -> Path:
-    """hurodes-written Unitree G1 (29 DoF) HRDF folder from ../shared/fixtures."""
-    return _need(HURODES_FIXTURES / "g1_29", "hurodes G1 fixture not available")
+    """hurodes-written Unitree G1 (29 DoF) HRDF folder (mjlab's G1 MJCF converted)."""
+    return _need(HURODES_FIXTURES / "g1_29", f"hurodes G1 fixture not made ({FETCH_HINT})")
+
+
+@pytest.fixture
+def g1_source_mjcf() -> Path:
+    """The MJCF file hurodes converted into ``g1_hrdf_dir``: the reference for its values."""
+    return _need(HURODES_FIXTURES / "sources" / "g1_29.xml", f"G1 source absent ({FETCH_HINT})")
 
 
 @pytest.fixture
 def synth_hrdf_dir() -> Path:
-    """hurodes-written small synthetic hinge robot from ../shared/fixtures."""
+    """hurodes-written small synthetic hinge robot (two bodies, one motor)."""
     return _need(
-        HURODES_FIXTURES / "synth_baseline_hinge", "hurodes synthetic fixture not available"
+        HURODES_FIXTURES / "synth_baseline_hinge",
+        f"hurodes synthetic fixture not made ({FETCH_HINT})",
     )
 
 
