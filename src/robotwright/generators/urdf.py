@@ -6,8 +6,12 @@ Mapping:
   after the HRDF free joint, else ``floating_base``) or a ``fixed`` joint (fixed base),
   whose origin is the root body's pose.
 - Each body -> a link with ``<inertial>`` (mass, centre of mass, the full inertia tensor
-  ``R diag R^T`` from ``diag_inertia`` and ``inertial_quat``), ``<visual>`` for geoms
-  that do not collide (contype = conaffinity = 0) and ``<collision>`` for the others.
+  ``R diag R^T`` from ``diag_inertia`` and ``inertial_quat``), a ``<collision>`` for each
+  geom that collides (contype or conaffinity non-zero) and a ``<visual>`` (with a
+  ``<material>`` of the geom's rgba) for each geom MuJoCo draws (see
+  :func:`drawn_by_mujoco`) or that does not collide. A geom that both collides and is
+  drawn gives a visual and a collision of the same geometry and origin; the URDF parser
+  reads such a pair back as one geom.
 - Each joint -> ``revolute`` (hinge with range), ``continuous`` (hinge without range),
   ``prismatic`` (slide); a ball joint -> three revolute/continuous joints about x, y, z
   (a change of meaning: reported). ``<limit>`` carries the range and, from the joint's
@@ -61,6 +65,14 @@ DUMMY_LINK_INERTIA = 1e-12
 _IDENTITY = (1.0, 0.0, 0.0, 0.0)
 _ZERO = (0.0, 0.0, 0.0)
 _DEFAULT_FRICTION = (1.0, 0.005, 0.0001)
+#: Geom groups MuJoCo's viewer draws by default (``mjvOption.geomgroup`` is 1 1 1 0 0 0).
+MUJOCO_DRAWN_GROUPS = (0, 1, 2)
+
+
+def drawn_by_mujoco(g: Geom) -> bool:
+    """Whether MuJoCo's default viewer draws the geom: its group is one of
+    :data:`MUJOCO_DRAWN_GROUPS` and its colour is not fully transparent (rgba alpha > 0)."""
+    return g.group in MUJOCO_DRAWN_GROUPS and float(g.rgba[3]) > 0.0
 
 
 def _sub(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float]:
@@ -565,8 +577,13 @@ class _RobotWriter:
         self, link: ET.Element, g: Geom, off: tuple[float, float, float], table: str, row: int
     ) -> None:
         collide = bool(g.contact_type or g.contact_affinity)
-        tag = "collision" if collide else "visual"
-        self._geom_losses(g, collide, table, row)
+        drawn = drawn_by_mujoco(g)
+        # A visual for what MuJoCo draws (URDF viewers show visuals only) and for what
+        # does not collide (else it would be lost); a collision for what collides.
+        tags: tuple[str, ...] = ("visual",) if drawn or not collide else ()
+        if collide:
+            tags += ("collision",)
+        self._geom_losses(g, collide, drawn, table, row)
         pos = _sub(g.pos, off)
         name = g.geom_name
         if isinstance(g, MeshGeom):
@@ -578,20 +595,22 @@ class _RobotWriter:
             attrs = {"filename": ref}
             if g.scale != (1.0, 1.0, 1.0):
                 attrs["scale"] = fmt_vec(g.scale)
-            self._shape(link, tag, name, pos, g.quat, "mesh", attrs, g.rgba)
+            self._shape(link, tags, name, pos, g.quat, "mesh", attrs, g.rgba)
             return
         assert isinstance(g, SimpleGeom)
         name = name or g.name
         s = g.size
         if g.type == "box":
             self._shape(
-                link, tag, name, pos, g.quat, "box", {"size": fmt_vec(2 * v for v in s)}, g.rgba
+                link, tags, name, pos, g.quat, "box", {"size": fmt_vec(2 * v for v in s)}, g.rgba
             )
         elif g.type == "sphere":
-            self._shape(link, tag, name, pos, g.quat, "sphere", {"radius": fmt_float(s[0])}, g.rgba)
+            self._shape(
+                link, tags, name, pos, g.quat, "sphere", {"radius": fmt_float(s[0])}, g.rgba
+            )
         elif g.type == "cylinder":
             attrs = {"radius": fmt_float(s[0]), "length": fmt_float(2 * s[1])}
-            self._shape(link, tag, name, pos, g.quat, "cylinder", attrs, g.rgba)
+            self._shape(link, tags, name, pos, g.quat, "cylinder", attrs, g.rgba)
         elif g.type == "capsule":
             self.losses.append(
                 Problem(
@@ -603,12 +622,12 @@ class _RobotWriter:
                 )
             )
             attrs = {"radius": fmt_float(s[0]), "length": fmt_float(2 * s[1])}
-            self._shape(link, tag, name, pos, g.quat, "cylinder", attrs, g.rgba)
+            self._shape(link, tags, name, pos, g.quat, "cylinder", attrs, g.rgba)
             for k, sign in ((1, 1.0), (2, -1.0)):
                 end = rotate(g.quat, (0.0, 0.0, sign * s[1]))
                 end_pos = (pos[0] + end[0], pos[1] + end[1], pos[2] + end[2])
                 self._shape(
-                    link, tag, f"{name}_end{k}" if name else None, end_pos, _IDENTITY,
+                    link, tags, f"{name}_end{k}" if name else None, end_pos, _IDENTITY,
                     "sphere", {"radius": fmt_float(s[0])}, g.rgba,
                 )  # fmt: skip
         else:
@@ -619,7 +638,7 @@ class _RobotWriter:
     def _shape(
         self,
         link: ET.Element,
-        tag: str,
+        tags: tuple[str, ...],
         name: str | None,
         pos: tuple[float, ...],
         quat: tuple[float, ...],
@@ -627,21 +646,26 @@ class _RobotWriter:
         attrs: dict[str, str],
         rgba: tuple[float, ...],
     ) -> None:
-        el = ET.SubElement(link, tag)
-        if name:
-            el.set("name", self.p(name))
-        _origin(el, pos, quat)
-        geometry = ET.SubElement(el, "geometry")
-        ET.SubElement(geometry, shape, attrs)
-        if tag == "visual":
-            key = tuple(float(v) for v in rgba)
-            mat = self.materials.get(key)
-            if mat is None:
-                mat = self.p(f"material_{len(self.materials)}")
-                self.materials[key] = mat
-            ET.SubElement(el, "material", {"name": mat})
+        """One ``<visual>`` and/or ``<collision>`` (``tags``) of the same geometry and
+        origin. The geom's name goes on the collision when there is one: MuJoCo's URDF
+        import drops visuals by default, and with ``discardvisual="false"`` it warns about
+        a visual and a collision of the same name."""
+        for tag in tags:
+            el = ET.SubElement(link, tag)
+            if name and (tag == "collision" or "collision" not in tags):
+                el.set("name", self.p(name))
+            _origin(el, pos, quat)
+            geometry = ET.SubElement(el, "geometry")
+            ET.SubElement(geometry, shape, attrs)
+            if tag == "visual":
+                key = tuple(float(v) for v in rgba)
+                mat = self.materials.get(key)
+                if mat is None:
+                    mat = self.p(f"material_{len(self.materials)}")
+                    self.materials[key] = mat
+                ET.SubElement(el, "material", {"name": mat})
 
-    def _geom_losses(self, g: Geom, collide: bool, table: str, row: int) -> None:
+    def _geom_losses(self, g: Geom, collide: bool, drawn: bool, table: str, row: int) -> None:
         lost = []
         if collide and (g.contact_type, g.contact_affinity) != (1, 1):
             lost.append(f"contype/conaffinity {g.contact_type}/{g.contact_affinity}")
@@ -652,10 +676,17 @@ class _RobotWriter:
             lost.append("friction")
         if g.condim != 3:
             lost.append(f"condim {g.condim}")
-        if g.group:
+        if g.group and not drawn and not collide:
+            lost.append(
+                f"group {g.group} (hidden by MuJoCo's default viewer; written as a <visual>, "
+                "which URDF viewers show)"
+            )
+        elif g.group:
             lost.append(f"group {g.group}")
-        if collide and tuple(g.rgba) != (0.5, 0.5, 0.5, 1.0):
-            lost.append("colour (URDF collisions have none)")
+        if collide and not drawn and tuple(g.rgba) != (0.5, 0.5, 0.5, 1.0):
+            lost.append(
+                "colour (not drawn by MuJoCo: collision only, and URDF collisions have none)"
+            )
         if g.restitution is not None:
             lost.append("restitution")
         if lost:
@@ -707,4 +738,10 @@ def _dfs(hrdf: HRDF) -> list[int]:
     return out
 
 
-__all__ = ["DUMMY_LINK_INERTIA", "DUMMY_LINK_MASS", "URDFHumanoidGenerator"]
+__all__ = [
+    "DUMMY_LINK_INERTIA",
+    "DUMMY_LINK_MASS",
+    "MUJOCO_DRAWN_GROUPS",
+    "URDFHumanoidGenerator",
+    "drawn_by_mujoco",
+]

@@ -6,7 +6,10 @@ it becomes the child body's ``pos``/``quat`` and the joint sits at the body orig
 Inertia tensors (``<inertial><origin rpy>`` honoured) are diagonalised exactly.
 
 Visual geoms go to group 2 without contacts (contype = conaffinity = 0), collision geoms
-to group 3 with contype = conaffinity = 1, so the two stay apart.
+to group 3 with contype = conaffinity = 1, so the two stay apart. A visual and a
+collision of the same geometry and origin are one geom that is drawn and collides
+(group 0, contype = conaffinity = 1, the visual's colour; see
+:mod:`robotwright.parsers.geom_pairs`), as MuJoCo's own geoms are by default.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ from robotwright.hrdf.model import (
 from robotwright.parsers import inertia as inr
 from robotwright.parsers import urdf_actuators as acts
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
+from robotwright.parsers.geom_pairs import BOTH, merge_visual_collision
 from robotwright.parsers.meshes import (
     MeshConversionError,
     conversion_note,
@@ -52,6 +56,8 @@ VISUAL_GROUP = 2
 #: Joints from a root link named "world" that stay on its child when the root is dropped.
 _WORLD_CHILD_JOINTS = ("revolute", "continuous", "prismatic")
 COLLISION_GROUP = 3
+#: Group of a geom read from a visual and collision pair (MuJoCo's default geom group).
+DRAWN_COLLISION_GROUP = 0
 _KNOWN_TOP = {"link", "joint", "material"}
 # "spherical" is not in the URDF specification; pybullet and MuJoCo read it as a ball.
 _JOINT_TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical"}
@@ -170,7 +176,7 @@ class _LinkData:
     mass: float
     com: np.ndarray
     tensor: np.ndarray  # about the com, link frame
-    geoms: list[tuple[str, _Pose, dict]]  # kind ("visual"/"collision"), pose, fields
+    geoms: list[tuple[str, _Pose, dict]]  # kind ("visual"/"collision"/BOTH), pose, fields
     has_inertial: bool
 
 
@@ -336,7 +342,7 @@ class _URDFReader:
                 g = self._geom(elem, kind, name)
                 if g is not None:
                     geoms.append(g)
-        return _LinkData(name, mass, com, tensor, geoms, has)
+        return _LinkData(name, mass, com, tensor, merge_visual_collision(geoms), has)
 
 
 def _make_geom(body: str, kind: str, pose: _Pose, fields: dict) -> MeshGeom | SimpleGeom:
@@ -344,7 +350,7 @@ def _make_geom(body: str, kind: str, pose: _Pose, fields: dict) -> MeshGeom | Si
         "body": body,
         "pos": _t(pose.pos),
         "quat": pose.quat,
-        "group": VISUAL_GROUP if kind == "visual" else COLLISION_GROUP,
+        "group": {"visual": VISUAL_GROUP, BOTH: DRAWN_COLLISION_GROUP}.get(kind, COLLISION_GROUP),
         "contact_type": 0 if kind == "visual" else 1,
         "contact_affinity": 0 if kind == "visual" else 1,
         "geom_name": fields.get("geom_name"),
