@@ -113,3 +113,49 @@ def test_robot_is_drawn_where_it_stands(chromium: str) -> None:
     assert changed[inside & view].mean() > 0.2
     assert changed[view & ~grown].sum() == 0
     assert _changed(again, full)[view].mean() < 0.002
+
+
+def test_scan_points_are_drawn_in_their_class_colours(chromium: str, tmp_path) -> None:
+    """A scan shown alone: its points appear inside their projected outline, in the
+    colours of their classes (terrain brown, valuable blue)."""
+    from robotwright.sensors import scan_to_files
+    from robotwright.view.server import class_color
+
+    room = tmp_path / "room.xml"
+    room.write_text(
+        '<mujoco><worldbody><geom name="floor" type="plane" size="3 3 0.1"/>'
+        '<body name="sofa" pos="1.5 0 0.4"><geom type="box" size="0.4 0.8 0.4"/></body>'
+        '<body name="s" pos="0 0 0.6"><site name="lidar"/></body></worldbody></mujoco>',
+        encoding="utf-8",
+    )
+    model = mujoco.MjModel.from_xml_path(str(room))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    npz = tmp_path / "scan.npz"
+    scan_to_files(model, data, "lidar", "vlp16", npz, max_distance=4.0, exclude_robot=False)
+    scene = load_source(npz)
+    with (
+        Viewer(scene, ViewerConfig(port=0, plain=True, point_size=0.06)) as viewer,
+        Browser(chromium, WIDTH, HEIGHT) as browser,
+    ):
+        px = _project(viewer, scene.scan.points)
+        x0, y0 = np.floor(px.min(axis=0)).astype(int)
+        x1, y1 = np.ceil(px.max(axis=0)).astype(int)
+        inside = np.zeros((HEIGHT, WIDTH), bool)
+        inside[max(y0, 0) : y1, max(x0, 0) : x1] = True
+        inside &= _view_mask()
+        browser.goto(viewer.url)
+        full = browser.steady_screenshot(
+            until=lambda s: (s[inside] < 200).any(axis=-1).mean() > 0.02
+        )
+        viewer._scan_node.visible = False
+        empty = browser.steady_screenshot(until=lambda s: _changed(s, full)[inside].any())
+    changed = _changed(full, empty) & _view_mask()
+    grown = np.zeros_like(inside)
+    grown[max(y0 - 8, 0) : y1 + 8, max(x0 - 8, 0) : x1 + 8] = True
+    assert changed.sum() > 500 and changed[~grown].sum() == 0
+    drawn = full[changed].astype(int)
+    for name in ("terrain", "valuable"):
+        colour = np.array(class_color(scene.scan.class_names.index(name)))
+        near = np.abs(drawn - colour).sum(axis=1) < 90  # shading varies the tone a little
+        assert near.sum() > 50, f"no {name} points drawn in {tuple(colour)}"
