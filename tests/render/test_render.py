@@ -166,7 +166,7 @@ def test_model_camera_by_name_and_unknown_camera() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"width": 8}, "picture width 8: expected an integer in 16..8192"),
+        ({"width": 8}, "picture width 8: expected an integer in 16..4096"),
         ({"height": 100000}, "picture height 100000"),
         ({"backend": "vulkan"}, "backend 'vulkan'"),
         ({"camera": "10,-100"}, "elevation -100.0 deg outside"),

@@ -28,8 +28,9 @@ __all__ = ["Picture", "RenderError", "RenderOptions", "render_model"]
 
 Backend = Literal["auto", "gl", "software"]
 
-#: Largest picture side [px]: a larger one is a typo more often than a wish.
-MAX_SIDE = 8192
+#: Largest picture side [px]: a larger one is a typo more often than a wish (and the
+#: software renderer holds several float arrays of the picture's size).
+MAX_SIDE = 4096
 #: Most geoms MuJoCo may put in the scene (robots with sites, composed scenes).
 _MAX_SCENE_GEOMS = 20_000
 #: Background, top and bottom rows (a light sky gradient: geoms stand out from it).
@@ -46,14 +47,15 @@ class RenderOptions:
     """How a picture is drawn.
 
     Attributes:
-        width, height: picture size [px], each in 16..8192.
+        width, height: picture size [px], each in 16..4096.
         camera: a model camera's name, a view (``iso``, ``front``, ``back``, ``left``,
             ``right``, ``top``) or ``AZ,EL[,DIST]`` (degrees, metres); see
             :mod:`robotwright.render.camera`.
         backend: ``"auto"`` (OpenGL when a platform starts, else software), ``"gl"``
             (OpenGL or an error) or ``"software"`` (numpy rasteriser).
         supersample: the software renderer draws at this multiple of the size and
-            averages down (smooth edges); 1..4.
+            averages down (smooth edges); 1..4, lowered for large pictures (at most
+            3000 x 3000 pixels are drawn).
         point_radius: radius of a drawn point [px].
     """
 
@@ -204,11 +206,22 @@ def _checker(
     image[ys[parity], xs[parity]] *= 0.8
 
 
+#: Most pixels the software renderer draws before averaging down: a large picture gets
+#: less supersampling (memory grows with the pixels drawn: about 2 GB at 4096 x 3000).
+_MAX_DRAWN_PIXELS = 3000 * 3000
+
+
+def _supersample(opts: RenderOptions) -> int:
+    """The supersampling factor used: the option, lowered for large pictures."""
+    fit = int(math.sqrt(_MAX_DRAWN_PIXELS / (opts.width * opts.height)))
+    return max(1, min(opts.supersample, fit))
+
+
 def _software(
     model: mujoco.MjModel, scene: mujoco.MjvScene, opts: RenderOptions, notes: list[str]
 ) -> tuple[np.ndarray, np.ndarray, View, int]:
     """Float RGB ``(sH, sW, 3)``, depth, view and the supersampling factor used."""
-    ss = opts.supersample
+    ss = _supersample(opts)
     w, h = opts.width * ss, opts.height * ss
     view = _view(scene, w, h)
     reach = max(float(model.stat.extent) * 10.0, 10.0)
