@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import random
 from pathlib import Path
 
@@ -21,7 +22,15 @@ from robotwright.hrdf import validate as hval
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
 from robotwright.hrdf.tables import TABLES
 
-G1 = Path(__file__).resolve().parents[3] / "shared" / "fixtures" / "hurodes" / "g1_29"
+#: The hurodes-written G1 that tools/fetch_test_data.py makes (as tests/conftest.py's
+#: HURODES_FIXTURES; needed at collection time, before fixtures exist).
+G1 = (
+    Path(
+        os.environ.get("ROBOTWRIGHT_HURODES_FIXTURES")
+        or Path(__file__).resolve().parents[2] / ".testdata" / "hurodes-fixtures"
+    )
+    / "g1_29"
+)
 
 
 def _robot_dirs() -> list[Path]:
@@ -133,7 +142,7 @@ def test_csv_fast_split_matches_on_mutated_g1_tables(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     if not G1.is_dir():
-        pytest.skip("shared fixtures absent (../shared/fixtures/hurodes/g1_29)")
+        pytest.skip(f"hurodes G1 fixture not made: {G1} (run python tools/fetch_test_data.py)")
     rng = random.Random(7)
     alphabet = ',\n\r" .-e0123456789xa\t'
     for stem in ("body", "joint", "actuator", "mesh", "simple_geom"):
