@@ -152,3 +152,30 @@ def test_unitree_g1_meshes(testdata_dir: Path) -> None:
     for s in visible:
         np.testing.assert_allclose(s.rgba, drawn[s.geom_id].rgba, atol=1e-6)
         np.testing.assert_allclose(s.rgba, geom_rgba(model, s.geom_id))
+
+
+def test_height_field_surface_matches_mujoco_ray_casts() -> None:
+    """Each vertex of a drawn height field lies on the surface MuJoCo collides with: a
+    ray cast straight down at its (x, y) hits at its height."""
+    model = mujoco.MjModel.from_xml_string(
+        """
+        <mujoco>
+          <asset>
+            <hfield name="h" nrow="3" ncol="4" size="1 2 0.5 0.1"
+                    elevation="0 1 2 3  1 2 3 4  4 3 1 0"/>
+          </asset>
+          <worldbody><geom type="hfield" hfield="h" pos="0.3 -0.2 0.1"/></worldbody>
+        </mujoco>
+        """
+    )
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    (shape,) = geom_shapes(model)
+    assert len(shape.vertices) == 12 and len(shape.faces) == 2 * 2 * 3
+    geomid = np.zeros(1, np.int32)
+    for v in shape.vertices.astype(np.float64):
+        # a hair inside the edge, where the vertex's own height is what the ray meets
+        x, y = v[0] * 0.999, v[1] * 0.999
+        start = np.array([x + 0.3, y - 0.2, 5.0])
+        dist = mujoco.mj_ray(model, data, start, np.array([0.0, 0.0, -1.0]), None, 1, -1, geomid)
+        np.testing.assert_allclose(5.0 - dist, v[2] + 0.1, atol=2e-3)
