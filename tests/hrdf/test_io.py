@@ -7,6 +7,8 @@ import math
 import shutil
 from pathlib import Path
 
+import mujoco
+import numpy as np
 import pytest
 
 from robotwright.hrdf import HRDF, Actuator, Joint
@@ -23,24 +25,28 @@ def _csv_rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
-def test_g1_counts_and_mass(g1_hrdf_dir: Path) -> None:
+def test_g1_counts_and_mass(g1_hrdf_dir: Path, g1_source_mjcf: Path) -> None:
+    """What hurodes wrote is the source G1 as MuJoCo compiles it: counts, masses, tree."""
+    src = mujoco.MjModel.from_xml_path(str(g1_source_mjcf))
     hrdf = HRDF.from_dir(g1_hrdf_dir)
-    assert len(hrdf.bodies) == 30
-    assert round(hrdf.total_mass, 5) == 35.11214
+    assert src.nu == 29 and src.body_jntnum[1] == 1  # the 29-motor G1, floating base
+    assert len(hrdf.bodies) == src.nbody - 1
+    assert math.isclose(hrdf.total_mass, src.body_subtreemass[0], rel_tol=1e-12)
     csv_total = math.fsum(float(r["mass"]) for r in _csv_rows(g1_hrdf_dir / "body.csv"))
     assert math.isclose(hrdf.total_mass, csv_total, rel_tol=1e-15)
     hinges = [j for j in hrdf.joints if j.type == "hinge"]
-    assert len(hinges) == 29
+    assert len(hinges) == int(np.sum(src.jnt_type == mujoco.mjtJoint.mjJNT_HINGE))
     free = [j for j in hrdf.joints if j.type == "free"]
-    assert len(free) == 1 and free[0].body == "pelvis" and free[0].name is None
+    assert len(free) == 1 and free[0].body == src.body(1).name and free[0].name is None
     assert hrdf.floating_base
-    assert len(hrdf.actuators) == 29
-    assert len(hrdf.meshes) == 61
-    assert len(hrdf.simple_geoms) == 12
-    assert hrdf.dof == 35
+    assert len(hrdf.actuators) == src.nu
+    is_mesh = src.geom_type == mujoco.mjtGeom.mjGEOM_MESH
+    assert len(hrdf.meshes) == int(np.sum(is_mesh)) and src.nmesh > 30
+    assert len(hrdf.simple_geoms) == int(np.sum(~is_mesh))
+    assert hrdf.dof == src.nv
 
 
-def test_g1_values_identical_to_csv(g1_hrdf_dir: Path) -> None:
+def test_g1_values_identical_to_csv(g1_hrdf_dir: Path, g1_source_mjcf: Path) -> None:
     hrdf = HRDF.from_dir(g1_hrdf_dir)
     for i, row in enumerate(_csv_rows(g1_hrdf_dir / "body.csv")):
         b = hrdf.bodies[i]
@@ -59,8 +65,9 @@ def test_g1_values_identical_to_csv(g1_hrdf_dir: Path) -> None:
         assert a.joint == row["joint_name"]
         assert a.peak_torque == float(row["peak_torque"])
         assert a.p_gain is None and a.d_gain is None and a.peak_velocity is None
-    parents = [b.parent for b in hrdf.bodies]
-    assert parents[0] == -1 and parents[7] == 0 and parents[23] == 15
+    src = mujoco.MjModel.from_xml_path(str(g1_source_mjcf))
+    assert [b.name for b in hrdf.bodies] == [src.body(i).name for i in range(1, src.nbody)]
+    assert [b.parent for b in hrdf.bodies] == (src.body_parentid[1:] - 1).tolist()
     assert hrdf.meta.simulator_config.timestep == 0.002
     assert hrdf.meta.imu_config_list[0].body_name == "pelvis"
     assert hrdf.meta.body_name_config.torso_name == "torso_link"
