@@ -36,20 +36,20 @@ def demo_pictures(
 
     out.mkdir(parents=True, exist_ok=True)
     w, h = SIZE
-    robot_opts = RenderOptions(width=w, height=h)
-    titles = {
-        "mini_humanoid": "mini_humanoid (bundled robot)",
-        "arm6": "arm6 (bundled robot)",
-        "wearer": "mini_humanoid wearing the grammar-generated limb",
+    # The limb is worn on the back: that picture is taken from behind, to the right.
+    views = {
+        "mini_humanoid": ("mini_humanoid (bundled robot)", "iso"),
+        "arm6": ("arm6 (bundled robot)", "iso"),
+        "wearer": ("mini_humanoid wearing the grammar-generated limb (from behind)", "-35,-20"),
     }
     written, backends = [], set()
-    for key, title in titles.items():
+    for key, (title, camera) in views.items():
         with warnings.catch_warnings():
             # The export step already reported what MJCF cannot hold for these robots;
             # the same notes again would only double the demo's list.
             warnings.simplefilter("ignore", ConversionWarning)
             model = MJCFHumanoidGenerator.from_hrdf(ctx[key]).to_model()
-        picture = render_model(model, None, robot_opts)
+        picture = render_model(model, None, RenderOptions(width=w, height=h, camera=camera))
         name = "humanoid_with_limb.png" if key == "wearer" else f"{key}.png"
         save_png(picture, out / name, title=title)
         written.append(name)
