@@ -166,3 +166,26 @@ def test_collision_only_robot_is_still_shown(tmp_path: Path) -> None:
         assert any("showing groups [3]" in n for n in viewer.notes)
     with show(xml, port=0, geom_groups=(0,)) as viewer:
         assert set(viewer._geom_nodes) == {0} and not viewer.notes
+
+
+def test_keyframe_menu_and_reset(tmp_path: Path) -> None:
+    model = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body name="b"><joint name="j" axis="0 1 0"/>'
+        '<geom type="capsule" fromto="0 0 0 0 0 -1" size="0.05"/>'
+        '<body name="tip" pos="0 0 -1"/></body></worldbody>'
+        '<keyframe><key name="up" qpos="0.7"/><key qpos="-0.3"/></keyframe></mujoco>'
+    )
+    tip = model.body("tip").id
+    with show(model, port=0) as viewer:
+        assert viewer._sliders[0].value == pytest.approx(0.7)  # keyframe 0 first
+        viewer._keyframe_menu.value = "1: key 1"  # as a person picks it
+        assert viewer.data.qpos[0] == pytest.approx(-0.3)
+        assert viewer._sliders[0].value == pytest.approx(-0.3)
+        np.testing.assert_allclose(
+            viewer._body_nodes[tip].position, [np.sin(-0.3) * -1, 0, -np.cos(-0.3)], atol=1e-9
+        )
+        viewer._sliders[0].value = 0.2  # a slider drag
+        assert viewer.data.qpos[0] == pytest.approx(0.2)
+        np.testing.assert_allclose(
+            viewer._body_nodes[tip].position, [-np.sin(0.2), 0, -np.cos(0.2)], atol=1e-9
+        )

@@ -14,6 +14,7 @@ import contextlib
 import html
 import io
 import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -129,6 +130,7 @@ class Viewer:
         self._shown_groups: set[int] = set()
         self._sliders: dict[int, Any] = {}
         self._group_boxes: dict[int, Any] = {}
+        self._quiet = False  # set while the code itself moves sliders
         # viser prints a banner on start; the caller prints the URL instead.
         quiet = contextlib.nullcontext() if self.config.verbose else _quiet_stdout()
         with quiet:
@@ -170,8 +172,9 @@ class Viewer:
         jid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
         if jid < 0 or jid not in self._sliders:
             raise ViewError(f"joint '{name}': no slider for it; sliders: {self.joint_names()}")
-        self._sliders[jid].value = float(value)  # runs the slider's callback
         self._set_qpos_value(jid, float(value))
+        with self._sliders_quiet():
+            self._sliders[jid].value = float(value)
 
     def set_qpos(self, qpos: np.ndarray) -> None:
         """Show the configuration ``qpos`` (``model.nq`` values)."""
@@ -180,8 +183,9 @@ class Viewer:
             raise ViewError(f"qpos: expected {self.model.nq} values, got {qpos.shape[0]}")
         with self._lock:
             self.data.qpos[:] = qpos
-        for jid, slider in self._sliders.items():
-            slider.value = float(qpos[self.model.jnt_qposadr[jid]])
+        with self._sliders_quiet():
+            for jid, slider in self._sliders.items():
+                slider.value = float(qpos[self.model.jnt_qposadr[jid]])
         self._update_poses()
 
     def show_groups(self, groups: set[int] | tuple[int, ...]) -> None:
@@ -344,6 +348,7 @@ class Viewer:
             bodies = gui.add_checkbox("Body frames", initial_value=self.config.body_frames)
             sites = gui.add_checkbox("Site frames", initial_value=self.config.site_frames)
             sites.disabled = not self._site_nodes
+            bodies.disabled = model.nbody <= 1
 
             @bodies.on_update
             def _(_: Any) -> None:
@@ -390,6 +395,24 @@ class Viewer:
                 def _(_: Any) -> None:
                     self.set_qpos(self.scene.initial_qpos())
 
+                if model.nkey:
+                    self._add_keyframes()
+
+    def _add_keyframes(self) -> None:
+        """A menu of the model's keyframes (``<key>``): picking one shows its ``qpos``."""
+        model = self.model
+        names = [
+            mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_KEY, k) or f"key {k}"
+            for k in range(model.nkey)
+        ]
+        labels = [f"{k}: {n}" for k, n in enumerate(names)]
+        menu = self.server.gui.add_dropdown("Keyframe", labels, initial_value=labels[0])
+        self._keyframe_menu = menu
+
+        @menu.on_update
+        def _(_: Any) -> None:
+            self.set_qpos(model.key_qpos[labels.index(menu.value)])
+
     def _joint_label(self, j: int) -> str:
         return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint {j}"
 
@@ -413,9 +436,20 @@ class Viewer:
 
         @slider.on_update
         def _(_: Any) -> None:
-            self._set_qpos_value(j, float(slider.value))
+            if not self._quiet:
+                self._set_qpos_value(j, float(slider.value))
 
         return slider
+
+    @contextlib.contextmanager
+    def _sliders_quiet(self) -> Iterator[None]:
+        """Move sliders without their callbacks (viser runs them on every assignment):
+        the caller updates the poses once."""
+        self._quiet = True
+        try:
+            yield
+        finally:
+            self._quiet = False
 
     def _set_qpos_value(self, j: int, value: float) -> None:
         with self._lock:
