@@ -22,7 +22,8 @@ from _timing import median_seconds, report, run_peer  # noqa: E402
 
 from robotwright.hrdf import HRDF  # noqa: E402
 
-DEFAULT_FIXTURE = Path(__file__).resolve().parents[2] / "shared" / "fixtures" / "hurodes" / "g1_29"
+#: The hurodes-written G1 that tools/fetch_test_data.py makes.
+DEFAULT_FIXTURE = Path(__file__).resolve().parents[1] / ".testdata" / "hurodes-fixtures" / "g1_29"
 
 PEER_CODE = """
 import json, statistics, time, warnings
@@ -48,7 +49,10 @@ def main() -> int:
     ap.add_argument("--number", type=int, default=10)
     args = ap.parse_args()
     if not (args.fixture / "meta.yaml").is_file():
-        print(f"fixture not found: {args.fixture}", file=sys.stderr)
+        print(
+            f"fixture not found: {args.fixture} (run python tools/fetch_test_data.py)",
+            file=sys.stderr,
+        )
         return 2
 
     with warnings.catch_warnings():

@@ -6,7 +6,7 @@ parser cannot resolve ``package://``. Timing covers the parse into an in-memory 
 (hurodes: ``parse()``; ours: ``*_to_hrdf``), not writing folders.
 
 Prints the median of --repeat runs for each side and the ratio hurodes / ours.
-Usage: python benchmarks/parsers.py --hurodes-python /work/hurodes-venv/bin/python
+Usage: python benchmarks/parsers.py --hurodes-python .testdata/hurodes-venv/bin/python
 """
 
 from __future__ import annotations
