@@ -134,10 +134,12 @@ def refine_keys(node: ET.Element, model: mujoco.MjModel) -> None:
         refine(key, _fields(model, _KEY, i))
 
 
-def refine_listed(elems: list[ET.Element], model: mujoco.MjModel, section: str) -> None:
-    """Carried ``<actuator>`` or ``<sensor>`` elements, one per model id, in order."""
+def refine_listed(
+    elems: list[ET.Element], model: mujoco.MjModel, section: str, start: int = 0
+) -> None:
+    """Carried ``<actuator>`` or ``<sensor>`` elements, model ids ``start``, ``start+1``..."""
     table = _ACTUATOR if section == "actuator" else _SENSOR
-    for i, elem in enumerate(elems):
+    for i, elem in enumerate(elems, start):
         refine(elem, _fields(model, table, i))
 
 

@@ -87,7 +87,17 @@ class _Reader:
         self.textures: dict[str, Texture] = {}
         self.used_hfields: set[str] = set()
         self.used_meshes: set[str] = set()
-        self.compiled: mujoco.MjModel | None = None  # set once the spec is compiled
+        self._compiled: mujoco.MjModel | None = None
+
+    @property
+    def compiled(self) -> mujoco.MjModel:
+        """The source compiled by MuJoCo (what our MJCF must give), on first use only:
+        models without carried sections or inherited ranges skip the compile."""
+        if self._compiled is None:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # to_xml() already showed MuJoCo's warnings
+                self._compiled = self.spec.compile()
+        return self._compiled
 
     # ------------------------------------------------------------------ helpers
     def lose(self, element: str, message: str) -> None:
@@ -468,7 +478,7 @@ class _Reader:
         trn = _enum(sa.trntype, "mjTRN_")
         target = self.by_name.get(({"joint": "joint", "site": "site"}.get(trn, ""), sa.target))
         if target is None or sa.slidersite or sa.refsite and trn != "site":
-            self._carry(world, "actuator", sa, carried, f"actuator on a {trn}")
+            self._carry(world, "actuator", sa, carried, f"actuator on a {trn}", index)
             return
         cls, extra = _actuator_class(sa)
         kw: dict[str, Any] = {
@@ -502,7 +512,9 @@ class _Reader:
         target.attach(act)
         self.register("actuator", sa.name, act)
 
-    def sensor(self, ss: Any, world: World, carried: dict[str, list[ET.Element]]) -> None:
+    def sensor(
+        self, ss: Any, world: World, carried: dict[str, list[ET.Element]], index: int
+    ) -> None:
         tag = _enum(ss.type, "mjSENS_")
         cls = S.SENSOR_CLASSES.get(tag)
         objtype = _enum(ss.objtype, "mjOBJ_")
@@ -516,7 +528,7 @@ class _Reader:
                 not in cls._TARGET_KINDS
             )
         ):
-            self._carry(world, "sensor", ss, carried, f"{tag} sensor on a {objtype}")
+            self._carry(world, "sensor", ss, carried, f"{tag} sensor on a {objtype}", index)
             return
         kw: dict[str, Any] = {"noise": ss.noise, "cutoff": ss.cutoff}
         if issubclass(cls, S.FrameSensor):
@@ -531,13 +543,20 @@ class _Reader:
         target.attach(sensor)
 
     def _carry(
-        self, world: World, section: str, elem: Any, carried: dict[str, list[ET.Element]], what: str
+        self,
+        world: World,
+        section: str,
+        elem: Any,
+        carried: dict[str, list[ET.Element]],
+        what: str,
+        index: int,
     ) -> None:
         queue = carried.get(section, [])
         if not queue:
             self.lose(f'<{section} name="{elem.name}">', f"{what} cannot be represented; dropped")
             return
         xml = queue.pop(0)
+        refine_listed([xml], self.compiled, section, start=index)  # full precision
         _carried_class(xml)
         world.attach(RawElement(section=section, xml=ET.tostring(xml, encoding="unicode").strip()))
 
@@ -667,10 +686,6 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
 
     try:
         carried_root = ET.fromstring(spec.to_xml())
-        # to_xml() compiled the spec; the compiled values are what our MJCF must give.
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # to_xml() already showed MuJoCo's warnings
-            reader.compiled = spec.compile()
     except ValueError as exc:
         raise ThingXMLError(f"{source}: MuJoCo rejected the MJCF: {exc}") from None
     carried: dict[str, list[ET.Element]] = {}
@@ -682,14 +697,12 @@ def _read_world(spec: mujoco.MjSpec, base_dir: Path, source: str, strict: bool) 
     ):
         carried = {"actuator": [], "sensor": []}
     acts, sens = carried["actuator"], carried["sensor"]
-    refine_listed(acts, reader.compiled, "actuator")
-    refine_listed(sens, reader.compiled, "sensor")
     for i, sa in enumerate(spec.actuators):
         carried["actuator"] = [acts[i]] if acts else []
         reader.actuator(sa, world, carried, i)
     for i, ss in enumerate(spec.sensors):
         carried["sensor"] = [sens[i]] if sens else []
-        reader.sensor(ss, world, carried)
+        reader.sensor(ss, world, carried, i)
     uses_classes = False
     for section in _CARRIED_SECTIONS:
         node = carried_root.find(section)
