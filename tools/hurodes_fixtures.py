@@ -133,7 +133,12 @@ def make_hurodes_fixtures(testdata: Path, hurodes_python: Path) -> Path:
     shutil.rmtree(work, ignore_errors=True)
     digest = _digest(_write_sources(testdata, work / "sources"))
     stamp = {"hurodes": HURODES_VERSION, "inputs_sha256": digest}
-    if marker.is_file() and json.loads(marker.read_text()) == stamp:
+    made = ("g1_29/meta.yaml", "g1_29/exported/robot.xml", "synth_baseline_hinge/meta.yaml")
+    if (
+        marker.is_file()
+        and json.loads(marker.read_text()) == stamp
+        and all((dest / f).is_file() for f in made)
+    ):
         shutil.rmtree(work)
         print(f"hurodes fixtures already in {dest}")
         return dest
