@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["Note", "collect_notes", "is_ours", "notes_of", "summary_line"]
+__all__ = ["Note", "collect_notes", "is_ours", "name_list", "notes_of", "summary_line"]
 
 _PACKAGE_DIR = str(Path(__file__).resolve().parent)
 
@@ -28,6 +28,13 @@ _TABLE = re.compile(
 )
 #: ``t.xml: <joint name="a">: ...`` -> kind ``<joint>``.
 _ELEMENT = re.compile(r"<(?P<tag>[A-Za-z_][\w-]*)[\s>/]")
+
+
+def name_list(names: Sequence[str], limit: int = 12) -> str:
+    """``"a, b, c"``, cut after ``limit`` names with ``"... (N more)"``: a warning about
+    a 10,000-joint robot stays one readable line."""
+    shown = ", ".join(names[:limit])
+    return shown if len(names) <= limit else f"{shown}, ... ({len(names) - limit} more)"
 
 
 @dataclass(frozen=True)

@@ -234,3 +234,27 @@ def test_non_utf8_source_is_exit_2_on_stderr(tmp_path, capsys, command) -> None:
     captured = capsys.readouterr()
     assert str(source) in captured.err and "line 1" in captured.err
     assert captured.out == ""
+
+
+def test_warning_about_many_joints_stays_one_short_line(tmp_path: Path, caplog) -> None:
+    """A warning naming the joints of a 300-joint robot lists a few and counts the rest."""
+    n = 300
+    links = "".join(
+        f'<link name="l{i}"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        for i in range(n + 1)
+    )
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="3" velocity="2"/></joint>'
+        for i in range(1, n + 1)
+    )
+    urdf = tmp_path / "many.urdf"
+    urdf.write_text(f'<robot name="many">{links}{joints}</robot>')
+    with caplog.at_level("WARNING"):
+        urdf_to_hrdf(urdf)
+    limits = [r.getMessage() for r in caplog.records if "effort/velocity limits" in r.getMessage()]
+    assert len(limits) == 1
+    assert f"of {n} joint(s)" in limits[0]
+    assert f"({n - 12} more)" in limits[0]
+    assert "j1, j2" in limits[0] and "j299" not in limits[0]

@@ -24,6 +24,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from robotwright._notes import name_list
 from robotwright._paths import trusted_asset_roots
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import (
@@ -787,7 +788,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         rep.warn(
             f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept (HRDF joints "
             "carry no force limit; keep them as motors with actuators='motor', "
-            "on the command line --actuators motor): " + ", ".join(dropped_limits)
+            "on the command line --actuators motor): " + name_list(dropped_limits)
         )
 
     hrdf_bodies: list[Body] = []

@@ -34,6 +34,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
+from robotwright._notes import name_list
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import Actuator, Joint
 from robotwright.parsers.report import Reporter
@@ -191,7 +192,7 @@ def make_actuators(
         if left:
             rep.warn(
                 f"{len(left)} moving joint(s) without a transmission/ros2_control interface "
-                "get no actuator: " + ", ".join(left)
+                "get no actuator: " + name_list(left)
             )
     else:
         actuated = moving
