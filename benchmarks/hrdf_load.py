@@ -3,16 +3,19 @@
 
     python benchmarks/hrdf_load.py [--hurodes-python /path/to/python-with-hurodes]
 
-hurodes only loads folders under ``~/.hurodes/robots``; the script copies the fixture
-there (to a temporary name it removes afterwards) for the peer's run.
+hurodes only loads folders under ``$HURODES_ASSETS_PATH/robots`` (default
+``~/.hurodes/robots``); the script copies the fixture under a temporary assets folder it
+removes afterwards, for the peer's run.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
+import tempfile
 import uuid
 import warnings
 from pathlib import Path
@@ -65,14 +68,14 @@ def main() -> int:
 
     peer = None
     if args.hurodes_python:
-        robots = Path.home() / ".hurodes" / "robots"
-        name = f"bench_{uuid.uuid4().hex[:8]}"
-        shutil.copytree(args.fixture, robots / name)
-        try:
-            code = PEER_CODE.format(path=str(robots / name), repeat=args.repeat, number=args.number)
+        # hurodes reads robots only under $HURODES_ASSETS_PATH/robots: a temporary one,
+        # so that nothing is written into the user's ~/.hurodes.
+        with tempfile.TemporaryDirectory() as assets:
+            robot = Path(assets) / "robots" / f"bench_{uuid.uuid4().hex[:8]}"
+            shutil.copytree(args.fixture, robot)
+            os.environ["HURODES_ASSETS_PATH"] = assets
+            code = PEER_CODE.format(path=str(robot), repeat=args.repeat, number=args.number)
             peer = run_peer(args.hurodes_python, code)["median"]
-        finally:
-            shutil.rmtree(robots / name, ignore_errors=True)
     report([("HRDF.from_dir (G1, 30 bodies)", ours, peer)])
     print(json.dumps({"ours_s": ours, "hurodes_s": peer}))
     return 0
