@@ -239,3 +239,20 @@ def test_cli_serves_the_page_until_ctrl_c() -> None:
             proc.wait()
     assert proc.returncode == 0, err
     assert "stopped" in out and "Traceback" not in err
+
+
+def test_composed_scene(tmp_path: Path) -> None:
+    """A scene written by compose_scene (two robots, prefixed) is shown as MuJoCo
+    compiles it: both robots, each at its placement."""
+    from robotwright.generators.tasks import compose_scene
+
+    xml = compose_scene(
+        {"h": "mini_humanoid", "arm": "arm6"},
+        tmp_path / "scene.xml",
+        placements={"h": (0.0, 0.0, 0.0), "arm": (1.5, 0.5, 0.0)},
+    )
+    scene = load_source(xml)
+    reference = mujoco.MjModel.from_xml_path(str(xml))
+    _same_model(scene.model, reference)
+    names = {scene.model.body(b).name for b in range(scene.model.nbody)}
+    assert any(n.startswith("h_") for n in names) and any(n.startswith("arm_") for n in names)
