@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import uuid
@@ -32,8 +33,12 @@ print(json.dumps({"xml": str(out)}))
 """
 
 
-def test_g1_written_by_us_loads_in_hurodes(g1_hrdf_dir: Path, hurodes_python: str) -> None:
-    robots = Path.home() / ".hurodes" / "robots"
+def test_g1_written_by_us_loads_in_hurodes(
+    g1_hrdf_dir: Path, hurodes_python: str, tmp_path: Path
+) -> None:
+    # hurodes reads robots only under $HURODES_ASSETS_PATH/robots: a temporary one, so
+    # that the test writes nothing into the user's ~/.hurodes.
+    robots = tmp_path / "robots"
     name = f"rw_test_{uuid.uuid4().hex[:8]}"
     try:
         HRDF.from_dir(g1_hrdf_dir).save(robots / name)
@@ -42,6 +47,7 @@ def test_g1_written_by_us_loads_in_hurodes(g1_hrdf_dir: Path, hurodes_python: st
             capture_output=True,
             text=True,
             check=True,
+            env={**os.environ, "HURODES_ASSETS_PATH": str(tmp_path)},
         )
         xml = json.loads(out.stdout.strip().splitlines()[-1])["xml"]
         ours = mujoco.MjModel.from_xml_path(xml)
