@@ -74,5 +74,10 @@ def test_g1_fixture_compiles_to_the_source_robot(g1_hrdf_dir: Path, g1_source_mj
 
 def test_fixtures_record_hurodes_version(g1_hrdf_dir: Path) -> None:
     """The cache stamp names the hurodes version that wrote the folders."""
-    stamp = json.loads((g1_hrdf_dir.parent / ".hurodes-fixtures.json").read_text())
+    path = g1_hrdf_dir.parent / ".hurodes-fixtures.json"
+    if not path.is_file():
+        pytest.skip(
+            f"{g1_hrdf_dir.parent} was not made by tools/fetch_test_data.py (no {path.name})"
+        )
+    stamp = json.loads(path.read_text())
     assert stamp["hurodes"] == "0.1.9" and len(stamp["inputs_sha256"]) == 64
