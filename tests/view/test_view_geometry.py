@@ -179,3 +179,17 @@ def test_height_field_surface_matches_mujoco_ray_casts() -> None:
         start = np.array([x + 0.3, y - 0.2, 5.0])
         dist = mujoco.mj_ray(model, data, start, np.array([0.0, 0.0, -1.0]), None, 1, -1, geomid)
         np.testing.assert_allclose(5.0 - dist, v[2] + 0.1, atol=2e-3)
+
+
+def test_textures_are_named_as_not_drawn() -> None:
+    model = mujoco.MjModel.from_xml_string(
+        '<mujoco><asset><texture name="t" type="2d" builtin="checker" width="8" height="8"/>'
+        '<material name="m" texture="t" rgba="0.2 0.4 0.6 1"/></asset><worldbody>'
+        '<geom name="tiled" size="0.1" material="m"/><geom name="plain" size="0.1"/>'
+        "</worldbody></mujoco>"
+    )
+    skipped: list[str] = []
+    shapes = geom_shapes(model, skipped=skipped)
+    assert len(shapes) == 2  # drawn, in the material's colour
+    np.testing.assert_allclose(shapes[0].rgba, [0.2, 0.4, 0.6, 1.0], atol=1e-6)
+    assert skipped == ["geom 'tiled': texture not drawn, only its colour"]

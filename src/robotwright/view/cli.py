@@ -103,8 +103,12 @@ def _run(args: argparse.Namespace) -> int:
         f"{scene.title}: {m.nbody - 1} bodies, {m.njnt} joints, {viewer.geom_count} geoms shown"
         + (f", {len(scene.scan.points)} scan points" if scene.scan is not None else "")
     )
-    for line in [*viewer.notes, *viewer.skipped]:
+    lines = [*viewer.notes, *viewer.skipped]
+    shown = lines if getattr(args, "verbose", False) else lines[:5]
+    for line in shown:
         print(f"note: {line}", file=sys.stderr)
+    if len(shown) < len(lines):
+        print(f"note: ... {len(lines) - len(shown)} more (-v lists each)", file=sys.stderr)
     print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
     try:
         while True:

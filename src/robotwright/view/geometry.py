@@ -162,7 +162,8 @@ def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> l
 
     Geoms of every group are returned (the viewer shows groups 0-2 first, as MuJoCo
     does). Fully transparent geoms (alpha 0) and geom types without a surface to draw
-    here (SDF plugins) are left out; when ``skipped`` is a list, a line naming each is
+    here (SDF plugins) are left out, and textures are not drawn (a textured geom shows
+    its material's colour); when ``skipped`` is a list, a line naming each such geom is
     appended to it.
     """
     G = mujoco.mjtGeom
@@ -185,6 +186,9 @@ def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> l
             if skipped is not None:
                 skipped.append(f"geom '{name}': type {G(gtype).name} is not drawn")
             continue
+        matid = int(model.geom_matid[g])
+        if skipped is not None and matid >= 0 and np.max(model.mat_texid[matid]) >= 0:
+            skipped.append(f"geom '{name}': texture not drawn, only its colour")
         out.append(
             GeomShape(
                 geom_id=g,

@@ -477,8 +477,9 @@ class Viewer:
             f"{m.nbody - 1} bodies, {m.njnt} joints, {m.nu} actuators, {m.ngeom} geoms, "
             f"{m.nsite} sites",
         ]
-        if self.skipped:
-            lines.append(f"not drawn: {len(self.skipped)} geom(s)")
+        drawn = sum(len(shapes) for shapes in self._shapes.values())
+        if drawn < m.ngeom:
+            lines.append(f"not drawn: {m.ngeom - drawn} geom(s)")
         return "  \n".join(lines)
 
     def _legend_html(self) -> str:
