@@ -261,6 +261,30 @@ def test_hostile_xacro_is_refused(robot_dir: Path, body: str, match: str) -> Non
         urdf_to_hrdf(_xacro(robot_dir, body))
 
 
+MACRO_BOMB = "".join(
+    f'<xacro:macro name="m{k}"><xacro:m{k - 1}/><xacro:m{k - 1}/></xacro:macro>'
+    for k in range(1, 40)
+)
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        '<xacro:macro name="m0"><link name="x"/></xacro:macro>' + MACRO_BOMB + "<xacro:m39/>",
+        "<link name=\"${'x' * 10**10}\"/>",
+    ],
+    ids=["macro-explosion", "huge-expression"],
+)
+def test_expansion_bombs_stop_at_the_limits(robot_dir: Path, body: str, monkeypatch) -> None:
+    import robotwright.parsers.xacro as X
+
+    monkeypatch.setattr(X, "XACRO_CPU_S", 2)
+    monkeypatch.setattr(X, "XACRO_MEMORY_BYTES", 1 << 30)
+    monkeypatch.setattr(X, "XACRO_TIMEOUT_S", 20)
+    with pytest.raises(ConversionError, match="refused"):
+        urdf_to_hrdf(_xacro(robot_dir, body))
+
+
 def test_entities_in_an_included_file_are_refused(robot_dir: Path) -> None:
     (robot_dir / "bomb.xacro").write_text(
         '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa">'

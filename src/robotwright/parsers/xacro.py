@@ -78,6 +78,14 @@ def read_robot_xml(path: Path, options: Any, rep: Reporter) -> ET.Element:
     return root
 
 
+#: Limits of one expansion (xacro macros and ``${}`` expressions can blow up: a macro
+#: calling the previous one twice, 40 deep, or ``${'x' * 10**10}``): wall time (s), CPU
+#: time (s) and address space (bytes) of the worker process.
+XACRO_TIMEOUT_S = 120
+XACRO_CPU_S = 60
+XACRO_MEMORY_BYTES = 4 << 30
+
+
 def expand_xacro(
     path: str | os.PathLike[str],
     *,
@@ -85,7 +93,8 @@ def expand_xacro(
     package_map: Mapping[str, str | os.PathLike[str]] | None = None,
     asset_roots: tuple[str | os.PathLike[str], ...] | list = (),
 ) -> tuple[str, dict[str, Path], list[str]]:
-    """Expand the xacro file at ``path``.
+    """Expand the xacro file at ``path`` in a separate process with time and memory
+    limits (:data:`XACRO_TIMEOUT_S`, :data:`XACRO_CPU_S`, :data:`XACRO_MEMORY_BYTES`).
 
     Returns:
         The URDF text, the package folders ``$(find)`` resolved (name -> folder), and
@@ -94,9 +103,104 @@ def expand_xacro(
     Raises:
         ConversionError: the ``xacro`` package is not installed, a file it would read
             lies outside the allowed folders or is unsafe XML, an unknown package or
-            ``$(arg)``, ``$(env)``, or any error xacro reports (message names the file).
+            ``$(arg)``, ``$(env)``, any error xacro reports (message names the file), or
+            the expansion ran past its limits.
     """
+    import json
+    import subprocess
+    import sys
+
     src = Path(path)
+    request = {
+        "path": str(src),
+        "xacro_args": {str(k): str(v) for k, v in (xacro_args or {}).items()},
+        "package_map": {str(k): str(v) for k, v in (package_map or {}).items()},
+        "trusted": [str(p) for p in trusted_roots(asset_roots)],
+        "limits": [XACRO_CPU_S, XACRO_MEMORY_BYTES],
+    }
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "robotwright.parsers.xacro"],
+            input=json.dumps(request),
+            capture_output=True,
+            text=True,
+            timeout=XACRO_TIMEOUT_S,
+            env=env,
+        )
+    except subprocess.TimeoutExpired:
+        raise ConversionError(
+            [Problem(str(src), f"xacro expansion ran past {XACRO_TIMEOUT_S} s; refused")]
+        ) from None
+    try:
+        reply = json.loads(done.stdout)
+    except ValueError:
+        how = f"signal {-done.returncode}" if done.returncode < 0 else f"exit {done.returncode}"
+        raise ConversionError(
+            [
+                Problem(
+                    str(src),
+                    f"xacro expansion stopped ({how}; limits: {XACRO_CPU_S} s CPU, "
+                    f"{XACRO_MEMORY_BYTES >> 30} GiB memory): refused",
+                )
+            ]
+        ) from None
+    if not reply["ok"]:
+        raise ConversionError([Problem(f, m) for f, m in reply["problems"]])
+    packages = {k: Path(v) for k, v in reply["packages"].items()}
+    return reply["text"], packages, reply["messages"]
+
+
+def _worker() -> None:
+    """``python -m robotwright.parsers.xacro``: one expansion, request on stdin, reply
+    (JSON) on stdout, under CPU and memory limits."""
+    import json
+    import sys
+
+    request = json.loads(sys.stdin.read())
+    cpu_s, memory = request["limits"]
+    try:
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu_s, cpu_s))
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    except (ImportError, ValueError, OSError):  # not on this platform: wall time only
+        pass
+    try:
+        text, packages, messages = _expand_here(
+            Path(request["path"]),
+            xacro_args=request["xacro_args"],
+            package_map=request["package_map"] or None,
+            trusted=tuple(Path(p) for p in request["trusted"]),
+        )
+        if len(text) > MAX_XML_BYTES:
+            raise ConversionError(
+                [Problem(request["path"], f"xacro output is over {MAX_XML_BYTES} bytes")]
+            )
+        reply = {
+            "ok": True,
+            "text": text,
+            "packages": {k: str(v) for k, v in packages.items()},
+            "messages": messages,
+        }
+    except ConversionError as exc:
+        reply = {"ok": False, "problems": [[p.file, p.message] for p in exc.problems]}
+    except MemoryError:
+        reply = {
+            "ok": False,
+            "problems": [[request["path"], "xacro expansion ran out of memory; refused"]],
+        }
+    sys.stdout.write(json.dumps(reply))
+
+
+def _expand_here(
+    src: Path,
+    *,
+    xacro_args: Mapping[str, str] | None,
+    package_map: Mapping[str, str | os.PathLike[str]] | None,
+    trusted: tuple[Path, ...],
+) -> tuple[str, dict[str, Path], list[str]]:
+    """The expansion itself (in the worker process)."""
     try:
         import xacro
         from xacro import substitution_args
@@ -109,7 +213,7 @@ def expand_xacro(
                 )
             ]
         ) from None
-    guard = _Guard(src, package_map, asset_roots)
+    guard = _Guard(src, package_map, trusted)
     args = {str(k): str(v) for k, v in (xacro_args or {}).items()}
     messages = io.StringIO()
     with _LOCK, _patched(xacro, substitution_args, guard), contextlib.redirect_stderr(messages):
@@ -120,9 +224,11 @@ def expand_xacro(
         except ConversionError:
             raise
         except Exception as exc:  # xacro raises many types; each is a fault of the source
-            cause = _cause(exc, (_Refused, substitution_args.ArgException))
+            cause = _cause(exc, (_Refused, substitution_args.ArgException, MemoryError))
             if isinstance(cause, _Refused):
                 message = str(cause)
+            elif isinstance(cause, MemoryError):
+                message = "xacro expansion ran out of memory; refused"
             elif isinstance(cause, substitution_args.ArgException):
                 message = (
                     f"xacro argument {cause} has no value and no default "
@@ -161,12 +267,12 @@ class _Guard:
         self,
         src: Path,
         package_map: Mapping[str, str | os.PathLike[str]] | None,
-        asset_roots: Any,
+        trusted: tuple[Path, ...],
     ) -> None:
         self.src = src
         self.package_map = package_map
         self.root = robot_root(src)
-        self.trusted = trusted_roots(asset_roots)
+        self.trusted = trusted
         self.packages: dict[str, Path] = {}
 
     def find(self, name: str) -> str:
@@ -316,3 +422,7 @@ def xacro_as_urdf(path: Path, options: dict[str, Any]) -> tuple[Path, dict[str, 
     out.write_text(ET.tostring(root, encoding="unicode"), encoding="utf-8")
     opts["asset_roots"] = (*asset_roots, *dict.fromkeys(roots))
     return out, opts
+
+
+if __name__ == "__main__":
+    _worker()
