@@ -19,7 +19,7 @@ read in place (``sources/g1_29.xml`` points at them).
 
 Cached: ``.hurodes-fixtures.json`` records hurodes' version and a hash of everything the
 result depends on (source MJCF texts, mesh bytes, the writer script); a re-run with the
-same inputs does nothing.
+same inputs keeps the folders (about 2 s to check) instead of running hurodes again.
 """
 
 from __future__ import annotations
