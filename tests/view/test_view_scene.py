@@ -256,3 +256,34 @@ def test_composed_scene(tmp_path: Path) -> None:
     _same_model(scene.model, reference)
     names = {scene.model.body(b).name for b in range(scene.model.nbody)}
     assert any(n.startswith("h_") for n in names) and any(n.startswith("arm_") for n in names)
+
+
+def test_xacro_file(tmp_path: Path) -> None:
+    """A .urdf.xacro is expanded (default arguments) and read as its URDF would be."""
+    pytest.importorskip("xacro", reason="the xacro extra is not installed")
+    body = (
+        '<link name="{n}"><inertial><mass value="{m}"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '<visual><geometry><box size="0.1 0.1 {len}"/></geometry></visual></link>'
+    )
+    urdf = (
+        '<robot name="two">'
+        + body.format(n="base", m=1.0, len=0.5)
+        + body.format(n="tip", m=0.5, len=0.5)
+        + '<joint name="j" type="revolute"><parent link="base"/><child link="tip"/>'
+        '<origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    macro = (
+        '<robot name="two" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="len" default="0.5"/>'
+        + body.format(n="base", m=1.0, len="$(arg len)")
+        + body.format(n="tip", m=0.5, len="$(arg len)")
+        + urdf[urdf.index("<joint") :]
+    )
+    (tmp_path / "two.urdf").write_text(urdf, encoding="utf-8")
+    (tmp_path / "two.urdf.xacro").write_text(macro, encoding="utf-8")
+    plain, expanded = load_source(tmp_path / "two.urdf"), load_source(tmp_path / "two.urdf.xacro")
+    assert expanded.kind == "urdf"
+    _same_model(expanded.model, plain.model)
+    np.testing.assert_allclose(expanded.model.geom_size, plain.model.geom_size)

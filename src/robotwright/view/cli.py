@@ -42,12 +42,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "view",
         help="show a robot, scene or scan in the browser (viser)",
         description="Serve a web page showing SOURCE: a bundled robot name, an HRDF "
-        "folder, an MJCF or URDF file, a composed scene, a grammar design folder, or a "
+        "folder, an MJCF, URDF or xacro file, a composed scene, a grammar design folder, or a "
         "scan .npz (with --scene). Meshes and primitives in MuJoCo's colours, body and site "
         "frames, joint sliders (MuJoCo forward kinematics), scan points by semantic class. "
         "Prints the URL and runs until Ctrl-C.",
     )
-    p.add_argument("source", help="robot name, HRDF or design folder, .xml, .urdf or scan .npz")
+    p.add_argument(
+        "source", help="robot name, HRDF or design folder, .xml, .urdf, .xacro or scan .npz"
+    )
     p.add_argument("--scene", type=Path, help="MJCF scene a scan .npz was taken in")
     p.add_argument(
         "--port", type=_port, default=8080, help="TCP port (default 8080; next free if taken)"

@@ -7,8 +7,9 @@ A *source* is one of:
 - an MJCF file (``.xml``), including a scene composed by ``robotwright compose`` or the
   demo: compiled by MuJoCo itself, so everything MuJoCo accepts is shown as MuJoCo
   compiles it;
-- a URDF file (``.urdf``): read by robotwright's URDF parser (``package://`` paths,
-  visual meshes, DAE/OBJ meshes), then generated as MJCF;
+- a URDF file (``.urdf``), or a xacro file (``.xacro``, ``.urdf.xacro``; the ``xacro``
+  extra) expanded with its default arguments: read by robotwright's URDF parser
+  (``package://`` paths, visual meshes, DAE/OBJ meshes), then generated as MJCF;
 - a grammar design folder (``design.txt`` inside, as ``robotwright grammar sample`` or
   ``export`` write it): its MJCF file, else the design rebuilt with the bundled grammar;
 - a scan ``.npz`` written by ``robotwright lidar`` or the demo, with the MJCF scene it
@@ -138,14 +139,15 @@ def load_source(
         return _design_scene(path, asset_roots)
     if path.is_file() and suffix in (".xml", ".mjcf"):
         return ViewScene(_compile_mjcf(path, asset_roots), path.stem, "mjcf", text)
-    if path.is_file() and suffix == ".urdf":
+    if path.is_file() and suffix in (".urdf", ".xacro"):
         return _urdf_scene(path, asset_roots)
     if path.is_file():
         raise ViewError(
             f"{path}: cannot show a '{suffix or 'extensionless'}' file; expected an MJCF "
-            "(.xml), a URDF (.urdf), a scan (.npz), an HRDF or design folder, or a robot name"
+            "(.xml), a URDF (.urdf) or xacro (.xacro) file, a scan (.npz), an HRDF or design "
+            "folder, or a robot name"
         )
-    if not path.exists() and suffix in (".xml", ".mjcf", ".urdf"):
+    if not path.exists() and suffix in (".xml", ".mjcf", ".urdf", ".xacro"):
         raise ViewError(f"{path}: no such file")
     return _robot_scene(text, asset_roots)
 
