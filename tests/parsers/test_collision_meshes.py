@@ -4,6 +4,7 @@ meshes untouched. Compared on compiled MuJoCo models."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import mujoco
@@ -194,3 +195,18 @@ def test_cli_convert_reports_the_repair(tmp_path: Path, capsys) -> None:
     assert [len(_mesh_faces(model, g)) <= 64 for g in collision] == [True]
     assert main([*argv[:3], "2", *argv[4:-1], str(tmp_path / "bad.xml")]) == 2
     assert "max_faces=2" in capsys.readouterr().err and not (tmp_path / "bad.xml").exists()
+
+
+def test_a_mesh_shared_by_collision_geoms_is_repaired_once(tmp_path: Path) -> None:
+    _need("fast_simplification")
+    robot = _ring_robot(tmp_path)
+    twin = replace(robot.meshes[1], body="base", geom_name="base_ring")
+    robot = replace(robot, meshes=[*robot.meshes, twin])
+    out = tmp_path / "out"
+    repaired, report = repair_collision_meshes(robot, CollisionMeshConfig(max_faces=64), out)
+    assert [r.body for r in report] == ["link", "base"]
+    assert report[0].faces_after == report[1].faces_after
+    assert len(list(out.iterdir())) == 1  # one decimated file, used by both geoms
+    collision = [m for m in repaired.meshes if m.contact_type]
+    assert len({m.file for m in collision}) == 1 and len(collision) == 2
+    assert [m.geom_name for m in collision] == ["ring_collision", "base_ring"]

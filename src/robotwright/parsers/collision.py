@@ -26,6 +26,7 @@ import math
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -177,78 +178,27 @@ def repair_collision_meshes(
     taken = {m.name for m in hrdf.meshes}
     meshes: list[MeshGeom] = []
     repairs: list[MeshRepair] = []
+    # A mesh file used by several collision geoms (four identical feet) is repaired once.
+    done: dict[tuple[str, tuple[float, ...]], tuple[list[tuple[str, str]], list[tuple]]] = {}
     for geom in hrdf.meshes:
         if not _is_collision(geom):
             meshes.append(geom)
             continue
-        try:
-            # process=True merges duplicate vertices (STL), so watertightness is known.
-            loaded = trimesh.load(str(hrdf.mesh_source(geom)), force="mesh", process=True)
-        except Exception as exc:  # trimesh raises many types for unreadable files
-            raise ConversionError(
-                [Problem("mesh.csv", f"cannot read mesh '{geom.name}': {exc}")]
-            ) from None
-        scale = np.asarray(geom.scale, dtype=float)
-        vertices = np.asarray(loaded.vertices, dtype=float)
-        faces = np.asarray(loaded.faces, dtype=np.int64)
-        before_faces, before_volume = len(faces), _volume(loaded, scale)
-        current = geom
-        if simplify is not None and len(faces) > config.max_faces:
-            new_v, new_f = simplify.simplify(vertices, faces, target_count=config.max_faces)
-            part = trimesh.Trimesh(new_v, new_f, process=False)
-            name = _unique(taken, f"{geom.name}_{config.max_faces}f")
-            current = _write(part, folder, name, geom)
-            vertices, faces = np.asarray(new_v), np.asarray(new_f)
-            repairs.append(
-                MeshRepair(
-                    geom.body,
-                    geom.name,
-                    "decimated",
-                    before_faces,
-                    len(new_f),
-                    before_volume,
-                    _volume(part, scale) if before_volume is not None else None,
-                )
-            )
-        if coacd is None:
-            meshes.append(current)
+        source = str(hrdf.mesh_source(geom))
+        key = (source, tuple(geom.scale))
+        if key not in done:
+            done[key] = _repair_file(source, geom, config, simplify, coacd, taken, folder, trimesh)
+        outputs, stats = done[key]
+        if not stats:
+            meshes.append(geom)
             continue
-        coacd.set_log_level("error")
-        parts = coacd.run_coacd(
-            coacd.Mesh(vertices, faces),
-            threshold=float(config.threshold),
-            max_convex_hull=config.max_parts,
-            seed=config.seed,
-            resolution=config.resolution,
-            mcts_iterations=config.mcts_iterations,
-            preprocess_resolution=config.preprocess_resolution,
-        )
-        made: list[MeshGeom] = []
-        total_faces, total_volume = 0, 0.0
-        for k, (pv, pf) in enumerate(parts):
-            hull = trimesh.Trimesh(np.asarray(pv), np.asarray(pf), process=False)
-            total_faces += len(pf)
-            total_volume += abs(float(hull.volume)) * float(np.prod(np.abs(scale)))
-            name = _unique(taken, f"{current.name}_part{k}")
-            part_geom = _write(hull, folder, name, current)
-            if current.geom_name is not None:
-                part_geom = replace(part_geom, geom_name=f"{current.geom_name}_part{k}")
-            made.append(part_geom)
-        meshes.extend(made)
-        start_faces = len(faces)
-        start_volume = repairs[-1].volume_after if current is not geom else before_volume
-        repairs.append(
-            MeshRepair(
-                geom.body,
-                current.name,
-                "decomposed",
-                start_faces,
-                total_faces,
-                start_volume,
-                total_volume if start_volume is not None and math.isfinite(total_volume) else None,
-                parts=len(made),
-            )
-        )
+        decomposed = stats[-1][1] == "decomposed"
+        for k, (name, file) in enumerate(outputs):
+            made = replace(geom, name=name, file=file)
+            if decomposed and geom.geom_name is not None:
+                made = replace(made, geom_name=f"{geom.geom_name}_part{k}")
+            meshes.append(made)
+        repairs += [MeshRepair(geom.body, *fields) for fields in stats]
     if not repairs:
         return hrdf, []
     holders = hrdf.temp_assets if holder is None else (hrdf.temp_assets, holder)
@@ -263,6 +213,65 @@ def repair_collision_meshes(
     )
 
 
+def _repair_file(
+    source: str,
+    geom: MeshGeom,
+    config: CollisionMeshConfig,
+    simplify: Any,
+    coacd: Any,
+    taken: set[str],
+    folder: Path,
+    trimesh: Any,
+) -> tuple[list[tuple[str, str]], list[tuple]]:
+    """Repair one mesh file: the ``(mesh name, file)`` of each output geom, and the
+    :class:`MeshRepair` fields (less the body) of each repair made (none: unchanged)."""
+    try:
+        # process=True merges duplicate vertices (STL), so watertightness is known.
+        loaded = trimesh.load(source, force="mesh", process=True)
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise ConversionError(
+            [Problem("mesh.csv", f"cannot read mesh '{geom.name}': {exc}")]
+        ) from None
+    scale = np.asarray(geom.scale, dtype=float)
+    vertices = np.asarray(loaded.vertices, dtype=float)
+    faces = np.asarray(loaded.faces, dtype=np.int64)
+    volume = _volume(loaded, scale)
+    name = geom.name
+    outputs: list[tuple[str, str]] = [(geom.name, geom.file or source)]
+    stats: list[tuple] = []
+    if simplify is not None and len(faces) > config.max_faces:
+        new_v, new_f = simplify.simplify(vertices, faces, target_count=config.max_faces)
+        part = trimesh.Trimesh(new_v, new_f, process=False)
+        after = _volume(part, scale) if volume is not None else None
+        stats.append((name, "decimated", len(faces), len(new_f), volume, after))
+        name = _unique(taken, f"{geom.name}_{config.max_faces}f")
+        outputs = [(name, _write(part, folder, name))]
+        vertices, faces, volume = np.asarray(new_v), np.asarray(new_f), after
+    if coacd is None:
+        return outputs, stats
+    coacd.set_log_level("error")
+    parts = coacd.run_coacd(
+        coacd.Mesh(vertices, faces),
+        threshold=float(config.threshold),
+        max_convex_hull=config.max_parts,
+        seed=config.seed,
+        resolution=config.resolution,
+        mcts_iterations=config.mcts_iterations,
+        preprocess_resolution=config.preprocess_resolution,
+    )
+    outputs = []
+    total_faces, total_volume = 0, 0.0
+    for k, (pv, pf) in enumerate(parts):
+        hull = trimesh.Trimesh(np.asarray(pv), np.asarray(pf), process=False)
+        total_faces += len(pf)
+        total_volume += abs(float(hull.volume)) * float(np.prod(np.abs(scale)))
+        part_name = _unique(taken, f"{name}_part{k}")
+        outputs.append((part_name, _write(hull, folder, part_name)))
+    after = total_volume if volume is not None and math.isfinite(total_volume) else None
+    stats.append((name, "decomposed", len(faces), total_faces, volume, after, len(outputs)))
+    return outputs, stats
+
+
 def _unique(taken: set[str], base: str) -> str:
     name, k = base, 1
     while name in taken:
@@ -272,11 +281,11 @@ def _unique(taken: set[str], base: str) -> str:
     return name
 
 
-def _write(mesh: object, folder: Path, name: str, geom: MeshGeom) -> MeshGeom:
-    """``mesh`` as ``folder/<name>.stl`` (binary), and ``geom`` pointing at it."""
+def _write(mesh: Any, folder: Path, name: str) -> str:
+    """``mesh`` as ``folder/<name>.stl`` (binary); returns the path."""
     path = folder / f"{name}.stl"
-    mesh.export(str(path), file_type="stl")  # type: ignore[attr-defined]
-    return replace(geom, name=name, file=str(path))
+    mesh.export(str(path), file_type="stl")
+    return str(path)
 
 
 #: ``convert`` / CLI options that select the repairs (not parser options).
