@@ -555,11 +555,11 @@ def _compare_actuators(ref: RobotView, ours: RobotView, tol: float) -> Row:
 # -- whole round trips ----------------------------------------------------------------------
 def source_kind(path: Path) -> str:
     ext = path.suffix.lower()
-    if ext == ".urdf":
+    if ext in (".urdf", ".xacro"):
         return "urdf"
     if ext == ".xml" or ext == ".mjcf":
         return "mjcf"
-    raise ValueError(f"{path}: expected a .urdf or .xml (MJCF) file")
+    raise ValueError(f"{path}: expected a .urdf, .xacro or .xml (MJCF) file")
 
 
 def parse_source(path: Path, strict: bool = False, **options: Any):
@@ -695,9 +695,11 @@ def _roundtrip(
 ) -> RoundTripReport:
     report = RoundTripReport(str(path), "")
     try:
-        if is_xacro(path):  # the references read a URDF file: expand it into work_dir
-            path, options = xacro_as_urdf(path, options)
+        # The parse reads the xacro itself (its messages name it); the references read
+        # a URDF file: the expansion, written into work_dir.
         result = parse_source(path, **options)
+        if is_xacro(path):
+            path, options = xacro_as_urdf(path, options)
     except Exception as exc:  # the table reports any failure with its reason
         report.error = f"parse failed: {type(exc).__name__}: {exc}"
         return report
