@@ -31,8 +31,8 @@ Mapping:
   same shape) and reported; ellipsoids are dropped and reported.
 
 Everything URDF cannot hold (armature, stiffness, springref, actuator types and gains,
-geom friction/contact bits/condim/groups, collision colours, restitution, sensors,
-``mjcf_extra``) is listed in one :class:`ConversionWarning` (``strict=True``: raised as
+geom friction/contact bits/condim/groups, colours of colliding geoms MuJoCo does not draw,
+restitution, sensors, ``mjcf_extra``) is listed in one :class:`ConversionWarning` (``strict=True``: raised as
 :class:`ConversionError`).
 """
 

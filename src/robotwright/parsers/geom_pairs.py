@@ -16,7 +16,7 @@ free one in document order.
 
 from __future__ import annotations
 
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -29,7 +29,8 @@ class _PoseLike(Protocol):
     rot: np.ndarray
 
 
-Parsed = tuple[str, Any, dict]  # (kind: "visual" | "collision", pose, fields)
+#: One parsed geom: kind ("visual", "collision" or :data:`BOTH`), origin, fields.
+Parsed = tuple[str, _PoseLike, dict]
 
 
 def _shape_key(fields: dict) -> tuple:
