@@ -189,3 +189,15 @@ def test_interrupt_is_one_line_and_exit_130(monkeypatch, capsys) -> None:
     monkeypatch.setattr(hrdf_cli, "_info", interrupted)
     assert main(["info", "arm6"]) == 130
     assert capsys.readouterr().err == "interrupted\n"
+
+
+def test_render_prints_no_notes_line_unless_verbose(tmp_path, capsys) -> None:
+    """render only shows a model: the notes of loading it are listed with -v only."""
+    from robotwright.cli import main
+
+    out = tmp_path / "arm.png"
+    assert main(["render", "arm6", "-o", str(out), "--size", "160x120"]) == 0
+    assert out.is_file()
+    assert "conversion note" not in capsys.readouterr().err
+    assert main(["render", "arm6", "-o", str(out), "--size", "160x120", "--overwrite", "-v"]) == 0
+    assert "conversion note" in capsys.readouterr().err

@@ -149,6 +149,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         roots = getattr(args, "asset_roots", None) or []
         with trusted_asset_roots(roots), collect_notes() as caught:
             code = int(args.func(args) or 0)
+        # Commands that only show a model (view, render) write no conversion: the notes
+        # of loading it say nothing about the picture, so they are listed with -v only.
+        if not args.verbose and getattr(args, "shows_only", False):
+            caught.notes = []
         _report_notes(caught, bool(args.verbose))
         return code
     except RobotwrightError as exc:

@@ -62,7 +62,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the MJCF scene a scan .npz was taken in (its points are drawn in it)",
     )
     add_overwrite_flag(p)
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, shows_only=True)
 
 
 def run(args: argparse.Namespace) -> int:

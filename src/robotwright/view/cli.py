@@ -71,7 +71,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="default lights only, no environment map or shadows (faster without a GPU)",
     )
-    p.set_defaults(func=_run)
+    p.set_defaults(func=_run, shows_only=True)
 
 
 def _run(args: argparse.Namespace) -> int:
