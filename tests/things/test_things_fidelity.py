@@ -124,9 +124,10 @@ def test_spot_motors_keep_their_ctrlrange_real(robot):
 # ---------------------------------------------------------------- full precision
 PRECISE = """<mujoco><worldbody>
   <site name="s0" pos="0 0 1"/>
-  <body name="a" pos="0 0 0.5"><joint name="j1" axis="1 0 0"/><geom size=".1"/>
+  <body name="a" pos="0 0 0.5"><joint name="j1" axis="1 0 0"/><geom name="ga" size=".1"/>
     <site name="s1" pos="0.1234567891 0 0"/>
-    <body name="b" pos="0 0 -0.3"><joint name="j2" axis="0 1 0"/><geom size=".05"/></body>
+    <body name="b" pos="0 0 -0.3"><joint name="j2" axis="0 1 0"/><geom name="gb" size=".05"/>
+    </body>
   </body></worldbody>
 <tendon>
   <fixed name="t" stiffness="3.14159265358979" springlength="0.123456789012" damping="0.7777777777">
@@ -138,6 +139,9 @@ PRECISE = """<mujoco><worldbody>
 <actuator><motor name="tm" tendon="t" gear="1.000000123" ctrlrange="-0.333333333 0.333333333"/>
 </actuator>
 <keyframe><key name="k" qpos="0.1234567891 -0.98765432109" ctrl="0.1111111111"/></keyframe>
+<contact><pair geom1="ga" geom2="gb" margin="0.00123456789" friction="0.91234567 0.91234567
+  0.005123456 0.0001 0.0001"/></contact>
+<statistic extent="2.123456789" center="0.1234567891 0 0.5"/>
 </mujoco>"""
 
 
@@ -156,8 +160,12 @@ def test_carried_sections_keep_full_precision():
         "actuator_ctrlrange",
         "key_qpos",
         "key_ctrl",
+        "pair_margin",
+        "pair_friction",
     ):
         np.testing.assert_array_equal(getattr(ours, field), getattr(original, field), field)
+    assert ours.stat.extent == original.stat.extent == 2.123456789
+    np.testing.assert_array_equal(ours.stat.center, original.stat.center)
     # MuJoCo's own writer would have rounded these to six digits
     assert ours.tendon_stiffness[0].ravel()[0] == 3.14159265358979
     assert ours.key_qpos[0, 0] == 0.1234567891

@@ -1,7 +1,7 @@
 """Full-precision numbers in the MJCF sections that Things carry verbatim.
 
-The carried sections (tendons, equalities, keyframes, actuators and sensors the Things
-do not model) come from ``MjSpec.to_xml()``, whose writer rounds every number to six
+The carried sections (tendons, equalities, keyframes, contact pairs, statistics,
+actuators and sensors the Things do not model) come from ``MjSpec.to_xml()``, whose writer rounds every number to six
 significant digits (a tendon stiffness of 3.14159265 becomes 3.14159, a keyframe qpos
 moves by up to 5e-7). Each number is put back to the value MuJoCo compiled, read from
 the compiled ``MjModel`` of the same source, so that our MJCF compiles to that model
@@ -143,8 +143,38 @@ def refine_listed(
         refine(elem, _fields(model, table, i))
 
 
+_PAIR = {
+    "margin": "pair_margin",
+    "gap": "pair_gap",
+    "friction": "pair_friction",
+    "solref": "pair_solref",
+    "solreffriction": "pair_solreffriction",
+    "solimp": "pair_solimp",
+}
+
+
+def refine_contact(node: ET.Element, model: mujoco.MjModel) -> None:
+    """``<pair>`` elements in pair-id order (``<exclude>`` has no numbers)."""
+    pairs = [child for child in node if child.tag == "pair"]
+    for i, pair in enumerate(pairs[: model.npair]):
+        refine(pair, _fields(model, _PAIR, i))
+
+
+def refine_statistic(node: ET.Element, model: mujoco.MjModel) -> None:
+    stat = model.stat
+    refine(
+        node,
+        {
+            name: np.atleast_1d(np.asarray(getattr(stat, name), dtype=float))
+            for name in ("meaninertia", "meanmass", "meansize", "extent", "center")
+        },
+    )
+
+
 SECTION_REFINERS: dict[str, Callable[[ET.Element, mujoco.MjModel], None]] = {
     "tendon": refine_tendons,
     "equality": refine_equalities,
     "keyframe": refine_keys,
+    "contact": refine_contact,
+    "statistic": refine_statistic,
 }
