@@ -82,11 +82,17 @@ def test_config_is_validated() -> None:
             ViewerConfig(**bad)
 
 
+def _rgb(hex_color: str) -> tuple[int, int, int]:
+    h = hex_color.lstrip("#")
+    return (int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16))
+
+
 def test_scan_points_coloured_by_class(tmp_path: Path) -> None:
     from robotwright.sensors import scan_to_files
-    from robotwright.sensors.plot import _COLORS
+    from robotwright.sensors.plot import class_color as picture_color
 
-    assert tuple(_COLORS) == CLASS_COLORS  # the same colours as the scan pictures
+    # the same colours as the scan pictures
+    assert all(class_color(i) == _rgb(picture_color(i)) for i in range(len(CLASS_COLORS)))
     xml = tmp_path / "room.xml"
     xml.write_text(
         '<mujoco><worldbody><geom name="floor" type="plane" size="3 3 0.1"/>'

@@ -9,10 +9,11 @@ import numpy as np
 
 from robotwright._atomic import atomic_open
 
-__all__ = ["class_color", "plot_scan", "upside_down"]
+__all__ = ["CLASS_COLORS", "class_color", "plot_scan", "upside_down"]
 
-# Fixed colours so the same class looks the same in every picture (class 0 = unknown).
-_COLORS = [
+#: Colours (hex) by semantic class id, fixed so that a class looks the same in every
+#: scan picture, rendered picture and the browser viewer (class 0 = unknown, grey).
+CLASS_COLORS: tuple[str, ...] = (
     "#9e9e9e",
     "#8c6d31",
     "#d62728",
@@ -22,12 +23,12 @@ _COLORS = [
     "#ff7f0e",
     "#17becf",
     "#e377c2",
-]
+)
 
 
 def class_color(cls_id: int) -> str:
     """The colour (hex) of semantic class ``cls_id`` in every scan picture."""
-    return _COLORS[cls_id % len(_COLORS)]
+    return CLASS_COLORS[cls_id % len(CLASS_COLORS)]
 
 
 def upside_down(sensor_quat: np.ndarray | Sequence[float] | None) -> bool:

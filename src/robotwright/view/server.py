@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
+from robotwright.sensors.plot import CLASS_COLORS
 from robotwright.view.geometry import (
     DEFAULT_GEOM_GROUPS,
     GeomShape,
@@ -34,20 +35,6 @@ if TYPE_CHECKING:
     import viser
 
 __all__ = ["CLASS_COLORS", "Viewer", "ViewerConfig", "class_color"]
-
-#: Point colours by semantic class id, the same as the scan pictures'
-#: (:func:`robotwright.sensors.plot.plot_scan`): class 0 (unknown) is grey.
-CLASS_COLORS: tuple[str, ...] = (
-    "#9e9e9e",
-    "#8c6d31",
-    "#d62728",
-    "#1f77b4",
-    "#2ca02c",
-    "#9467bd",
-    "#ff7f0e",
-    "#17becf",
-    "#e377c2",
-)
 
 #: Slider range of a joint without limits: a full turn for a hinge [rad], +-1 m for a
 #: slide. Only the slider's range; the model is not changed.
