@@ -473,6 +473,13 @@ def urdf_for_mujoco(
             mesh.set("filename", str(resolved))
     if not mujoco_urdf_keeps_inertial_rotation():
         _inertia_into_link_frame(root)
+    # A continuous joint has no limits (URDF specification; MuJoCo 4 ignores lower/upper
+    # there), but MuJoCo 3.11 applies them: leave them out, so both import it alike.
+    for joint in root.iter("joint"):
+        limit = joint.find("limit")
+        if joint.get("type") == "continuous" and limit is not None:
+            limit.attrib.pop("lower", None)
+            limit.attrib.pop("upper", None)
     for old in root.findall("mujoco"):
         root.remove(old)
     mj = ET.SubElement(root, "mujoco")
