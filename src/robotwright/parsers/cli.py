@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import logging
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag, check_overwrite
@@ -183,13 +185,31 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_roundtrip)
 
 
+def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
+    """Run a command with the parsers' logger quiet (their warnings reach the user as the
+    command's notes), restoring its level after, so that a program calling ``main()``
+    keeps its own logging (and later log records are not lost)."""
+
+    @functools.wraps(func)
+    def wrapper(args: argparse.Namespace) -> int:
+        log = logging.getLogger("robotwright.parsers")
+        old = log.level
+        log.setLevel(logging.ERROR)
+        try:
+            return func(args)
+        finally:
+            log.setLevel(old)
+
+    return wrapper
+
+
+@_quiet_parser_log
 def _convert(args: argparse.Namespace) -> int:
     from robotwright.parsers.convert import convert
 
-    logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
     check_overwrite(args.output, args.overwrite)
     source = Path(args.src)
-    if not source.exists() and source.suffix.lower() not in (".urdf", ".xml"):
+    if not source.exists() and source.suffix.lower() not in (".urdf", ".xml", ".xacro"):
         # Not a file: a robot name (bundled or under $HURODES_ASSETS_PATH), as export takes.
         from robotwright.hrdf.assets import resolve_robot
 
@@ -206,10 +226,10 @@ def _convert(args: argparse.Namespace) -> int:
     return 0
 
 
+@_quiet_parser_log
 def _roundtrip(args: argparse.Namespace) -> int:
     from robotwright.parsers.roundtrip import roundtrip
 
-    logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
     report = roundtrip(
         args.source, configs=args.configs, reference=args.reference, **_options(args)
     )
