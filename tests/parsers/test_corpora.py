@@ -28,7 +28,17 @@ from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_fr
 from robotwright.parsers.roundtrip import our_mjcf_model, parse_source, roundtrip
 
 pytestmark = pytest.mark.realdata
-logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
+
+
+@pytest.fixture(autouse=True)
+def _quiet_parsers():
+    """Parser warnings off while these tests run (restored after: other tests read them)."""
+    logger = logging.getLogger("robotwright.parsers")
+    old = logger.level
+    logger.setLevel(logging.ERROR)
+    yield
+    logger.setLevel(old)
+
 
 TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"
 #: corpus -> folder holding its files (paths in the ids are relative to it).

@@ -26,7 +26,16 @@ from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_fr
 from robotwright.parsers.roundtrip import our_mjcf_model, roundtrip
 from robotwright.parsers.xmlsafe import parse_xml
 
-logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
+
+@pytest.fixture(autouse=True)
+def _quiet_parsers():
+    """Parser warnings off while these tests run (restored after: other tests read them)."""
+    logger = logging.getLogger("robotwright.parsers")
+    old = logger.level
+    logger.setLevel(logging.ERROR)
+    yield
+    logger.setLevel(old)
+
 
 TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"
 RSM = TESTDATA / "robosuite-models" / "robosuite_models" / "assets"

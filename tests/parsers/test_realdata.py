@@ -18,7 +18,17 @@ import pytest
 from robotwright.parsers.roundtrip import roundtrip
 
 pytestmark = pytest.mark.realdata
-logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
+
+
+@pytest.fixture(autouse=True)
+def _quiet_parsers():
+    """Parser warnings off while these tests run (restored after: other tests read them)."""
+    logger = logging.getLogger("robotwright.parsers")
+    old = logger.level
+    logger.setLevel(logging.ERROR)
+    yield
+    logger.setLevel(old)
+
 
 ERD = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data/robots"
 PURELIB = Path(sysconfig.get_paths()["purelib"])
