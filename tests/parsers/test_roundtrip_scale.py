@@ -131,3 +131,21 @@ def test_inertia_of_a_massless_link_is_compared() -> None:
     assert not _inertia_row(ref, _massless_model(None)).ok
     assert _inertia_row(ref, _massless_model("0.3 0.3 0.3")).ok
     assert _inertia_row(_massless_model(None), _massless_model(None)).ok
+
+
+@pytest.mark.parametrize("full", [True, False])
+def test_every_body_inertia_is_compared_on_both_legs(full: bool) -> None:
+    """The URDF leg (``full=False``) compares each body's inertia too: a link whose
+    inertia was lost (a massless moving link that carries inertia) fails the row."""
+    xml = """<mujoco><worldbody><body name="a"><joint type="hinge"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+      <body name="b" pos="0 0 0.2"><joint type="hinge"/>
+        <inertial pos="0 0 0" mass="{m}" diaginertia="{i} {i} {i}"/></body>
+    </body></worldbody></mujoco>"""
+    ref = mujoco.MjModel.from_xml_string(xml.format(m=1e-9, i=0.02))
+    lost = mujoco.MjModel.from_xml_string(xml.format(m=1e-9, i=1e-12))
+    same = compare_views(view_from_model(ref), view_from_model(ref), configs=2, full=full)
+    rows = compare_views(view_from_model(ref), view_from_model(lost), configs=2, full=full)
+    assert all(r.ok for r in same)
+    inertia = next(r for r in rows if r.check == "inertia tensors max rel.err")
+    assert not inertia.ok
