@@ -148,3 +148,39 @@ def test_roundtrip_names_sites_carried_as_urdf_links(tmp_path: Path, capsys) -> 
     (row,) = [r for r in report.rows if r.check == "URDF: bodies (ref/ours)"]
     assert row.value == "7/8" and row.ok and "1 site(s) as massless links: ['tool0']" in row.note
     assert len(report.passed()) < len(report.rows)  # the n/a rows are not counted
+
+
+def test_convert_reports_the_actuators_it_made(tmp_path, capsys) -> None:
+    """--actuators is reported: one line with the count, each actuator with -v; the
+    parsers' logger is left as it was."""
+    import logging
+
+    from robotwright.cli import main
+
+    links = "".join(
+        f'<link name="l{i}"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        for i in range(3)
+    )
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="7" velocity="2"/></joint>'
+        for i in (1, 2)
+    )
+    urdf = tmp_path / "two.urdf"
+    urdf.write_text(f'<robot name="two">{links}{joints}</robot>')
+    log = logging.getLogger("robotwright.parsers")
+    before = (log.level, log.propagate, list(log.handlers))
+    out = tmp_path / "two.xml"
+    assert main(["convert", str(urdf), "-o", str(out), "--actuators", "motor"]) == 0
+    err = capsys.readouterr().err
+    assert "2 actuator(s) made by --actuators (-v lists each)" in err
+    assert "made: " not in err
+    assert (
+        main(["convert", str(urdf), "-o", str(out), "--overwrite", "--actuators", "motor", "-v"])
+        == 0
+    )
+    err = capsys.readouterr().err
+    assert "motor actuator 'j1' on joint 'j1' ctrlrange=[-7, 7]" in err
+    assert "motor actuator 'j2'" in err
+    assert (log.level, log.propagate, list(log.handlers)) == before

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import functools
 import logging
+import sys
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -185,20 +186,47 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_roundtrip)
 
 
+class _InfoRecords(logging.Handler):
+    """Keeps the INFO records of the parsers (the actuators an option made)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.INFO)
+        self.lines: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.levelno == logging.INFO:
+            self.lines.append(record.getMessage())
+
+
 def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
-    """Run a command with the parsers' logger quiet (their warnings reach the user as the
-    command's notes), restoring its level after, so that a program calling ``main()``
-    keeps its own logging (and later log records are not lost)."""
+    """Run a command with the parsers' log kept from the console (their warnings reach the
+    user as the command's notes), restoring it after, so that a program calling
+    ``main()`` keeps its own logging. What an option made (``--actuators``) is reported
+    on stderr: one line, each with ``-v``."""
 
     @functools.wraps(func)
     def wrapper(args: argparse.Namespace) -> int:
         log = logging.getLogger("robotwright.parsers")
-        old = log.level
-        log.setLevel(logging.ERROR)
+        old_level, old_propagate = log.level, log.propagate
+        made = _InfoRecords()
+        log.setLevel(logging.INFO)
+        log.propagate = False
+        log.addHandler(made)
         try:
             return func(args)
         finally:
-            log.setLevel(old)
+            log.removeHandler(made)
+            log.setLevel(old_level)
+            log.propagate = old_propagate
+            if made.lines:
+                if getattr(args, "verbose", False):
+                    for line in made.lines:
+                        print(f"made: {line}", file=sys.stderr)
+                print(
+                    f"{len(made.lines)} actuator(s) made by --actuators"
+                    + ("" if getattr(args, "verbose", False) else " (-v lists each)"),
+                    file=sys.stderr,
+                )
 
     return wrapper
 

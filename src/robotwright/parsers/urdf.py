@@ -528,6 +528,7 @@ def _joint_record(
             peak_velocity=velocity if velocity > 0 else None,
             ctrl_range=(-effort, effort),
         )
+        acts.LOG.info("%s: %s", rep.file, acts.describe([actuator])[0])
     for tag in ("safety_controller", "calibration"):
         if j.find(tag) is not None:
             rep.warn(f"<{tag}> dropped (no HRDF equivalent)", where)
