@@ -168,6 +168,10 @@ def compare_views(
     )
 
     if not missing:
+        # Inertials are compared in the frame of the body that holds them, each model at
+        # its own zero configuration: the two may differ where a joint has a reference
+        # position (our URDF has none), while body frames agree (the FK row checks them).
+        ref_frames, our_frames0 = ref.fk({}), ours.fk({})
         # Group reference bodies by the body that holds them in ours (merged links).
         groups: dict[str, list[str]] = {}
         for b in ref.bodies:
@@ -188,6 +192,9 @@ def compare_views(
             )
             m_o = ours.mass[owner]
             c_o, i_o = ours.inertia_world[owner]
+            if owner in ref_frames and owner in our_frames0:
+                c_ref, i_ref = _in_frame(ref_frames[owner], c_ref, i_ref)
+                c_o, i_o = _in_frame(our_frames0[owner], c_o, i_o)
             worst_m = max(worst_m, _rel(m_ref, m_o))
             if m_ref > 0:
                 worst_c = max(worst_c, float(np.abs(c_ref - c_o).max()))
@@ -315,6 +322,14 @@ def compare_views(
         )
     )
     return rows
+
+
+def _in_frame(
+    frame: tuple[np.ndarray, np.ndarray], com: np.ndarray, inertia: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A centre of mass and an inertia tensor (world) in the frame ``(pos, rot)``."""
+    pos, rot = frame
+    return rot.T @ (com - pos), rot.T @ inertia @ rot
 
 
 def _geom_records(model: mujoco.MjModel, bodies: set[str], collision_only: bool) -> list:
