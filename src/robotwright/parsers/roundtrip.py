@@ -125,6 +125,56 @@ def _rel(a: float, b: float) -> float:
     return 0.0 if scale == 0 else abs(a - b) / scale
 
 
+def _compare_inertials(ref: RobotView, ours: RobotView, tol: float, label: str) -> list[Row]:
+    """Rows for the mass, inertia and centre of mass of every body of ``ref`` (bodies
+    merged into one of ours are combined first)."""
+    rows: list[Row] = []
+    # Inertials are compared in the frame of the body that holds them, each model at
+    # its own zero configuration: the two may differ where a joint has a reference
+    # position (our URDF has none), while body frames agree (the FK row checks them).
+    ref_frames, our_frames0 = ref.fk({}), ours.fk({})
+    # Group reference bodies by the body that holds them in ours (merged links).
+    groups: dict[str, list[str]] = {}
+    for b in ref.bodies:
+        owner = b if b in ours.mass else ours.site_body.get(b)
+        groups.setdefault(owner, []).append(b)
+    worst_m = worst_i = worst_c = 0.0
+    worst_i_body = ""
+    for owner, members in groups.items():
+        # Every part with mass or inertia: a massless link may carry inertia (MuJoCo
+        # keeps it), and dropping it must show here.
+        parts = [
+            (ref.mass[m], ref.inertia_world[m][0], ref.inertia_world[m][1])
+            for m in members
+            if ref.mass[m] > 0 or np.any(ref.inertia_world[m][1])
+        ]
+        m_ref, c_ref, i_ref = inr.combine(parts) if parts else (0.0, np.zeros(3), np.zeros((3, 3)))
+        m_o = ours.mass[owner]
+        c_o, i_o = ours.inertia_world[owner]
+        if owner in ref_frames and owner in our_frames0:
+            c_ref, i_ref = _in_frame(ref_frames[owner], c_ref, i_ref)
+            c_o, i_o = _in_frame(our_frames0[owner], c_o, i_o)
+        worst_m = max(worst_m, _rel(m_ref, m_o))
+        if m_ref > 0:
+            worst_c = max(worst_c, float(np.abs(c_ref - c_o).max()))
+        scale = max(np.abs(i_ref).max(), np.abs(i_o).max())
+        if scale > 0:
+            err = float(np.abs(i_ref - i_o).max() / scale)
+            if err > worst_i:
+                worst_i, worst_i_body = err, owner
+    rows.append(Row("body masses max rel.err" + label, f"{worst_m:.1e}", worst_m <= tol))
+    rows.append(
+        Row(
+            "inertia tensors max rel.err" + label,
+            f"{worst_i:.1e}",
+            worst_i <= tol,
+            f"worst: {worst_i_body}" if worst_i > tol else "",
+        )
+    )
+    rows.append(Row("centres of mass max err (m)" + label, f"{worst_c:.1e}", worst_c <= tol))
+    return rows
+
+
 def compare_views(
     ref: RobotView,
     ours: RobotView,
@@ -134,6 +184,7 @@ def compare_views(
     mimic: dict | None = None,
     full: bool = True,
     collision_only: bool = False,
+    inertials_ref: RobotView | None = None,
 ) -> list[Row]:
     """Rows comparing ``ours`` with ``ref``. ``full=False`` checks masses, inertias and
     centres of mass of every body and FK only (what a URDF can carry of an MJCF robot)."""
@@ -167,52 +218,13 @@ def compare_views(
         )
     )
 
-    if not missing:
-        # Inertials are compared in the frame of the body that holds them, each model at
-        # its own zero configuration: the two may differ where a joint has a reference
-        # position (our URDF has none), while body frames agree (the FK row checks them).
-        ref_frames, our_frames0 = ref.fk({}), ours.fk({})
-        # Group reference bodies by the body that holds them in ours (merged links).
-        groups: dict[str, list[str]] = {}
-        for b in ref.bodies:
-            owner = b if b in ours.mass else ours.site_body.get(b)
-            groups.setdefault(owner, []).append(b)
-        worst_m = worst_i = worst_c = 0.0
-        worst_i_body = ""
-        for owner, members in groups.items():
-            # Every part with mass or inertia: a massless link may carry inertia (MuJoCo
-            # keeps it), and dropping it must show here.
-            parts = [
-                (ref.mass[m], ref.inertia_world[m][0], ref.inertia_world[m][1])
-                for m in members
-                if ref.mass[m] > 0 or np.any(ref.inertia_world[m][1])
-            ]
-            m_ref, c_ref, i_ref = (
-                inr.combine(parts) if parts else (0.0, np.zeros(3), np.zeros((3, 3)))
-            )
-            m_o = ours.mass[owner]
-            c_o, i_o = ours.inertia_world[owner]
-            if owner in ref_frames and owner in our_frames0:
-                c_ref, i_ref = _in_frame(ref_frames[owner], c_ref, i_ref)
-                c_o, i_o = _in_frame(our_frames0[owner], c_o, i_o)
-            worst_m = max(worst_m, _rel(m_ref, m_o))
-            if m_ref > 0:
-                worst_c = max(worst_c, float(np.abs(c_ref - c_o).max()))
-            scale = max(np.abs(i_ref).max(), np.abs(i_o).max())
-            if scale > 0:
-                err = float(np.abs(i_ref - i_o).max() / scale)
-                if err > worst_i:
-                    worst_i, worst_i_body = err, owner
-        rows.append(Row("body masses max rel.err", f"{worst_m:.1e}", worst_m <= tol))
-        rows.append(
-            Row(
-                "inertia tensors max rel.err",
-                f"{worst_i:.1e}",
-                worst_i <= tol,
-                f"worst: {worst_i_body}" if worst_i > tol else "",
-            )
-        )
-        rows.append(Row("centres of mass max err (m)", f"{worst_c:.1e}", worst_c <= tol))
+    # The URDF leg compares inertials with our MJCF of the same HRDF (``inertials_ref``):
+    # its links merged by fixed joints keep their own (massless) link, which the
+    # source's bodies cannot be matched to one by one; the MJCF leg compares with the source.
+    iref = inertials_ref if inertials_ref is not None else ref
+    if all(b in our_frames for b in iref.bodies):
+        label = "" if inertials_ref is None else " (vs our MJCF)"
+        rows += _compare_inertials(iref, ours, tol, label)
 
     if full and not missing:
         ours_j = {j.name: j for j in ours.joints}
@@ -758,7 +770,10 @@ def _roundtrip(
                 )
             )
             return report
-        for r in compare_views(ref, ours_u, tol=TOL_URDF, configs=configs, mimic=mimic, full=False):
+        urdf_rows = compare_views(
+            ref, ours_u, tol=TOL_URDF, configs=configs, mimic=mimic, full=False, inertials_ref=ours
+        )
+        for r in urdf_rows:
             r.check = "URDF: " + r.check
             report.rows.append(r)
     return report
