@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import pytest
@@ -113,3 +114,14 @@ def arm_mjcf(tmp_path: Path) -> Path:
 def write_tet():
     """Writes a binary STL tetrahedron to the path given."""
     return _tet_stl
+
+
+@pytest.fixture
+def quiet_parsers():
+    """Parser warnings off while a test runs (restored after: other tests read them).
+    Real-robot tests use it: a corpus file may warn about hundreds of values."""
+    logger = logging.getLogger("robotwright.parsers")
+    old = logger.level
+    logger.setLevel(logging.ERROR)
+    yield
+    logger.setLevel(old)

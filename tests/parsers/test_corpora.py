@@ -17,7 +17,6 @@ The counts per corpus are in docs/parsers.md and the README.
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
 import mujoco
@@ -27,17 +26,7 @@ import pytest
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_from_model
 from robotwright.parsers.roundtrip import our_mjcf_model, parse_source, roundtrip
 
-pytestmark = pytest.mark.realdata
-
-
-@pytest.fixture(autouse=True)
-def _quiet_parsers():
-    """Parser warnings off while these tests run (restored after: other tests read them)."""
-    logger = logging.getLogger("robotwright.parsers")
-    old = logger.level
-    logger.setLevel(logging.ERROR)
-    yield
-    logger.setLevel(old)
+pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
 
 
 TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"

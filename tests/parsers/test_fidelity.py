@@ -7,7 +7,6 @@ data) and the ``test`` extra (example-robot-data); tests skip with a reason when
 
 from __future__ import annotations
 
-import logging
 import sysconfig
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -26,16 +25,7 @@ from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_fr
 from robotwright.parsers.roundtrip import our_mjcf_model, roundtrip
 from robotwright.parsers.xmlsafe import parse_xml
 
-
-@pytest.fixture(autouse=True)
-def _quiet_parsers():
-    """Parser warnings off while these tests run (restored after: other tests read them)."""
-    logger = logging.getLogger("robotwright.parsers")
-    old = logger.level
-    logger.setLevel(logging.ERROR)
-    yield
-    logger.setLevel(old)
-
+pytestmark = pytest.mark.usefixtures("quiet_parsers")
 
 TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"
 RSM = TESTDATA / "robosuite-models" / "robosuite_models" / "assets"

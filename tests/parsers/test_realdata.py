@@ -9,7 +9,6 @@ round-trip exactly are strict expected failures with the reason (docs/parsers.md
 
 from __future__ import annotations
 
-import logging
 import sysconfig
 from pathlib import Path
 
@@ -17,17 +16,7 @@ import pytest
 
 from robotwright.parsers.roundtrip import roundtrip
 
-pytestmark = pytest.mark.realdata
-
-
-@pytest.fixture(autouse=True)
-def _quiet_parsers():
-    """Parser warnings off while these tests run (restored after: other tests read them)."""
-    logger = logging.getLogger("robotwright.parsers")
-    old = logger.level
-    logger.setLevel(logging.ERROR)
-    yield
-    logger.setLevel(old)
+pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
 
 
 ERD = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data/robots"
