@@ -375,7 +375,9 @@ class _Reader:
     def unused_meshes(self, world: World) -> None:
         """Meshes no geom uses: MuJoCo still compiles them, so keep them as assets."""
         for sm in self.spec.meshes:
-            if sm.name in self.used_meshes:
+            # An unnamed file mesh is named after its file (MuJoCo 3.x leaves the spec's
+            # name empty while geoms refer to it by that name).
+            if (sm.name or Path(sm.file).stem) in self.used_meshes:
                 continue
             kw = self.mesh_asset(sm.name, f'<mesh name="{sm.name}">')
             kw.pop("mesh")
