@@ -115,7 +115,8 @@ class Material(BaseThing):
         super().__init__(name=name, parent=parent, **kwargs)
 
 
-_MESH_ATTR: dict[str, Any] = {
+#: The <mesh> asset's attributes (a Mesh geom writes the same, see geoms.py).
+MESH_ATTR: dict[str, Any] = {
     "file": Text(),
     "scale": Vector(3),
     "vertex": Vector(None, optional=True),
@@ -135,8 +136,8 @@ class MeshAsset(BaseThing):
 
     _TAG = "mesh"
     _ASSET_KIND = "mesh"
-    _NEW_MUJOCO_ATTR = _MESH_ATTR
-    _NEW_BLUEPRINTS_ATTR = _MESH_ATTR
+    _NEW_MUJOCO_ATTR = MESH_ATTR
+    _NEW_BLUEPRINTS_ATTR = MESH_ATTR
     _NEW_DEFAULT_VALS = {
         "file": None,
         "scale": np.ones(3),

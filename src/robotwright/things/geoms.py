@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from robotwright.things.assets import MESH_ATTR
 from robotwright.things.attrs import Choice, Integer, Real, Ref, Text, Vector
 from robotwright.things.base import BaseThing
 from robotwright.things.pose import POS, QUAT, PoseMixin
@@ -183,16 +184,11 @@ class Plane(Geom):
     type = "plane"
 
 
+# The <mesh> asset's attributes (as on a MeshAsset), plus the asset name; a geom calls
+# the asset's ``inertia`` ``meshinertia`` (a geom has no ``inertia`` of its own).
 _MESH_ASSET_ATTR: dict[str, Any] = {
     "mesh": Text(),
-    "file": Text(),
-    "scale": Vector(3),
-    "vertex": Vector(None, optional=True),
-    "face": Vector(None, optional=True, integer=True),
-    "maxhullvert": Integer(minimum=-1),
-    "meshinertia": Choice("convex", "exact", "legacy", "shell"),
-    "refpos": Vector(3),
-    "refquat": Vector(4, nonzero=True),
+    **{("meshinertia" if key == "inertia" else key): kind for key, kind in MESH_ATTR.items()},
 }
 
 
