@@ -224,17 +224,24 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
         yield fh
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`.
-    Folders it created are removed again when the write fails."""
+@contextmanager
+def _with_parents(path: Path) -> Iterator[None]:
+    """Create the folder of the file ``path`` for the block; the folders created are
+    removed again when the block fails."""
     check_output_path(path)
     created = _make_parents(path.parent)
     try:
-        with atomic_open(path, "w") as fh:
-            fh.write(text)
+        yield
     except BaseException:
         _remove_empty(created)
         raise
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`.
+    Folders it created are removed again when the write fails."""
+    with _with_parents(path), atomic_open(path, "w") as fh:
+        fh.write(text)
 
 
 def _copy(src: Path, tmp: Path, dst: Path) -> None:
@@ -255,14 +262,8 @@ def copy_file_atomic(src: Path, dst: Path) -> None:
     Only a regular file is copied: a FIFO or a device as ``src`` raises
     :class:`~robotwright.errors.InputFileError` before anything is read or written.
     """
-    check_output_path(dst)
-    created = _make_parents(dst.parent)
-    try:
-        with atomic_path(dst) as tmp:
-            _copy(src, tmp, dst)
-    except BaseException:
-        _remove_empty(created)
-        raise
+    with _with_parents(dst), atomic_path(dst) as tmp:
+        _copy(src, tmp, dst)
 
 
 class StagedFiles:
