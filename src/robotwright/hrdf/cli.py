@@ -91,8 +91,10 @@ def format_info(hrdf: HRDF) -> str:
     def limit(value: float | None, joint: str, per: str) -> str:
         if value is None:
             return "-"
-        slide = joint_types.get(joint) == "slide"
-        return f"{value:g} {('N' if slide else 'N m') if per == 'force' else unit(joint_types.get(joint)) + '/s'}"
+        j_type = joint_types.get(joint)
+        if per == "force":
+            return f"{value:g} {'N' if j_type == 'slide' else 'N m'}"
+        return f"{value:g} {unit(j_type)}/s"
 
     acts = [
         [
