@@ -211,6 +211,21 @@ def test_unknown_file_warns(synth_hrdf_dir: Path, tmp_path: Path) -> None:
         HRDF.from_dir(src)
 
 
+def test_hurodes_export_folder_is_ignored_quietly(synth_hrdf_dir: Path, tmp_path: Path) -> None:
+    """hurodes exports a robot into ``<folder>/exported/`` by default: not robot data,
+    and no warning on every load."""
+    import warnings
+
+    src = tmp_path / "r"
+    shutil.copytree(synth_hrdf_dir, src)
+    (src / "exported").mkdir()
+    (src / "exported" / "robot.xml").write_text("<mujoco/>")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", HRDFWarning)
+        loaded = HRDF.from_dir(src)
+    assert loaded.bodies == HRDF.from_dir(synth_hrdf_dir).bodies
+
+
 def test_schemas_cover_every_record_field() -> None:
     # The reader builds records from schema rows without calling __init__.
     import dataclasses

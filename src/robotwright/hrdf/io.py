@@ -88,9 +88,12 @@ HURODES_META_KEYS: tuple[str, ...] = (
 EXTENSION_META_KEYS: tuple[str, ...] = ("format_version", "floating_base", "base_joint_name")
 EXTRA_MJCF_FILE = "extra.xml"
 JOINT_MAPPING_FILE = "joint_mapping.yaml"
+#: Where hurodes' generators export a robot by default (``<folder>/exported/robot.xml``):
+#: its own output, not robot data, so it is ignored without a warning.
+HURODES_EXPORT_DIR = "exported"
 _KNOWN_FILES = frozenset(
     {f"{stem}.csv" for stem in TABLES}
-    | {"meta.yaml", "meshes", EXTRA_MJCF_FILE, JOINT_MAPPING_FILE}
+    | {"meta.yaml", "meshes", EXTRA_MJCF_FILE, JOINT_MAPPING_FILE, HURODES_EXPORT_DIR}
 )
 
 
