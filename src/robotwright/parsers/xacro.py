@@ -35,7 +35,7 @@ from typing import Any
 import defusedxml
 import defusedxml.ElementTree as DET
 
-from robotwright._inputs import MAX_XML_BYTES, MAX_YAML_BYTES, read_bytes
+from robotwright._inputs import MAX_XML_BYTES, MAX_YAML_BYTES, decode, read_bytes
 from robotwright._paths import resolve_inside, trusted_roots
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.parsers.packages import find_package, robot_root
@@ -315,9 +315,9 @@ class _Guard:
             except ET.ParseError as exc:
                 raise _Refused(f"{path}: not well-formed XML: {exc}") from None
         try:
-            return io.StringIO(data.decode("utf-8"))
-        except UnicodeDecodeError:
-            raise _Refused(f"{path}: not UTF-8 text") from None
+            return io.StringIO(decode(data, path))
+        except InputFileError as exc:
+            raise _Refused(str(exc)) from None
 
 
 @contextlib.contextmanager
