@@ -15,6 +15,8 @@ import mujoco
 import numpy as np
 import trimesh
 
+from robotwright.view.geometry import hfield_surface
+
 __all__ = ["SceneTriangles", "scene_triangles"]
 
 _G = mujoco.mjtGeom
@@ -81,24 +83,6 @@ def _grid(nx: int, ny: int, hx: float, hy: float) -> tuple[np.ndarray, np.ndarra
     return verts, faces
 
 
-def _hfield(model: mujoco.MjModel, hid: int) -> tuple[np.ndarray, np.ndarray]:
-    """Top surface of height field ``hid`` in its geom frame (MuJoCo's layout: rows
-    along y, columns along x, elevation scaled by ``size[2]``)."""
-    nrow, ncol = int(model.hfield_nrow[hid]), int(model.hfield_ncol[hid])
-    rx, ry, top, _ = model.hfield_size[hid]
-    adr = int(model.hfield_adr[hid])
-    z = model.hfield_data[adr : adr + nrow * ncol].reshape(nrow, ncol) * top
-    xs, ys = np.linspace(-rx, rx, ncol), np.linspace(-ry, ry, nrow)
-    gx, gy = np.meshgrid(xs, ys)  # (nrow, ncol)
-    verts = np.stack([gx.ravel(), gy.ravel(), z.ravel()], axis=1)
-    r, c = np.meshgrid(np.arange(nrow - 1), np.arange(ncol - 1), indexing="ij")
-    a = (r * ncol + c).ravel()
-    faces = np.concatenate(
-        [np.stack([a, a + 1, a + ncol + 1], 1), np.stack([a, a + ncol + 1, a + ncol], 1)]
-    )
-    return verts, faces
-
-
 def _plane_extent(size: np.ndarray, reach: float) -> tuple[float, float]:
     """Half sizes of a plane; MuJoCo draws a zero half size as infinite, which we
     draw out to ``reach`` [m]."""
@@ -138,7 +122,7 @@ def _local_mesh(
             False,
         )
     if t == _G.mjGEOM_HFIELD and is_geom:
-        return (*_hfield(model, int(model.geom_dataid[geom.objid])), False)
+        return (*hfield_surface(model, int(model.geom_dataid[geom.objid])), False)
     return f"{_describe(model, geom)} (type {_type_name(t)})"
 
 

@@ -139,7 +139,7 @@ def _mesh(model: mujoco.MjModel, mesh_id: int) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
-def _hfield(model: mujoco.MjModel, hid: int) -> tuple[np.ndarray, np.ndarray]:
+def hfield_surface(model: mujoco.MjModel, hid: int) -> tuple[np.ndarray, np.ndarray]:
     """The top surface of a height field: ``size`` = (x half, y half, top, bottom) [m];
     MuJoCo's rows run along y from -y to +y, columns along x."""
     nrow, ncol = int(model.hfield_nrow[hid]), int(model.hfield_ncol[hid])
@@ -179,7 +179,7 @@ def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> l
         if gtype == G.mjGEOM_MESH:
             shape = _mesh(model, int(model.geom_dataid[g]))
         elif gtype == G.mjGEOM_HFIELD:
-            shape = _hfield(model, int(model.geom_dataid[g]))
+            shape = hfield_surface(model, int(model.geom_dataid[g]))
         else:
             shape = _primitive(model, gtype, np.asarray(model.geom_size[g], dtype=np.float64))
         if shape is None:
