@@ -9,7 +9,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from robotwright.view.geometry import body_poses, geom_rgba, geom_shapes, site_frames
+from robotwright.view.geometry import (
+    body_poses,
+    geom_rgba,
+    geom_shapes,
+    primitive_mesh,
+    site_frames,
+)
 
 PRIMITIVES = """
 <mujoco>
@@ -193,3 +199,78 @@ def test_textures_are_named_as_not_drawn() -> None:
     assert len(shapes) == 2  # drawn, in the material's colour
     np.testing.assert_allclose(shapes[0].rgba, [0.2, 0.4, 0.6, 1.0], atol=1e-6)
     assert skipped == ["geom 'tiled': texture not drawn, only its colour"]
+
+
+G = mujoco.mjtGeom
+
+
+def _signed_volume(v: np.ndarray, f: np.ndarray) -> float:
+    """Volume enclosed by triangles (divergence theorem): positive when they face out."""
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+@pytest.mark.parametrize(
+    ("gtype", "size", "half_extent", "volume"),
+    [
+        (G.mjGEOM_SPHERE, [0.07], [0.07, 0.07, 0.07], 4 / 3 * np.pi * 0.07**3),
+        (
+            G.mjGEOM_ELLIPSOID,
+            [0.03, 0.05, 0.08],
+            [0.03, 0.05, 0.08],
+            4 / 3 * np.pi * 0.03 * 0.05 * 0.08,
+        ),
+        (G.mjGEOM_BOX, [0.1, 0.2, 0.3], [0.1, 0.2, 0.3], 8 * 0.1 * 0.2 * 0.3),
+        (G.mjGEOM_CYLINDER, [0.05, 0.1], [0.05, 0.05, 0.1], np.pi * 0.05**2 * 0.2),
+        (
+            G.mjGEOM_CAPSULE,
+            [0.04, 0.12],
+            [0.04, 0.04, 0.12 + 0.04],
+            np.pi * 0.04**2 * 0.24 + 4 / 3 * np.pi * 0.04**3,
+        ),
+    ],
+)
+def test_primitive_mesh_spans_the_geom_size(gtype, size, half_extent, volume) -> None:
+    """Each closed primitive spans exactly its MuJoCo size (a box 2 x half sizes, a
+    capsule 2 x (half length + radius) along z), faces outwards, and encloses about
+    the shape's volume (tessellation loses at most 3 %)."""
+    v, f = primitive_mesh(gtype, size, plane_extent=50.0)
+    assert v.dtype == np.float64 and f.shape[1] == 3 and f.max() < len(v)
+    np.testing.assert_allclose(v.max(axis=0), half_extent, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(v.min(axis=0), -np.asarray(half_extent), rtol=0, atol=1e-12)
+    assert 0.97 * volume <= _signed_volume(v, f) <= volume * (1 + 1e-12)
+    if gtype == G.mjGEOM_SPHERE:
+        np.testing.assert_allclose(np.linalg.norm(v, axis=1), 0.07, rtol=0, atol=1e-12)
+    if gtype == G.mjGEOM_ELLIPSOID:
+        np.testing.assert_allclose(np.linalg.norm(v / size, axis=1), 1.0, atol=1e-12)
+    if gtype in (G.mjGEOM_CYLINDER, G.mjGEOM_CAPSULE):
+        assert np.linalg.norm(v[:, :2], axis=1).max() == pytest.approx(size[0], abs=1e-12)
+    v32, f32 = primitive_mesh(gtype, size, plane_extent=50.0, dtype=np.float32)
+    assert v32.dtype == np.float32 and np.array_equal(f32, f)
+    np.testing.assert_allclose(v32, v, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("size", "cells", "half"),
+    [
+        ([2.0, 3.0, 0.1], 1, [2.0, 3.0]),
+        ([0.0, 0.0, 0.1], 24, [50.0, 50.0]),
+        ([0.0, 0.5, 0.1], 3, [50.0, 0.5]),
+    ],
+)
+def test_primitive_mesh_plane(size, cells, half) -> None:
+    """A plane spans its half sizes; a side of size 0 (infinite in MuJoCo) reaches the
+    extent given; it is ``cells`` x ``cells`` squares at z = 0 facing +z."""
+    v, f = primitive_mesh(G.mjGEOM_PLANE, size, plane_extent=50.0, plane_cells=cells)
+    np.testing.assert_array_equal(v.max(axis=0), [*half, 0.0])
+    np.testing.assert_array_equal(v.min(axis=0), [-half[0], -half[1], 0.0])
+    assert len(f) == 2 * cells * cells and len(v) == (cells + 1) ** 2
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    normal_z = np.cross(b - a, c - a)[:, 2]
+    np.testing.assert_allclose(normal_z.sum() / 2, 4 * half[0] * half[1])
+    assert (normal_z > 0).all()
+
+
+def test_primitive_mesh_is_none_for_meshes_and_height_fields() -> None:
+    for gtype in (G.mjGEOM_MESH, G.mjGEOM_HFIELD, G.mjGEOM_SDF):
+        assert primitive_mesh(gtype, [0.1, 0.1, 0.1], plane_extent=1.0) is None

@@ -2,20 +2,19 @@
 
 MuJoCo's own :func:`mujoco.mjv_updateScene` decides what is visible (geom and site
 groups, materials, colours, poses); this module only turns each visible ``mjvGeom``
-into world-frame triangles: primitives are tessellated with ``trimesh.creation``,
-meshes and height fields come from the compiled model's arrays.
+into world-frame triangles: primitives come from
+:func:`robotwright.view.geometry.primitive_mesh` (the browser viewer's shapes too), meshes
+and height fields from the compiled model's arrays.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import mujoco
 import numpy as np
-import trimesh
 
-from robotwright.view.geometry import hfield_surface
+from robotwright.view.geometry import hfield_surface, primitive_mesh
 
 __all__ = ["SceneTriangles", "scene_triangles"]
 
@@ -47,70 +46,19 @@ class SceneTriangles:
     skipped: list[str] = field(default_factory=list)
 
 
-@lru_cache(maxsize=16)
-def _unit_sphere() -> tuple[np.ndarray, np.ndarray]:
-    m = trimesh.creation.icosphere(subdivisions=3)
-    return np.asarray(m.vertices), np.asarray(m.faces)
-
-
-@lru_cache(maxsize=64)
-def _cylinder(radius: float, half: float) -> tuple[np.ndarray, np.ndarray]:
-    m = trimesh.creation.cylinder(radius=radius, height=2 * half, sections=32)
-    return np.asarray(m.vertices), np.asarray(m.faces)
-
-
-@lru_cache(maxsize=64)
-def _capsule(radius: float, half: float) -> tuple[np.ndarray, np.ndarray]:
-    m = trimesh.creation.capsule(height=2 * half, radius=radius, count=[24, 24])
-    return np.asarray(m.vertices), np.asarray(m.faces)
-
-
-@lru_cache(maxsize=1)
-def _unit_box() -> tuple[np.ndarray, np.ndarray]:
-    m = trimesh.creation.box(extents=(2.0, 2.0, 2.0))
-    return np.asarray(m.vertices), np.asarray(m.faces)
-
-
-def _grid(nx: int, ny: int, hx: float, hy: float) -> tuple[np.ndarray, np.ndarray]:
-    """A flat ``nx`` x ``ny`` cell grid over ``[-hx, hx] x [-hy, hy]`` at z = 0."""
-    xs, ys = np.linspace(-hx, hx, nx + 1), np.linspace(-hy, hy, ny + 1)
-    gx, gy = np.meshgrid(xs, ys, indexing="ij")
-    verts = np.stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)], axis=1)
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    a = (i * (ny + 1) + j).ravel()
-    b, c, d = a + (ny + 1), a + (ny + 1) + 1, a + 1
-    faces = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
-    return verts, faces
-
-
-def _plane_extent(size: np.ndarray, reach: float) -> tuple[float, float]:
-    """Half sizes of a plane; MuJoCo draws a zero half size as infinite, which we
-    draw out to ``reach`` [m]."""
-    return (float(size[0]) or reach, float(size[1]) or reach)
-
-
 def _local_mesh(
     model: mujoco.MjModel, geom: mujoco.MjvGeom, reach: float
 ) -> tuple[np.ndarray, np.ndarray, bool] | str:
     """Vertices and faces of one scene geom in its own frame, whether it is a plane;
     or a description of why it is not drawn."""
     t, size = int(geom.type), np.asarray(geom.size, dtype=np.float64)
-    if t == _G.mjGEOM_SPHERE:
-        v, f = _unit_sphere()
-        return v * size[0], f, False
-    if t == _G.mjGEOM_ELLIPSOID:
-        v, f = _unit_sphere()
-        return v * size, f, False
-    if t == _G.mjGEOM_BOX:
-        v, f = _unit_box()
-        return v * size, f, False
-    if t == _G.mjGEOM_CYLINDER:
-        return (*_cylinder(round(float(size[0]), 9), round(float(size[2]), 9)), False)
-    if t == _G.mjGEOM_CAPSULE:
-        return (*_capsule(round(float(size[0]), 9), round(float(size[2]), 9)), False)
-    if t == _G.mjGEOM_PLANE:
-        hx, hy = _plane_extent(size, reach)
-        return (*_grid(_PLANE_CELLS, _PLANE_CELLS, hx, hy), True)
+    if t in (_G.mjGEOM_CYLINDER, _G.mjGEOM_CAPSULE):
+        # The scene holds (radius, radius, half length) as float32; drawn at MuJoCo's
+        # geom size (radius, half length) rounded to 1e-9 m.
+        size = np.array([round(float(size[0]), 9), round(float(size[2]), 9)])
+    shape = primitive_mesh(t, size, plane_extent=reach, plane_cells=_PLANE_CELLS)
+    if shape is not None:
+        return (*shape, t == _G.mjGEOM_PLANE)
     is_geom = int(geom.objtype) == mujoco.mjtObj.mjOBJ_GEOM and geom.objid >= 0
     if t == _G.mjGEOM_MESH and is_geom:
         mid = int(model.geom_dataid[geom.objid])

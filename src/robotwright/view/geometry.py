@@ -16,6 +16,7 @@ from functools import lru_cache
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
 __all__ = [
     "DEFAULT_GEOM_GROUPS",
@@ -24,6 +25,8 @@ __all__ = [
     "body_poses",
     "geom_rgba",
     "geom_shapes",
+    "hfield_surface",
+    "primitive_mesh",
     "site_frames",
 ]
 
@@ -87,46 +90,96 @@ def _name(model: mujoco.MjModel, kind: mujoco.mjtObj, idx: int, label: str) -> s
     return mujoco.mj_id2name(model, kind, idx) or f"{label} {idx}"
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=4)
 def _unit(kind: str) -> tuple[np.ndarray, np.ndarray]:
     """Unit primitives, tessellated once: sphere of radius 1, cylinder of radius 1 and
-    height 2 (along z, centred)."""
+    height 2 (along z, centred), box of half size 1."""
     import trimesh
 
     if kind == "sphere":
         mesh = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
-    else:
+    elif kind == "cylinder":
         mesh = trimesh.creation.cylinder(radius=1.0, height=2.0, sections=32)
-    return np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.int32)
+    else:
+        mesh = trimesh.creation.box(extents=(2.0, 2.0, 2.0))
+    return _frozen(mesh.vertices, mesh.faces)
 
 
-def _primitive(
-    model: mujoco.MjModel, gtype: int, size: np.ndarray
-) -> tuple[np.ndarray, np.ndarray] | None:
+@lru_cache(maxsize=256)
+def _capsule(radius: float, half: float) -> tuple[np.ndarray, np.ndarray]:
+    """A capsule along z (its end caps are not a scaled unit shape): one per size."""
     import trimesh
 
+    mesh = trimesh.creation.capsule(height=2.0 * half, radius=radius, count=[24, 24])
+    return _frozen(mesh.vertices, mesh.faces)
+
+
+def _frozen(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Read-only float64 copies of a cached mesh (callers share them)."""
+    v, f = np.array(vertices, dtype=np.float64), np.array(faces)
+    v.flags.writeable = f.flags.writeable = False
+    return v, f
+
+
+def _grid(nx: int, ny: int, hx: float, hy: float) -> tuple[np.ndarray, np.ndarray]:
+    """A flat ``nx`` x ``ny`` cell grid over ``[-hx, hx] x [-hy, hy]`` at z = 0."""
+    xs, ys = np.linspace(-hx, hx, nx + 1), np.linspace(-hy, hy, ny + 1)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    verts = np.stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)], axis=1)
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    a = (i * (ny + 1) + j).ravel()
+    b, c, d = a + (ny + 1), a + (ny + 1) + 1, a + 1
+    faces = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    return verts, faces
+
+
+def primitive_mesh(
+    gtype: int,
+    size: ArrayLike,
+    *,
+    plane_extent: float,
+    plane_cells: int = 1,
+    dtype: DTypeLike = np.float64,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The triangles of a MuJoCo primitive geom in the geom's own frame.
+
+    Args:
+        gtype: the geom type (``mujoco.mjtGeom``).
+        size: MuJoCo's geom size [m] (``geom_size``): sphere (radius), capsule and
+            cylinder (radius, half length along z), ellipsoid radii and box half sizes
+            (x, y, z), plane half sizes (x, y).
+        plane_extent: half size [m] drawn for a plane side of size 0 (or less), which
+            MuJoCo draws as infinite.
+        plane_cells: cells per side of a plane (two triangles each).
+        dtype: type of the vertices; a sphere, ellipsoid, box or cylinder is a unit
+            shape scaled in this type.
+
+    Returns:
+        ``(vertices, faces)``: ``(V, 3)`` vertices [m] and ``(F, 3)`` vertex indices of
+        the triangles (counter-clockwise seen from outside, a plane's facing +z); None
+        for a type that is not a primitive (mesh, height field, SDF).
+    """
     G = mujoco.mjtGeom
-    if gtype == G.mjGEOM_BOX:
-        mesh = trimesh.creation.box(extents=2.0 * size)
-        return np.asarray(mesh.vertices, np.float32), np.asarray(mesh.faces, np.int32)
-    if gtype in (G.mjGEOM_SPHERE, G.mjGEOM_ELLIPSOID):
-        v, f = _unit("sphere")
-        radii = np.full(3, size[0]) if gtype == G.mjGEOM_SPHERE else size[:3]
-        return v * radii.astype(np.float32), f
-    if gtype == G.mjGEOM_CYLINDER:
-        v, f = _unit("cylinder")
-        return v * np.array([size[0], size[0], size[1]], np.float32), f
+    size = np.asarray(size, dtype=np.float64)
+    if gtype in (G.mjGEOM_SPHERE, G.mjGEOM_ELLIPSOID, G.mjGEOM_BOX, G.mjGEOM_CYLINDER):
+        if gtype == G.mjGEOM_SPHERE:
+            kind, scale = "sphere", np.full(3, size[0])
+        elif gtype == G.mjGEOM_ELLIPSOID:
+            kind, scale = "sphere", size[:3]
+        elif gtype == G.mjGEOM_BOX:
+            kind, scale = "box", size[:3]
+        else:
+            kind, scale = "cylinder", size[[0, 0, 1]]
+        v, f = _unit(kind)
+        return v.astype(dtype) * scale.astype(dtype), f
     if gtype == G.mjGEOM_CAPSULE:
-        mesh = trimesh.creation.capsule(height=2.0 * size[1], radius=size[0], count=[24, 24])
-        return np.asarray(mesh.vertices, np.float32), np.asarray(mesh.faces, np.int32)
+        v, f = _capsule(float(size[0]), float(size[1]))
+        return v.astype(dtype), f
     if gtype == G.mjGEOM_PLANE:
-        # A plane of size 0 is infinite in MuJoCo; drawn as a square 10 times the model's
-        # extent (MuJoCo's own renderer also draws a finite patch).
-        far = 10.0 * max(float(model.stat.extent), 1.0)
-        hx = size[0] if size[0] > 0 else far
-        hy = size[1] if size[1] > 0 else far
-        v = np.array([[-hx, -hy, 0], [hx, -hy, 0], [hx, hy, 0], [-hx, hy, 0]], np.float32)
-        return v, np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+        hx = float(size[0]) if size[0] > 0 else plane_extent
+        hy = float(size[1]) if size[1] > 0 else plane_extent
+        v, f = _grid(plane_cells, plane_cells, hx, hy)
+        return v.astype(dtype), f
     return None
 
 
@@ -167,6 +220,9 @@ def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> l
     appended to it.
     """
     G = mujoco.mjtGeom
+    # A plane of size 0 is infinite in MuJoCo; drawn as a square 10 times the model's
+    # extent (MuJoCo's own renderer also draws a finite patch).
+    far = 10.0 * max(float(model.stat.extent), 1.0)
     out: list[GeomShape] = []
     for g in range(model.ngeom):
         name = _name(model, mujoco.mjtObj.mjOBJ_GEOM, g, "geom")
@@ -181,7 +237,9 @@ def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> l
         elif gtype == G.mjGEOM_HFIELD:
             shape = hfield_surface(model, int(model.geom_dataid[g]))
         else:
-            shape = _primitive(model, gtype, np.asarray(model.geom_size[g], dtype=np.float64))
+            shape = primitive_mesh(gtype, model.geom_size[g], plane_extent=far, dtype=np.float32)
+            if shape is not None:
+                shape = (shape[0], shape[1].astype(np.int32))
         if shape is None:
             if skipped is not None:
                 skipped.append(f"geom '{name}': type {G(gtype).name} is not drawn")
