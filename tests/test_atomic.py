@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import errno
+import os
 from pathlib import Path
 
 import pytest
 
+import robotwright._atomic as atomic_module
+import robotwright._inputs as inputs
 from robotwright._atomic import (
     atomic_dir,
+    atomic_files,
     atomic_open,
     atomic_path,
     check_output_path,
@@ -111,3 +116,54 @@ def test_output_in_a_missing_folder_is_an_error_for_atomic_path(tmp_path):
         pass
     assert isinstance(OutputPathError("x"), RobotwrightError)
     assert isinstance(OutputPathError("x"), OSError)
+
+
+def _full_disk(*args: object) -> None:
+    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def test_a_full_disk_names_the_output_and_the_copied_source(tmp_path: Path, monkeypatch) -> None:
+    src = tmp_path / "src.bin"
+    src.write_bytes(b"mesh")
+    monkeypatch.setattr(inputs, "copy_regular_file", _full_disk)
+    dst = tmp_path / "out" / "dst.bin"
+    full = f"{dst}: cannot write it: No space left on device (copying {src})"
+    with pytest.raises(OutputPathError) as info:
+        copy_file_atomic(src, dst)
+    assert str(info.value) == full and info.value.__cause__.errno == errno.ENOSPC
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["src.bin"]  # no folder "out" left
+    with pytest.raises(OutputPathError) as info, atomic_files(tmp_path / "out") as staged:
+        staged.copy(src, "dst.bin")
+    assert str(info.value) == full
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["src.bin"]
+
+
+def test_other_errors_of_a_write_pass_unchanged(tmp_path: Path, monkeypatch) -> None:
+    """Only errors of the output side (no space, quota, read-only) become OutputPathError."""
+
+    def denied(*args: object) -> None:
+        raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+
+    monkeypatch.setattr(os, "replace", denied)
+    with pytest.raises(PermissionError) as info:
+        write_text_atomic(tmp_path / "sub" / "a.txt", "x")
+    assert not isinstance(info.value, OutputPathError)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_output_path_is_checked_once_per_write(tmp_path: Path, monkeypatch) -> None:
+    checked: list[Path] = []
+    real = atomic_module.check_output_path
+
+    def check(path, **kwargs) -> None:
+        checked.append(Path(path))
+        real(path, **kwargs)
+
+    monkeypatch.setattr(atomic_module, "check_output_path", check)
+    src = tmp_path / "src.bin"
+    src.write_bytes(b"mesh")
+    write_text_atomic(tmp_path / "a" / "t.txt", "x")
+    copy_file_atomic(src, tmp_path / "b" / "c.bin")
+    with atomic_path(tmp_path / "p.bin") as tmp:
+        tmp.write_bytes(b"1")
+    assert checked == [tmp_path / "a" / "t.txt", tmp_path / "b" / "c.bin", tmp_path / "p.bin"]

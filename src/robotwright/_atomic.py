@@ -27,7 +27,7 @@ import re
 import shutil
 import tempfile
 from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import AbstractContextManager, contextmanager, suppress
 from pathlib import Path
 from typing import IO, Any
 
@@ -71,12 +71,21 @@ def check_output_path(path: str | os.PathLike[str], *, folder: bool = False) -> 
             break
 
 
-def write_error(path: str | os.PathLike[str], exc: OSError) -> OSError:
-    """``exc`` as an :class:`OutputPathError` naming ``path`` when it is an error of the
-    output side (:data:`WRITE_ERRNOS`), else ``exc`` itself."""
-    if isinstance(exc, OutputPathError) or exc.errno not in WRITE_ERRNOS:
-        return exc
-    return OutputPathError(f"{path}: cannot write it: {exc.strerror or exc}")
+@contextmanager
+def _naming_output(
+    path: str | os.PathLike[str], *, source: str | os.PathLike[str] | None = None
+) -> Iterator[None]:
+    """Raise an error of the output side (:data:`WRITE_ERRNOS`: no space, no quota, too
+    big, read-only) from the block as an :class:`OutputPathError` naming ``path`` (and
+    ``source`` for a copy); other errors, and an :class:`OutputPathError`, pass as they
+    are."""
+    try:
+        yield
+    except OSError as exc:
+        if isinstance(exc, OutputPathError) or exc.errno not in WRITE_ERRNOS:
+            raise
+        copying = f" (copying {source})" if source is not None else ""
+        raise OutputPathError(f"{path}: cannot write it: {exc.strerror or exc}{copying}") from exc
 
 
 def _umask() -> int:
@@ -175,7 +184,6 @@ def _remove_empty(folders: list[Path]) -> None:
 
 
 def _mkstemp(path: Path) -> str:
-    check_output_path(path)
     remove_stale_temporaries(path.parent, path.name)
     try:
         fd, tmp = tempfile.mkstemp(prefix=_prefix(path.name), suffix=".tmp", dir=path.parent)
@@ -190,7 +198,28 @@ def _mkstemp(path: Path) -> str:
 
 
 @contextmanager
-def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+def _new_file(path: str | os.PathLike[str], *, make_parents: bool = False) -> Iterator[Path]:
+    """:func:`atomic_path`; with ``make_parents`` the folder of ``path`` is created first
+    (and the folders created are removed again when the block fails)."""
+    path = Path(path)
+    check_output_path(path)
+    created = _make_parents(path.parent) if make_parents else []
+    try:
+        with _naming_output(path):
+            tmp = _mkstemp(path)
+            try:
+                yield Path(tmp)
+                os.replace(tmp, path)
+            except BaseException:
+                if os.path.exists(tmp):
+                    os.unlink(tmp)
+                raise
+    except BaseException:
+        _remove_empty(created)
+        raise
+
+
+def atomic_path(path: str | os.PathLike[str]) -> AbstractContextManager[Path]:
     """Yield an empty temporary file next to ``path``; on success rename it onto ``path``.
 
     The caller writes the temporary by name (for writers that only take a path).
@@ -198,19 +227,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     disk raises :class:`OutputPathError` naming ``path``. The folder of ``path`` must
     exist.
     """
-    path = Path(path)
-    tmp = _mkstemp(path)
-    try:
-        yield Path(tmp)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            err = write_error(path, exc)
-            if err is not exc:
-                raise err from exc
-        raise
+    return _new_file(path)
 
 
 @contextmanager
@@ -224,36 +241,18 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
         yield fh
 
 
-@contextmanager
-def _with_parents(path: Path) -> Iterator[None]:
-    """Create the folder of the file ``path`` for the block; the folders created are
-    removed again when the block fails."""
-    check_output_path(path)
-    created = _make_parents(path.parent)
-    try:
-        yield
-    except BaseException:
-        _remove_empty(created)
-        raise
-
-
 def write_text_atomic(path: Path, text: str) -> None:
     """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`.
     Folders it created are removed again when the write fails."""
-    with _with_parents(path), atomic_open(path, "w") as fh:
+    with _new_file(path, make_parents=True) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         fh.write(text)
 
 
 def _copy(src: Path, tmp: Path, dst: Path) -> None:
     from robotwright._inputs import copy_regular_file
 
-    try:
+    with _naming_output(dst, source=src):
         copy_regular_file(src, tmp)
-    except OSError as exc:
-        err = write_error(dst, exc)
-        if err is not exc:
-            raise OutputPathError(f"{err} (copying {src})") from exc
-        raise
 
 
 def copy_file_atomic(src: Path, dst: Path) -> None:
@@ -262,7 +261,7 @@ def copy_file_atomic(src: Path, dst: Path) -> None:
     Only a regular file is copied: a FIFO or a device as ``src`` raises
     :class:`~robotwright.errors.InputFileError` before anything is read or written.
     """
-    with _with_parents(dst), atomic_path(dst) as tmp:
+    with _new_file(dst, make_parents=True) as tmp:
         _copy(src, tmp, dst)
 
 
@@ -290,13 +289,8 @@ class StagedFiles:
     def write_text(self, rel: str | os.PathLike[str], text: str) -> None:
         """Stage ``text`` (UTF-8) as ``out_dir/rel``."""
         staged = self.path(rel)
-        try:
+        with _naming_output(self.out_dir / rel):
             staged.write_text(text, encoding="utf-8")
-        except OSError as exc:
-            err = write_error(self.out_dir / rel, exc)
-            if err is not exc:
-                raise err from exc
-            raise
 
     def copy(self, src: Path, rel: str | os.PathLike[str]) -> None:
         """Stage a copy of the regular file ``src`` as ``out_dir/rel``."""
@@ -366,24 +360,21 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
             f"{target}: cannot create a folder in {target.parent}: {exc.strerror or exc}"
         ) from exc
     try:
-        yield tmp
-        if target.exists() or target.is_symlink():
-            # Move the old one aside first: os.replace cannot overwrite a non-empty folder.
-            # (Killed between the two renames, the next atomic_dir puts it back.)
-            old = Path(tempfile.mkdtemp(prefix=_prefix(target.name), dir=target.parent))
-            os.replace(target, old / "x")
-            os.replace(tmp, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, target)
+        with _naming_output(target):
+            yield tmp
+            if target.exists() or target.is_symlink():
+                # Move the old one aside first: os.replace cannot overwrite a non-empty
+                # folder. (Killed between the two renames, the next atomic_dir puts it back.)
+                old = Path(tempfile.mkdtemp(prefix=_prefix(target.name), dir=target.parent))
+                os.replace(target, old / "x")
+                os.replace(tmp, target)
+                shutil.rmtree(old, ignore_errors=True)
+            else:
+                os.replace(tmp, target)
     except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
         _remove_empty(created)
         if isinstance(exc, OutputPathError) and str(tmp) in str(exc):
             # A file inside the folder failed: name it where the user will look for it.
             raise OutputPathError(str(exc).replace(str(tmp), str(target))) from exc
-        if isinstance(exc, OSError):
-            err = write_error(target, exc)
-            if err is not exc:
-                raise err from exc
         raise
