@@ -47,6 +47,49 @@ def test_a_tree_of_many_links_round_trips(tmp_path: Path) -> None:
     assert rows["MJCF: collision geoms (type, size, pose at q0)"].value.startswith("600/600")
 
 
+def test_a_chain_too_deep_for_mjcf_is_answered_before_the_reference(tmp_path: Path) -> None:
+    """A chain of 600 links: MuJoCo imports the URDF, but MJCF cannot nest it. The answer
+    names the body too deep, and no reference was loaded for it (MuJoCo's import of a
+    deeper chain takes far longer than this answer)."""
+    path = tmp_path / "chain.urdf"
+    path.write_text(tree_urdf(600, branching=1))
+    report = roundtrip(path, configs=2)
+    assert not report.ok
+    assert report.error is not None and report.error.startswith("our MJCF is not written")
+    assert "'l496' is nested 497 bodies deep" in report.error
+    assert report.reference == "" and not report.rows
+
+
+def test_the_round_trip_legs_agree_with_one_at_a_time(tmp_path: Path) -> None:
+    """The three MuJoCo imports run at once; each leg's table equals the one computed
+    alone (the source's view, our MJCF's, our URDF's)."""
+    from robotwright.parsers.roundtrip import (
+        TOL_URDF,
+        our_mjcf_model,
+        our_urdf_view,
+        parse_source,
+        reference_view,
+    )
+
+    path = tmp_path / "tree.urdf"
+    path.write_text(tree_urdf(40, branching=3))
+    report = roundtrip(path, configs=3)
+    hrdf = parse_source(path).hrdf
+    ref, ours = reference_view(path), view_from_model(our_mjcf_model(hrdf))
+    alone = [
+        ("MJCF: " + r.check, r.value, r.ok)
+        for r in compare_views(ref, ours, configs=3, collision_only=True)
+    ]
+    alone += [
+        ("URDF: " + r.check, r.value, r.ok)
+        for r in compare_views(
+            ref, our_urdf_view(hrdf), tol=TOL_URDF, configs=3, full=False, inertials_ref=ours
+        )
+    ]
+    assert [(r.check, r.value, r.ok) for r in report.rows] == alone
+    assert report.ok and report.reference == "mujoco"
+
+
 def _model(bodies: list[list[tuple[str, str]]]) -> mujoco.MjModel:
     """Bodies on hinges, each with unnamed box geoms given as (pos, size) strings."""
     xml = ["<mujoco><worldbody><body name='root'><freejoint/><geom size='0.1'/>"]

@@ -456,13 +456,19 @@ def urdf_for_mujoco(
     balance_inertia: bool = False,
     bound_mass=None,
     bound_inertia=None,
+    root: ET.Element | None = None,
 ) -> str:
     """The URDF text with mesh URIs made absolute, rotated inertial frames written in the
     link frame where MuJoCo would drop the rotation (see
     :func:`_inertia_into_link_frame`) and a ``<mujoco><compiler>`` block
     that keeps every link a body (``fusestatic="false"``), takes inertia only from
-    ``<inertial>`` (``inertiafromgeom="false"``) and drops visual geoms."""
-    root = parse_xml(path)
+    ``<inertial>`` (``inertiafromgeom="false"``) and drops visual geoms.
+
+    ``root``: the URDF already parsed (changed in place), for a document that is not a
+    file yet; relative mesh URIs then resolve from ``path``'s folder all the same.
+    """
+    if root is None:
+        root = parse_xml(path)
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename")
         if uri:
@@ -660,8 +666,8 @@ def urdf_yourdfpy_view(
 def mimic_map(path: Path) -> dict[str, tuple[str, float, float]]:
     """URDF mimic joints: name -> (mimicked joint, multiplier, offset)."""
     out = {}
-    if path.suffix.lower() != ".urdf":
-        return out
+    if path.suffix.lower() != ".urdf" or b"mimic" not in path.read_bytes():
+        return out  # a file without the word has no <mimic>: no second parse of a large robot
     for j in parse_xml(path).findall("joint"):
         m = j.find("mimic")
         if m is not None:

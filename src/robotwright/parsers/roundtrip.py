@@ -15,8 +15,11 @@ models, since forward kinematics does not apply equality constraints.
 
 from __future__ import annotations
 
+import functools
 import os
 import tempfile
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,8 +32,9 @@ from robotwright.hrdf.model import HRDF
 from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
     RobotView,
+    compile_urdf,
     mimic_map,
-    urdf_mujoco_view,
+    urdf_for_mujoco,
     urdf_yourdfpy_view,
     view_from_model,
 )
@@ -189,12 +193,15 @@ def compare_views(
     """Rows comparing ``ours`` with ``ref``. ``full=False`` checks masses, inertias and
     centres of mass of every body and FK only (what a URDF can carry of an MJCF robot)."""
     rows: list[Row] = []
-    our_frames = set(ours.bodies) | set(ours.sites)
+    # Sets for membership: lists made these checks quadratic in bodies.
+    our_bodies, our_sites = set(ours.bodies), set(ours.sites)
+    ref_bodies, ref_sites = set(ref.bodies), set(ref.sites)
+    our_frames = our_bodies | our_sites
     missing = [b for b in ref.bodies if b not in our_frames]
-    as_sites = [b for b in ref.bodies if b not in ours.bodies and b in ours.sites]
+    as_sites = [b for b in ref.bodies if b not in our_bodies and b in our_sites]
     # URDF has no sites: our URDF carries each site as a massless link.
-    extra = [b for b in ours.bodies if b not in ref.bodies and b not in ref.sites]
-    site_links = [b for b in ours.bodies if b not in ref.bodies and b in ref.sites]
+    extra = [b for b in ours.bodies if b not in ref_bodies and b not in ref_sites]
+    site_links = [b for b in ours.bodies if b not in ref_bodies and b in ref_sites]
     note = f"{len(as_sites)} as sites" if as_sites else ""
     if site_links:
         # URDF has no sites: ours carries each as a massless link, so ours has more.
@@ -285,7 +292,7 @@ def compare_views(
         )
         if ref.kind == "mujoco":
             rows.append(_compare_actuators(ref, ours, tol))
-            missing_sites = [s for s in ref.sites if s not in ours.sites]
+            missing_sites = [s for s in ref.sites if s not in our_sites]
             rows.append(
                 Row(
                     "sites kept",
@@ -600,76 +607,143 @@ def parse_source(path: Path, strict: bool = False, **options: Any):
     return mjcf_to_hrdf_with_warnings(path, strict=strict, **options)
 
 
-def our_mjcf_model(hrdf: HRDF) -> mujoco.MjModel:
-    """Our MJCF of ``hrdf`` compiled by MuJoCo (no scene)."""
+def our_mjcf_text(hrdf: HRDF) -> str:
+    """Our MJCF of ``hrdf`` as a string (no scene, mesh paths absolute)."""
     import warnings
 
     from robotwright.generators import MJCFHumanoidGenerator
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return MJCFHumanoidGenerator.from_hrdf(hrdf).to_model(add_scene=False)
+        gen = MJCFHumanoidGenerator.from_hrdf(hrdf)
+        return gen.export(None, relative_mesh_path=False, add_scene=False)
 
 
-def _our_urdf(hrdf: HRDF) -> tuple[mujoco.MjModel, dict[str, str], dict[str, str]]:
-    """Our URDF of ``hrdf`` loaded by MuJoCo, with the generator's added links: dummy
-    links (link -> the body it splits) and frame links (site -> its link)."""
+def our_mjcf_model(hrdf: HRDF) -> mujoco.MjModel:
+    """Our MJCF of ``hrdf`` compiled by MuJoCo (no scene)."""
+    return mujoco.MjSpec.from_string(our_mjcf_text(hrdf)).compile()
+
+
+@dataclass
+class OurURDF:
+    """Our URDF of a robot, ready for MuJoCo's import (:func:`urdf_for_mujoco`), with the
+    links the URDF form adds: dummy links (link -> the body it splits) and frame links
+    (site -> its link)."""
+
+    text: str
+    dummy_links: dict[str, str]
+    frame_links: dict[str, str]
+
+    def view(self, model: mujoco.MjModel) -> RobotView:
+        """View of ``model`` (this URDF compiled) without the links the URDF form adds:
+        dummy links (their 1e-9 kg each stays in the total mass) and site links renamed
+        because a body has the site's name (the reference's FK of that name is the body)."""
+        view = view_from_model(model)
+        drop = set(self.dummy_links)
+        drop |= {link for site, link in self.frame_links.items() if link != site}
+        view.bodies = [b for b in view.bodies if b not in drop]
+        view.inertia_world = {k: v for k, v in view.inertia_world.items() if k not in drop}
+        view.mass = {k: v for k, v in view.mass.items() if k not in drop or k in self.dummy_links}
+        return view
+
+
+def our_urdf(hrdf: HRDF) -> OurURDF:
+    """Our URDF of ``hrdf``, with mesh paths absolute (files of the robot, or of the
+    parser's staging folder: keep the robot until MuJoCo has loaded the text)."""
     import warnings
 
     from robotwright.generators import URDFHumanoidGenerator
 
-    with tempfile.TemporaryDirectory(prefix="robotwright-rt-") as tmp:
-        out = Path(tmp) / "robot.urdf"
-        gen = URDFHumanoidGenerator.from_hrdf(hrdf)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            gen.export(out)
-        from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
-
-        text = urdf_for_mujoco(out)
-        return compile_urdf(text), dict(gen.dummy_links), dict(gen.frame_links)
+    gen = URDFHumanoidGenerator.from_hrdf(hrdf)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        root = gen.generate(relative_mesh_path=False)
+    # The generated tree as is: the same document export writes, less its indentation.
+    text = urdf_for_mujoco(Path(f"{hrdf.name}.urdf"), root=root)
+    return OurURDF(text, dict(gen.dummy_links), dict(gen.frame_links))
 
 
 def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
     """Our URDF of ``hrdf`` loaded by MuJoCo (every link kept, inertia from <inertial>)."""
-    return _our_urdf(hrdf)[0]
+    return compile_urdf(our_urdf(hrdf).text)
 
 
 def our_urdf_view(hrdf: HRDF) -> RobotView:
-    """View of our URDF in MuJoCo without the links the URDF form adds: dummy links
-    (their 1e-9 kg each stays in the total mass) and site links renamed because a body
-    has the site's name (the reference's FK of that name is the body)."""
-    model, dummy_links, frame_links = _our_urdf(hrdf)
-    view = view_from_model(model)
-    drop = set(dummy_links) | {link for site, link in frame_links.items() if link != site}
-    view.bodies = [b for b in view.bodies if b not in drop]
-    view.inertia_world = {k: v for k, v in view.inertia_world.items() if k not in drop}
-    view.mass = {k: v for k, v in view.mass.items() if k not in drop or k in dummy_links}
+    """View of our URDF in MuJoCo without the links the URDF form adds (see
+    :meth:`OurURDF.view`)."""
+    ours = our_urdf(hrdf)
+    return ours.view(compile_urdf(ours.text))
+
+
+def _check_reference(reference: str) -> None:
+    if reference not in ("auto", "mujoco", "yourdfpy"):
+        raise ValueError(f"reference={reference!r}: expected 'auto', 'mujoco' or 'yourdfpy'")
+
+
+@dataclass
+class ReferenceLoader:
+    """The reference of a round trip, in steps: the text MuJoCo will import is prepared
+    on construction (see :func:`reference_loader`); :meth:`load` does the import
+    (MuJoCo's work, which may run on another thread: MuJoCo releases the interpreter
+    while it parses and compiles) and raises ValueError when MuJoCo refuses the source;
+    :meth:`instead` is the view to use then."""
+
+    load: Callable[[], RobotView]
+    #: For a URDF MuJoCo refuses, with ``reference="auto"``: yourdfpy's view (None: the
+    #: refusal is the answer).
+    fallback: Callable[[ValueError], RobotView] | None = None
+
+    def instead(self, exc: ValueError) -> RobotView:
+        if self.fallback is None:
+            raise exc
+        return self.fallback(exc)
+
+    def __call__(self) -> RobotView:
+        try:
+            return self.load()
+        except ValueError as exc:
+            return self.instead(exc)
+
+
+def _yourdfpy_instead(path: Path, compiler: dict[str, Any], exc: ValueError) -> RobotView:
+    view = urdf_yourdfpy_view(path, **compiler)
+    view.kind = f"yourdfpy (MuJoCo refuses the source: {str(exc).splitlines()[0][:120]})"
     return view
 
 
-def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:
-    """The source as MuJoCo compiles it; for a URDF MuJoCo refuses (or with
-    ``reference="yourdfpy"``), yourdfpy's view."""
-    if reference not in ("auto", "mujoco", "yourdfpy"):
-        raise ValueError(f"reference={reference!r}: expected 'auto', 'mujoco' or 'yourdfpy'")
+def _raise(exc: Exception) -> RobotView:
+    raise exc
+
+
+def reference_loader(path: Path, reference: str = "auto", **options: Any) -> ReferenceLoader:
+    """The reference of ``path`` (see :func:`reference_view`), prepared to be loaded."""
+    _check_reference(reference)
     if source_kind(path) == "mjcf":
-        return view_from_model(
-            mujoco.MjModel.from_xml_path(str(path)), root=options.get("root_body")
+        root = options.get("root_body")
+        return ReferenceLoader(
+            lambda: view_from_model(mujoco.MjModel.from_xml_path(str(path)), root=root)
         )
     compiler = {
         k: options[k] for k in ("balance_inertia", "bound_mass", "bound_inertia") if k in options
     }
     if reference == "yourdfpy":
-        return urdf_yourdfpy_view(path, **compiler)
+        return ReferenceLoader(lambda: urdf_yourdfpy_view(path, **compiler))
+    fallback = (
+        None if reference == "mujoco" else functools.partial(_yourdfpy_instead, path, compiler)
+    )
     try:
-        return urdf_mujoco_view(path, options.get("package_map"), **compiler)
+        text = urdf_for_mujoco(path, options.get("package_map"), **compiler)
     except ValueError as exc:
-        if reference == "mujoco":
+        if fallback is None:
             raise
-        view = urdf_yourdfpy_view(path, **compiler)
-        view.kind = f"yourdfpy (MuJoCo refuses the source: {str(exc).splitlines()[0][:120]})"
-        return view
+        return ReferenceLoader(functools.partial(_raise, exc), fallback)
+    return ReferenceLoader(lambda: view_from_model(compile_urdf(text), "mujoco"), fallback)
+
+
+def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:
+    """The source as MuJoCo compiles it; for a URDF MuJoCo refuses (or with
+    ``reference="yourdfpy"``), yourdfpy's view."""
+    return reference_loader(path, reference, **options)()
 
 
 def roundtrip(
@@ -722,6 +796,37 @@ def _check_input(path: Path, configs: int) -> None:
 def _roundtrip(
     path: Path, configs: int, urdf: bool, reference: str, options: dict[str, Any]
 ) -> RoundTripReport:
+    # The three MuJoCo imports (the source, our MJCF, our URDF) run on threads as soon as
+    # each text is ready, beside the Python work that writes the next one: on a large
+    # robot they are most of the time, and MuJoCo releases the interpreter while it works.
+    with ThreadPoolExecutor(max_workers=3) as pool:
+        return _roundtrip_on(pool, path, configs, urdf, reference, options)
+
+
+def _reference_job(
+    pool: ThreadPoolExecutor, path: Path, reference: str, options: dict[str, Any]
+) -> tuple[Future, ReferenceLoader | None]:
+    """MuJoCo's import of the reference, started on ``pool`` (a failure to prepare it is
+    the job's), and its loader: the fallback runs later, only if it is needed."""
+    try:
+        loader = reference_loader(
+            path, reference, **{k: v for k, v in options.items() if k != "work_dir"}
+        )
+    except Exception as exc:  # reported by the caller with the job's result
+        failed: Future = Future()
+        failed.set_exception(exc)
+        return failed, None
+    return pool.submit(loader.load), loader
+
+
+def _roundtrip_on(
+    pool: ThreadPoolExecutor,
+    path: Path,
+    configs: int,
+    urdf: bool,
+    reference: str,
+    options: dict[str, Any],
+) -> RoundTripReport:
     report = RoundTripReport(str(path), "")
     try:
         # The parse reads the xacro itself (its messages name it); the references read
@@ -733,17 +838,39 @@ def _roundtrip(
         report.error = f"parse failed: {type(exc).__name__}: {exc}"
         return report
     report.warnings = [str(w) for w in result.warnings]
+    mimic = mimic_map(path)
     try:
-        ref = reference_view(
-            path, reference, **{k: v for k, v in options.items() if k != "work_dir"}
-        )
+        mjcf_text = our_mjcf_text(result.hrdf)
+    except Exception as exc:
+        # Known before MuJoCo's import of the source starts: for a robot our MJCF cannot
+        # hold (a chain deeper than MJCF allows) that import can take far longer than
+        # this answer (MuJoCo 4.0 spends 20 s refusing a chain of 2,000 links).
+        report.error = f"our MJCF is not written: {type(exc).__name__}: {exc}"
+        return report
+    ref_job, loader = _reference_job(pool, path, reference, options)
+    mjcf_job = pool.submit(lambda: mujoco.MjSpec.from_string(mjcf_text).compile())
+    ours_urdf: OurURDF | Exception | None = None
+    urdf_job = None
+    if urdf:
+        try:
+            ours_urdf = our_urdf(result.hrdf)
+        except Exception as exc:  # reported in the URDF rows
+            ours_urdf = exc
+        else:
+            urdf_job = pool.submit(compile_urdf, ours_urdf.text)
+    try:
+        try:
+            ref = ref_job.result()
+        except ValueError as exc:
+            if loader is None:
+                raise
+            ref = loader.instead(exc)
     except Exception as exc:
         report.error = f"no reference: {type(exc).__name__}: {exc}"
         return report
     report.reference = ref.kind
-    mimic = mimic_map(path)
     try:
-        ours = view_from_model(our_mjcf_model(result.hrdf))
+        ours = view_from_model(mjcf_job.result())
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
         if "mass" in str(exc) and source_kind(path) == "urdf":
@@ -755,25 +882,29 @@ def _roundtrip(
     for r in compare_views(ref, ours, configs=configs, mimic=mimic, collision_only=collision_only):
         r.check = "MJCF: " + r.check
         report.rows.append(r)
-    if urdf:
-        try:
-            ours_u = our_urdf_view(result.hrdf)
-        except ImportError:
-            report.rows.append(Row("URDF: generator", "not available", False))
-            return report
-        except Exception as exc:
-            report.rows.append(
-                Row(
-                    "URDF: our URDF loads in MuJoCo",
-                    f"no: {type(exc).__name__}: {str(exc)[:200]}",
-                    False,
-                )
+    if not urdf:
+        return report
+    if isinstance(ours_urdf, ImportError):
+        report.rows.append(Row("URDF: generator", "not available", False))
+        return report
+    try:
+        if isinstance(ours_urdf, Exception):
+            raise ours_urdf
+        assert isinstance(ours_urdf, OurURDF) and urdf_job is not None
+        ours_u = ours_urdf.view(urdf_job.result())
+    except Exception as exc:
+        report.rows.append(
+            Row(
+                "URDF: our URDF loads in MuJoCo",
+                f"no: {type(exc).__name__}: {str(exc)[:200]}",
+                False,
             )
-            return report
-        urdf_rows = compare_views(
-            ref, ours_u, tol=TOL_URDF, configs=configs, mimic=mimic, full=False, inertials_ref=ours
         )
-        for r in urdf_rows:
-            r.check = "URDF: " + r.check
-            report.rows.append(r)
+        return report
+    urdf_rows = compare_views(
+        ref, ours_u, tol=TOL_URDF, configs=configs, mimic=mimic, full=False, inertials_ref=ours
+    )
+    for r in urdf_rows:
+        r.check = "URDF: " + r.check
+        report.rows.append(r)
     return report
