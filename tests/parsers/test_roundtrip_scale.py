@@ -78,7 +78,9 @@ def test_the_round_trip_legs_agree_with_one_at_a_time(tmp_path: Path) -> None:
     ref, ours = reference_view(path), view_from_model(our_mjcf_model(hrdf))
     alone = [
         ("MJCF: " + r.check, r.value, r.ok)
-        for r in compare_views(ref, ours, configs=3, collision_only=True)
+        for r in compare_views(
+            ref, ours, configs=3, collision_only=True, source_has_actuators=False
+        )
     ]
     alone += [
         ("URDF: " + r.check, r.value, r.ok)
@@ -192,3 +194,35 @@ def test_every_body_inertia_is_compared_on_both_legs(full: bool) -> None:
     assert all(r.ok for r in same)
     inertia = next(r for r in rows if r.check == "inertia tensors max rel.err")
     assert not inertia.ok
+
+
+def test_actuators_made_for_a_urdf_are_checked_against_its_joints(tmp_path: Path) -> None:
+    """MuJoCo's URDF import has no actuators; those ``actuators="motor"`` makes are not a
+    failure, but each must drive a moving joint of the source, once."""
+    from robotwright.parsers.roundtrip import _made_actuators_row
+
+    path = tmp_path / "tree.urdf"
+    path.write_text(tree_urdf(6))
+    report = roundtrip(path, configs=2, actuators="motor")
+    row = next(r for r in report.rows if r.check.startswith("MJCF: actuators"))
+    assert report.ok and row.ok and row.value == "0/5" and row.compared == 5
+    plain = roundtrip(path, configs=2)
+    row = next(r for r in plain.rows if r.check.startswith("MJCF: actuators"))
+    assert plain.ok and not row.applicable
+    # An actuator on a joint the source does not have, or a joint driven twice, fails.
+    ref = view_from_model(_motor_model(["j1", "j2"]))
+    assert _made_actuators_row(ref, view_from_model(_motor_model(["j1", "j2"], ["j1", "j2"]))).ok
+    assert not _made_actuators_row(
+        ref, view_from_model(_motor_model(["j1", "j2"], ["j1", "j1"]))
+    ).ok
+    assert not _made_actuators_row(ref, view_from_model(_motor_model(["j1", "jx"], ["jx"]))).ok
+
+
+def _motor_model(joints: list[str], motors: tuple[str, ...] | list[str] = ()) -> mujoco.MjModel:
+    xml = "<mujoco><worldbody><body name='a'><freejoint/><geom size='0.1'/>"
+    xml += "".join(
+        f"<body name='b{j}'><joint name='{j}'/><geom size='0.1'/></body>" for j in joints
+    )
+    xml += "</body></worldbody><actuator>"
+    xml += "".join(f"<motor joint='{j}'/>" for j in motors)
+    return mujoco.MjModel.from_xml_string(xml + "</actuator></mujoco>")

@@ -189,9 +189,12 @@ def compare_views(
     full: bool = True,
     collision_only: bool = False,
     inertials_ref: RobotView | None = None,
+    source_has_actuators: bool = True,
 ) -> list[Row]:
     """Rows comparing ``ours`` with ``ref``. ``full=False`` checks masses, inertias and
-    centres of mass of every body and FK only (what a URDF can carry of an MJCF robot)."""
+    centres of mass of every body and FK only (what a URDF can carry of an MJCF robot).
+    ``source_has_actuators=False`` (a URDF): our actuators, if any, were made by the
+    parser's ``actuators`` option, and are checked to drive joints of the source."""
     rows: list[Row] = []
     # Sets for membership: lists made these checks quadratic in bodies.
     our_bodies, our_sites = set(ours.bodies), set(ours.sites)
@@ -291,7 +294,10 @@ def compare_views(
             )
         )
         if ref.kind == "mujoco":
-            rows.append(_compare_actuators(ref, ours, tol))
+            if source_has_actuators or ref.actuators:
+                rows.append(_compare_actuators(ref, ours, tol))
+            else:
+                rows.append(_made_actuators_row(ref, ours))
             missing_sites = [s for s in ref.sites if s not in our_sites]
             rows.append(
                 Row(
@@ -548,6 +554,28 @@ def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
         not problems,
         "; ".join(problems),
         compared=sum(counts) + len(problems),
+    )
+
+
+def _made_actuators_row(ref: RobotView, ours: RobotView) -> Row:
+    """The actuators of a robot whose source format has none (URDF): made by the parser's
+    ``actuators`` option, so there is nothing to compare them with; each must drive a
+    moving joint of the source, one actuator per joint."""
+    moving = {j.name for j in ref.joints if j.type in ("hinge", "slide")}
+    joints = [a["joint"] for a in ours.actuators]
+    stray = [j or a["name"] for j, a in zip(joints, ours.actuators, strict=True) if j not in moving]
+    twice = sorted({j for j in joints if j is not None and joints.count(j) > 1})
+    note = "the source has none: made by --actuators" if joints else "the source has none"
+    if stray:
+        note += f"; not on a moving joint of the source: {stray[:5]}"
+    if twice:
+        note += f"; joints driven twice: {twice[:5]}"
+    return Row(
+        "actuators (made, each on a moving joint of the source)",
+        f"0/{len(ours.actuators)}",
+        not stray and not twice,
+        note,
+        compared=len(ours.actuators),
     )
 
 
@@ -879,7 +907,15 @@ def _roundtrip_on(
             )
         return report
     collision_only = source_kind(path) == "urdf"  # MuJoCo's URDF import drops visuals
-    for r in compare_views(ref, ours, configs=configs, mimic=mimic, collision_only=collision_only):
+    rows = compare_views(
+        ref,
+        ours,
+        configs=configs,
+        mimic=mimic,
+        collision_only=collision_only,
+        source_has_actuators=source_kind(path) != "urdf",
+    )
+    for r in rows:
         r.check = "MJCF: " + r.check
         report.rows.append(r)
     if not urdf:
