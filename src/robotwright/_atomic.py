@@ -241,11 +241,17 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
         yield fh
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path``, creating its folder; see :func:`atomic_path`.
+def write_bytes_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path``, creating its folder; see :func:`atomic_path`.
     Folders it created are removed again when the write fails."""
-    with _new_file(path, make_parents=True) as tmp, open(tmp, "w", encoding="utf-8") as fh:
-        fh.write(text)
+    with _new_file(path, make_parents=True) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8, ``\n`` line ends as given) to ``path``; see
+    :func:`write_bytes_atomic`."""
+    write_bytes_atomic(path, text.encode("utf-8"))
 
 
 def _copy(src: Path, tmp: Path, dst: Path) -> None:

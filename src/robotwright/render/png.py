@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robotwright._atomic import _make_parents, _remove_empty, atomic_open, check_output_path
+from robotwright._atomic import write_bytes_atomic
 from robotwright.render.core import Picture
 
 __all__ = ["save_png"]
@@ -79,12 +79,5 @@ def save_png(
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=_DPI)
     path = Path(path)
-    check_output_path(path)
-    created = _make_parents(path.parent)  # a missing folder is made (and removed on failure)
-    try:
-        with atomic_open(path, "wb") as fh:
-            fh.write(buffer.getvalue())
-    except BaseException:
-        _remove_empty(created)
-        raise
+    write_bytes_atomic(path, buffer.getvalue())  # a missing folder is made
     return path
