@@ -118,6 +118,21 @@ def test_roundtrip_bad_input_is_exit_2_on_stderr(tmp_path, capsys, name, content
     assert captured.out == ""  # no half table
 
 
+def test_roundtrip_input_the_parser_refuses_is_exit_2_on_stderr(tmp_path, capsys) -> None:
+    """A file that is well-formed but that the parser refuses (here a mesh that does not
+    exist) is bad input as for ``convert``: exit 2, the reason on stderr, no table."""
+    path = tmp_path / "nomesh.urdf"
+    path.write_text(
+        '<robot name="r"><link name="a"><collision><geometry><mesh filename="gone.stl"/>'
+        "</geometry></collision></link></robot>"
+    )
+    assert main(["roundtrip", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert "'gone.stl' resolves to" in captured.err and "does not exist" in captured.err
+    assert captured.out == "" and "Traceback" not in captured.err
+    assert main(["convert", str(path), "-o", str(tmp_path / "out")]) == 2
+
+
 def test_roundtrip_needs_at_least_one_configuration(probe: Path, capsys) -> None:
     assert main(["roundtrip", str(probe), "--configs", "0"]) == 2
     assert "configs: expected at least 1 configuration, got 0" in capsys.readouterr().err

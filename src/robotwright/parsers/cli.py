@@ -261,6 +261,8 @@ def _roundtrip(args: argparse.Namespace) -> int:
     report = roundtrip(
         args.source, configs=args.configs, reference=args.reference, **_options(args)
     )
+    if report.input_error is not None:
+        raise report.input_error  # bad input: exit 2 on stderr, no table
     print(report.table())
     if args.show_warnings or args.verbose:
         for w in report.warnings:

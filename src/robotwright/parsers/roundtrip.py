@@ -70,6 +70,10 @@ class RoundTripReport:
     rows: list[Row] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     error: str | None = None
+    #: The parser's refusal of the input itself (a missing mesh, a bad value, a lost one
+    #: under ``strict``), also summed up in ``error``: the command line reports it as bad
+    #: input (exit 2), as ``convert`` does.
+    input_error: ConversionError | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:
@@ -864,6 +868,8 @@ def _roundtrip_on(
             path, options = xacro_as_urdf(path, options)
     except Exception as exc:  # the table reports any failure with its reason
         report.error = f"parse failed: {type(exc).__name__}: {exc}"
+        if isinstance(exc, ConversionError):
+            report.input_error = exc
         return report
     report.warnings = [str(w) for w in result.warnings]
     mimic = mimic_map(path)
