@@ -220,7 +220,40 @@ def test_moving_body_without_mass(arm: Path) -> None:
 
 def test_inertia_not_positive(arm: Path) -> None:
     set_cell(arm / "body.csv", 4, "diag_inertia1", "-0.001")
-    assert has(errors_of(arm), "body.csv", "expected all >= 0", row=4, column="diag_inertia")
+    assert has(
+        errors_of(arm),
+        "body.csv",
+        "expected finite numbers, all >= 0",
+        row=4,
+        column="diag_inertia",
+    )
+
+
+@pytest.mark.parametrize(
+    ("column", "expected"),
+    [
+        ("mass", "mass inf kg: expected a finite"),
+        ("diag_inertia", "expected finite numbers, all >= 0"),
+    ],
+)
+def test_infinite_mass_or_inertia_of_a_robot_built_in_python(
+    arm: Path, column: str, expected: str
+) -> None:
+    """Tables refuse 'inf' when read; a robot built in Python (or by a parser) is checked
+    too: an infinite mass passed as ">= 0" and was written out."""
+    import dataclasses
+    import math
+
+    from robotwright.hrdf.model import HRDF
+    from robotwright.hrdf.validate import check_model
+
+    robot = HRDF.from_dir(arm)
+    body = robot.bodies[2]
+    d = body.diag_inertia
+    value = math.inf if column == "mass" else (d[0], math.inf, d[2])
+    robot.bodies[2] = dataclasses.replace(body, **{column: value})
+    problems = [p for p in check_model(robot) if p.severity == "error"]
+    assert any(expected in p.message and p.row == 2 and p.column == column for p in problems)
 
 
 def test_inertia_triangle_inequality(arm: Path) -> None:
@@ -286,7 +319,10 @@ def test_cli_validate_reports_and_fails(arm: Path) -> None:
         [sys.executable, "-m", "robotwright", "validate", str(arm)], capture_output=True, text=True
     )
     assert run.returncode == 1
-    assert "error: body.csv: row 1: column 'mass': mass -2.0 kg: expected >= 0" in run.stdout
+    assert (
+        "error: body.csv: row 1: column 'mass': mass -2.0 kg: expected a finite number >= 0"
+        in run.stdout
+    )
     assert "error: joint.csv: row 0: column 'range0'" in run.stdout
     assert "2 error(s)" in run.stdout
 

@@ -6,6 +6,7 @@ nothing is written; trusted folders are an explicit opt-in."""
 from __future__ import annotations
 
 import os
+import re
 import threading
 from pathlib import Path
 
@@ -258,3 +259,45 @@ def test_warning_about_many_joints_stays_one_short_line(tmp_path: Path, caplog) 
     assert f"of {n} joint(s)" in limits[0]
     assert f"({n - 12} more)" in limits[0]
     assert "j1, j2" in limits[0] and "j299" not in limits[0]
+
+
+_LINK = (
+    '<link name="a"><inertial><origin xyz="{xyz}"/><mass value="{mass}"/>'
+    '<inertia ixx="{ixx}" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    '<collision><geometry><box size="{box}"/></geometry></collision></link>'
+    '<link name="b"><inertial><mass value="1"/>'
+    '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+    '<limit lower="{lower}" upper="1" effort="1" velocity="1"/></joint>'
+)
+_SANE = {"xyz": "0 0 0", "mass": "1", "ixx": "1", "box": "1 1 1", "lower": "-1"}
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "expected"),
+    [
+        ("mass", "1e400", "mass '1e400': expected a finite number"),
+        ("mass", "nan", "mass 'nan': expected a finite number"),
+        ("ixx", "inf", "inertia: expected finite numbers ixx..izz"),
+        ("xyz", "0 0 -inf", "expected 3 finite numbers"),
+        ("box", "1 nan 1", "<box size> = '1 nan 1': expected 3 finite numbers"),
+        ("lower", "-inf", "<limit lower='-inf'>: expected a finite number"),
+    ],
+)
+def test_urdf_numbers_must_be_finite(tmp_path, capsys, field, value, expected) -> None:
+    """Python reads "1e400", "inf" and "nan" as floats; MuJoCo's reader refuses them, and
+    so does ours, naming the element, instead of writing an infinite mass."""
+    path = tmp_path / "r.urdf"
+    path.write_text(f'<robot name="r">{_LINK.format(**{**_SANE, field: value})}</robot>')
+    with pytest.raises(ConversionError, match=re.escape(expected)):
+        urdf_to_hrdf(path)
+    out = tmp_path / "out"
+    assert main(["convert", str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "r.urdf" in err and not out.exists()
+
+
+def test_urdf_with_finite_numbers_still_converts(tmp_path) -> None:
+    path = tmp_path / "r.urdf"
+    path.write_text(f'<robot name="r">{_LINK.format(**_SANE)}</robot>')
+    assert urdf_to_hrdf(path).bodies[0].mass == 1.0

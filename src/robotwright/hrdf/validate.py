@@ -144,13 +144,13 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
         if (
             _QUICK_PASS
             and b.name
-            and b.mass >= MJ_MINVAL
+            and MJ_MINVAL <= b.mass < math.inf
             and not abs(hypot(*b.quat) - 1.0) > QUAT_NORM_TOL
             and not abs(hypot(*b.inertial_quat) - 1.0) > QUAT_NORM_TOL
             and len(d) == 3
-            and d[0] >= MJ_MINVAL
-            and d[1] >= MJ_MINVAL
-            and d[2] >= MJ_MINVAL
+            and MJ_MINVAL <= d[0] < math.inf
+            and MJ_MINVAL <= d[1] < math.inf
+            and MJ_MINVAL <= d[2] < math.inf
             and not d[0] + d[1] < d[2] * k
             and not d[1] + d[2] < d[0] * k
             and not d[2] + d[0] < d[1] * k
@@ -158,19 +158,27 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
             continue
         if not b.name:
             out.append(Problem("body.csv", "empty body name", row=i, column="name"))
-        if not b.mass >= 0:
+        if not 0 <= b.mass < math.inf:
             out.append(
-                Problem("body.csv", f"mass {b.mass} kg: expected >= 0", row=i, column="mass")
+                Problem(
+                    "body.csv",
+                    f"mass {b.mass} kg: expected a finite number >= 0",
+                    row=i,
+                    column="mass",
+                )
             )
         for col, q in (("quat", b.quat), ("inertial_quat", b.inertial_quat)):
             msg = _quat_problem(q)
             if msg:
                 out.append(Problem("body.csv", msg, row=i, column=col))
         d = b.diag_inertia
-        if len(d) != 3 or any(not v >= 0 for v in d):
+        if len(d) != 3 or any(not 0 <= v < math.inf for v in d):
             out.append(
                 Problem(
-                    "body.csv", f"diag_inertia {d}: expected all >= 0", row=i, column="diag_inertia"
+                    "body.csv",
+                    f"diag_inertia {d}: expected finite numbers, all >= 0",
+                    row=i,
+                    column="diag_inertia",
                 )
             )
             continue
@@ -186,7 +194,7 @@ def _check_bodies(hrdf: HRDF) -> list[Problem]:
                     )
                 )
                 break
-        if b.mass >= 0 and b.name in moving and not _carries_mass(hrdf, i, moving):
+        if 0 <= b.mass < math.inf and b.name in moving and not _carries_mass(hrdf, i, moving):
             out.append(
                 Problem(
                     "body.csv",

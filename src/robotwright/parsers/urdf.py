@@ -14,6 +14,7 @@ collision of the same geometry and origin are one geom that is drawn and collide
 
 from __future__ import annotations
 
+import math
 import os
 import xml.etree.ElementTree as ET
 from collections import Counter
@@ -130,16 +131,25 @@ class URDFOptions:
                 raise ValueError(f"{name}={value!r}: expected None or >= 0")
 
 
+def _finite(text: str) -> float:
+    """A URDF number: finite, as MuJoCo's reader requires ("1e400", "inf" and "nan" are
+    refused there too). Raises ValueError."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"{text!r} is not a finite number")
+    return value
+
+
 def _floats(text: str | None, n: int, default: tuple[float, ...], what: str, rep) -> np.ndarray:
     if text is None:
         return np.array(default, dtype=float)
     try:
-        values = [float(v) for v in text.split()]
+        values = [_finite(v) for v in text.split()]
     except ValueError:
         values = []
     if len(values) != n:
         raise ConversionError(
-            [Problem(rep.file, f"{what} = {text!r}: expected {n} numbers")],
+            [Problem(rep.file, f"{what} = {text!r}: expected {n} finite numbers")],
         )
     return np.array(values, dtype=float)
 
@@ -191,23 +201,18 @@ def _link_inertial(link: ET.Element, rep: Reporter) -> tuple[float, np.ndarray, 
     mass = 0.0
     if mass_el is not None:
         try:
-            mass = float(mass_el.get("value", "0"))
+            mass = _finite(mass_el.get("value", "0"))
         except ValueError as exc:
-            raise ConversionError(
-                [
-                    Problem(
-                        rep.file, f"mass {mass_el.get('value')!r}: expected a number", element=where
-                    )
-                ]
-            ) from exc
+            problem = f"mass {mass_el.get('value')!r}: expected a finite number"
+            raise ConversionError([Problem(rep.file, problem, element=where)]) from exc
     i_el = inertial.find("inertia")
     tensor = np.zeros((3, 3))
     if i_el is not None:
         try:
-            v = {k: float(i_el.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+            v = {k: _finite(i_el.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
         except ValueError as exc:
             raise ConversionError(
-                [Problem(rep.file, "inertia: expected numbers ixx..izz", element=where)]
+                [Problem(rep.file, "inertia: expected finite numbers ixx..izz", element=where)]
             ) from exc
         local = np.array(
             [
@@ -279,11 +284,10 @@ class _URDFReader:
 
         def num(attr: str) -> float:
             try:
-                return float(shape.get(attr, ""))
+                return _finite(shape.get(attr, ""))
             except ValueError as exc:
-                raise ConversionError(
-                    [Problem(self.rep.file, f"<{tag} {attr}>: expected a number", element=where)]
-                ) from exc
+                problem = f"<{tag} {attr}>: expected a finite number"
+                raise ConversionError([Problem(self.rep.file, problem, element=where)]) from exc
 
         if tag == "box":
             size = _floats(shape.get("size"), 3, (0, 0, 0), f"{where} <box size>", self.rep)
@@ -464,13 +468,13 @@ def _num(elem: ET.Element | None, attr: str, default: float, where: str, rep: Re
     if elem is None or elem.get(attr) is None:
         return default
     try:
-        return float(elem.get(attr))
+        return _finite(elem.get(attr))
     except ValueError as exc:
         raise ConversionError(
             [
                 Problem(
                     rep.file,
-                    f"<{elem.tag} {attr}={elem.get(attr)!r}>: expected a number",
+                    f"<{elem.tag} {attr}={elem.get(attr)!r}>: expected a finite number",
                     element=where,
                 )
             ]
