@@ -172,7 +172,7 @@ class Vector(AttrType):
         if self.size is not None and arr.size != self.size:
             raise self.fail(owner, name, value, self._expect())
         if not self.integer and np.isnan(arr).any():
-            raise self.fail(owner, name, value, "finite numbers, not NaN")
+            raise self.fail(owner, name, value, "numbers, not NaN")
         if self.nonneg and (arr < 0).any():
             raise self.fail(owner, name, value, "non-negative entries (sizes cannot be negative)")
         if self.ordered and arr.size >= 2 and arr[0] > arr[1]:
