@@ -353,3 +353,22 @@ def test_massless_body_without_joints_is_allowed(arm: Path) -> None:
 def test_moving_leaf_body_needs_mass_and_inertia(arm: Path) -> None:
     set_cell(arm / "body.csv", 6, "mass", "0.0")  # wrist_3_link moves: needs mass
     assert has(errors_of(arm), "body.csv", "a body with joints needs mass", row=6, column="mass")
+
+
+def test_a_robot_with_an_infinite_position_is_not_saved(arm: Path, tmp_path: Path) -> None:
+    """Every table number of a robot built in memory must be finite to be saved: the
+    folder's reader would refuse it. Named by table, row and CSV column."""
+    import dataclasses
+    import math
+
+    from robotwright.hrdf.model import HRDF
+
+    robot = HRDF.from_dir(arm)
+    body = robot.bodies[3]
+    robot.bodies[3] = dataclasses.replace(body, pos=(body.pos[0], body.pos[1], math.inf))
+    with pytest.raises(HRDFError) as info:
+        robot.save(tmp_path / "out")
+    assert has(
+        info.value.problems, "body.csv", "expected a finite number, got 'inf'", row=3, column="pos2"
+    )
+    assert not (tmp_path / "out").exists()

@@ -301,3 +301,26 @@ def test_urdf_with_finite_numbers_still_converts(tmp_path) -> None:
     path = tmp_path / "r.urdf"
     path.write_text(f'<robot name="r">{_LINK.format(**_SANE)}</robot>')
     assert urdf_to_hrdf(path).bodies[0].mass == 1.0
+
+
+@pytest.mark.parametrize(
+    ("element", "expected"),
+    [
+        ("<joint name='j' damping='inf'/>", "column 'viscous_friction': expected a finite number"),
+        ("<joint name='j' armature='nan'/>", "column 'armature': expected a finite number"),
+    ],
+)
+def test_mjcf_values_a_folder_cannot_hold_are_refused_by_convert(
+    tmp_path, capsys, element, expected
+) -> None:
+    """MuJoCo takes inf and nan in these attributes; an HRDF folder cannot hold them (its
+    reader refuses them), so ``convert`` refuses to write a folder that would not load."""
+    source = tmp_path / "m.xml"
+    source.write_text(
+        f"<mujoco><worldbody><body name='a'>{element}<geom size='0.1'/></body></worldbody></mujoco>"
+    )
+    out = tmp_path / "out"
+    assert main(["convert", str(source), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "joint.csv: row 0" in err and expected in err
+    assert not out.exists()

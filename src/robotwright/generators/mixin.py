@@ -50,7 +50,11 @@ class HRDFMixin:
         if validate:
             from robotwright.hrdf.validate import check_model
 
-            errors = [p for p in check_model(hrdf, check_files=False) if p.severity == "error"]
+            # Table numbers are not checked finite here (it would double the check's
+            # cost on every export): MJCF takes inf as MuJoCo does, masses and inertias
+            # are checked finite all the same, and a saved folder is checked in full.
+            problems = check_model(hrdf, check_files=False, finite=False)
+            errors = [p for p in problems if p.severity == "error"]
             if errors:
                 raise HRDFError(errors, f"robot '{hrdf.name}' cannot be generated")
         self.hrdf = hrdf

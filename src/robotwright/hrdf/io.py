@@ -721,7 +721,8 @@ def collect_hrdf_dir(
     )
     if any(b is None for b in hrdf.bodies):
         return None, problems
-    problems.extend(check_model(hrdf, check_files=True))
+    # Every cell was checked finite as it was read.
+    problems.extend(check_model(hrdf, check_files=True, finite=False))
     return hrdf, problems
 
 
@@ -744,7 +745,9 @@ def read_hrdf_dir(
 # --------------------------------------------------------------------------------- write
 
 
-def _table_rows(hrdf: HRDF, stem: str) -> list[Any]:
+def table_rows(hrdf: HRDF, stem: str) -> list[Any]:
+    """The records of table ``stem`` in CSV row order (``joint``: the free joint is in
+    ``meta.yaml``, not a row)."""
     if stem == "body":
         return list(hrdf.bodies)
     if stem == "joint":
@@ -769,7 +772,7 @@ def _column_needed(col: Column, rows: list[Any]) -> bool:
 
 def table_csv(hrdf: HRDF, stem: str) -> str | None:
     """The CSV text of one table, or ``None`` when the table has no rows."""
-    rows = _table_rows(hrdf, stem)
+    rows = table_rows(hrdf, stem)
     if not rows:
         return None
     schema = TABLES[stem]

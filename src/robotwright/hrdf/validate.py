@@ -692,8 +692,43 @@ def check_extra(text: str | None) -> list[Problem]:
     return out
 
 
-def check_model(hrdf: HRDF, *, check_files: bool = True) -> list[Problem]:
-    """All problems of an in-memory model (empty list when it is valid)."""
+def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> list[Problem]:
+    """Every number a table holds is finite, as the CSV reader requires of a folder: a
+    robot built in memory (by a parser, in Python) would otherwise be saved as a folder
+    that does not load. Cells of a field ``reported`` already (table, row, field) are
+    left out."""
+    from robotwright.hrdf.io import table_rows
+    from robotwright.hrdf.tables import TABLES
+
+    out: list[Problem] = []
+    for stem, schema in TABLES.items():
+        table = f"{stem}.csv"
+        columns = [c for c in schema if c.kind == "float"]
+        scalars = [c.field for c in columns if c.size == 0]
+        vectors = [c.field for c in columns if c.size]
+        for row, record in enumerate(table_rows(hrdf, stem)):
+            # Fast pass: a sum is finite exactly when every term is (or it overflowed,
+            # which the cell-by-cell pass below then clears).
+            total = sum(v for f in scalars if (v := getattr(record, f)) is not None)
+            total += sum(sum(v) for f in vectors if (v := getattr(record, f)) is not None)
+            if math.isfinite(total):
+                continue
+            for col in columns:
+                value = getattr(record, col.field)
+                if value is None or (table, row, col.field) in reported:
+                    continue
+                values = (value,) if col.size == 0 else value
+                for header, v in zip(col.headers, values, strict=False):
+                    if not math.isfinite(v):
+                        message = f"expected a finite number, got '{v!r}'"
+                        out.append(Problem(table, message, row=row, column=header))
+    return out
+
+
+def check_model(hrdf: HRDF, *, check_files: bool = True, finite: bool = True) -> list[Problem]:
+    """All problems of an in-memory model (empty list when it is valid). ``finite=False``
+    skips the check that every table number is finite (for records read from CSV,
+    whose cells the reader checked)."""
     problems = _check_tree(hrdf)
     problems += _check_bodies(hrdf)
     body_names = {b.name for b in hrdf.bodies}
@@ -703,6 +738,9 @@ def check_model(hrdf: HRDF, *, check_files: bool = True) -> list[Problem]:
     problems += _check_sites_sensors(hrdf, body_names)
     problems += _check_meta(hrdf, body_names)
     problems += check_extra(hrdf.mjcf_extra)
+    if finite:
+        reported = {(p.file, p.row, p.column) for p in problems if p.column is not None}
+        problems += _check_finite(hrdf, reported)
     return problems
 
 
