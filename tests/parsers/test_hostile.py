@@ -285,8 +285,9 @@ _SANE = {"xyz": "0 0 0", "mass": "1", "ixx": "1", "box": "1 1 1", "lower": "-1"}
     ],
 )
 def test_urdf_numbers_must_be_finite(tmp_path, capsys, field, value, expected) -> None:
-    """Python reads "1e400", "inf" and "nan" as floats; MuJoCo's reader refuses them, and
-    so does ours, naming the element, instead of writing an infinite mass."""
+    """Python reads "1e400", "inf" and "nan" as floats; MuJoCo's URDF reader refuses the
+    first and takes the others (a mass of inf compiles). An HRDF cannot hold them: the
+    parser refuses all three, naming the element, instead of writing an infinite mass."""
     path = tmp_path / "r.urdf"
     path.write_text(f'<robot name="r">{_LINK.format(**{**_SANE, field: value})}</robot>')
     with pytest.raises(ConversionError, match=re.escape(expected)):
