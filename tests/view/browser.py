@@ -8,11 +8,13 @@ Debian's ``chromium`` package (``tools/fetch_test_data.py`` installs it where it
 from __future__ import annotations
 
 import base64
+import contextlib
 import io
 import itertools
 import json
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -62,6 +64,9 @@ class Browser:
             ],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
+            # Its own process group: close() ends the helpers it starts (renderer, GPU,
+            # crash handler) too, which otherwise write into the profile after it exits.
+            start_new_session=True,
         )
         port_file = Path(self._profile.name) / "DevToolsActivePort"
         deadline = time.monotonic() + 30
@@ -141,13 +146,26 @@ class Browser:
         ws = getattr(self, "_ws", None)
         if ws is not None:
             ws.close()
-        self._proc.terminate()
+        self._signal_group(signal.SIGTERM)
         try:
             self._proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
-            self._proc.kill()
+            self._signal_group(signal.SIGKILL)
             self._proc.wait()
-        self._profile.cleanup()
+        self._signal_group(signal.SIGKILL)  # helpers that outlived the browser
+        # A helper killed just now may have written one last file: try a few times.
+        for attempt in range(5):
+            try:
+                self._profile.cleanup()
+                break
+            except OSError:
+                if attempt == 4:
+                    raise
+                time.sleep(0.2)
+
+    def _signal_group(self, sig: signal.Signals) -> None:
+        with contextlib.suppress(ProcessLookupError):  # the group has no process left
+            os.killpg(self._proc.pid, sig)
 
     def __enter__(self) -> Browser:
         return self
