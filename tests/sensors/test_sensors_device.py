@@ -246,3 +246,18 @@ def test_cpu_blocks_give_the_same_frame_as_one_launch(clutter_model):
         assert torch.equal(one.get_hit_mask(), three.get_hit_mask())
         assert torch.equal(one.data.ray_directions_w, three.data.ray_directions_w)
     assert 0.0 < one.get_hit_mask().float().mean() < 1.0
+
+
+def test_a_pipeline_refused_while_made_closes_cleanly() -> None:
+    """An unknown device is refused in ``__init__``; the half-made pipeline's ``close``
+    (which ``__del__`` calls) must not raise, or the refusal ends in a second error."""
+    from robotwright.sensors.device import WarpLidarPipeline
+
+    model = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>"
+    )
+    pipeline = WarpLidarPipeline.__new__(WarpLidarPipeline)
+    with pytest.raises(SensorError, match="warp device 'nope:7' is not available"):
+        pipeline.__init__(model, 1, "nope:7", None, ("body", 0), None, None, "yaw", None, None)
+    pipeline.close()  # raised AttributeError ('_pool') before
+    assert getattr(pipeline, "_pool", None) is None

@@ -188,8 +188,10 @@ class WarpLidarPipeline:
         self._pool = ThreadPoolExecutor(len(self._blocks)) if len(self._blocks) > 1 else None
 
     def close(self) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=False)
+        # getattr: __del__ runs this on a pipeline whose __init__ raised before the pool.
+        pool = getattr(self, "_pool", None)
+        if pool is not None:
+            pool.shutdown(wait=False)
             self._pool = None
 
     def __del__(self) -> None:  # pragma: no cover - best effort at interpreter teardown
