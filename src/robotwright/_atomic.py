@@ -249,7 +249,7 @@ def write_bytes_atomic(path: Path, data: bytes) -> None:
 
 
 def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` (UTF-8, ``\n`` line ends as given) to ``path``; see
+    """Write ``text`` (UTF-8, line ends as given) to ``path``; see
     :func:`write_bytes_atomic`."""
     write_bytes_atomic(path, text.encode("utf-8"))
 

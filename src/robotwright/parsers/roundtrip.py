@@ -19,7 +19,7 @@ import functools
 import os
 import tempfile
 from collections.abc import Callable
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -743,10 +743,6 @@ def _yourdfpy_instead(path: Path, compiler: dict[str, Any], exc: ValueError) -> 
     return view
 
 
-def _raise(exc: Exception) -> RobotView:
-    raise exc
-
-
 def reference_loader(path: Path, reference: str = "auto", **options: Any) -> ReferenceLoader:
     """The reference of ``path`` (see :func:`reference_view`), prepared to be loaded."""
     _check_reference(reference)
@@ -768,7 +764,7 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
     except ValueError as exc:
         if fallback is None:
             raise
-        return ReferenceLoader(functools.partial(_raise, exc), fallback)
+        return ReferenceLoader(functools.partial(fallback, exc))  # yourdfpy's from the start
     return ReferenceLoader(lambda: view_from_model(compile_urdf(text), "mujoco"), fallback)
 
 
@@ -835,22 +831,6 @@ def _roundtrip(
         return _roundtrip_on(pool, path, configs, urdf, reference, options)
 
 
-def _reference_job(
-    pool: ThreadPoolExecutor, path: Path, reference: str, options: dict[str, Any]
-) -> tuple[Future, ReferenceLoader | None]:
-    """MuJoCo's import of the reference, started on ``pool`` (a failure to prepare it is
-    the job's), and its loader: the fallback runs later, only if it is needed."""
-    try:
-        loader = reference_loader(
-            path, reference, **{k: v for k, v in options.items() if k != "work_dir"}
-        )
-    except Exception as exc:  # reported by the caller with the job's result
-        failed: Future = Future()
-        failed.set_exception(exc)
-        return failed, None
-    return pool.submit(loader.load), loader
-
-
 def _roundtrip_on(
     pool: ThreadPoolExecutor,
     path: Path,
@@ -881,7 +861,14 @@ def _roundtrip_on(
         # this answer (MuJoCo 4.0 spends 20 s refusing a chain of 2,000 links).
         report.error = f"our MJCF is not written: {type(exc).__name__}: {exc}"
         return report
-    ref_job, loader = _reference_job(pool, path, reference, options)
+    try:
+        loader = reference_loader(
+            path, reference, **{k: v for k, v in options.items() if k != "work_dir"}
+        )
+    except Exception as exc:
+        report.error = f"no reference: {type(exc).__name__}: {exc}"
+        return report
+    ref_job = pool.submit(loader.load)  # MuJoCo's import; a fallback runs only if needed
     mjcf_job = pool.submit(lambda: mujoco.MjSpec.from_string(mjcf_text).compile())
     ours_urdf: OurURDF | Exception | None = None
     urdf_job = None
@@ -896,8 +883,6 @@ def _roundtrip_on(
         try:
             ref = ref_job.result()
         except ValueError as exc:
-            if loader is None:
-                raise
             ref = loader.instead(exc)
     except Exception as exc:
         report.error = f"no reference: {type(exc).__name__}: {exc}"

@@ -132,8 +132,8 @@ class URDFOptions:
 
 
 def _finite(text: str) -> float:
-    """A URDF number: finite, as MuJoCo's reader requires ("1e400", "inf" and "nan" are
-    refused there too). Raises ValueError."""
+    """A URDF number, finite as an HRDF holds it ("1e400", "inf" and "nan" are refused;
+    MuJoCo's reader refuses the first and takes the others). Raises ValueError."""
     value = float(text)
     if not math.isfinite(value):
         raise ValueError(f"{text!r} is not a finite number")
