@@ -312,13 +312,18 @@ class BaseThing(metaclass=ThingType):
             requested[(thing._NAMESPACE, base)] = requested.get((thing._NAMESPACE, base), 0) + 1
         resolved: dict[int, str] = {}
         taken: set[tuple[str, str]] = set()
+        # The next suffix to try per requested name. ``taken`` only grows, so a suffix
+        # refused once stays refused: each name resumes where its last clash stopped
+        # (linear in the number of clashes; restarting at 1 made 20,000 copies quadratic).
+        next_k: dict[tuple[str, str], int] = {}
         for thing, base in wanted:
             ns = thing._NAMESPACE
             final = base
             if (ns, base) in taken:
-                k = 1
+                k = next_k.get((ns, base), 1)
                 while (ns, f"{base}_{k}") in taken or (ns, f"{base}_{k}") in requested:
                     k += 1
+                next_k[(ns, base)] = k + 1
                 final = f"{base}_{k}"
             taken.add((ns, final))
             resolved[thing.ID] = final
@@ -348,6 +353,25 @@ class BaseThing(metaclass=ThingType):
         return new
 
     def _copy_tree(self, memo: dict[int, BaseThing], overrides: dict[str, Any]) -> BaseThing:
+        # Iterative (a chain of thousands of bodies exceeds Python's recursion limit).
+        # Copies are made depth-first in child order, as MJCF lists them; children are
+        # attached from the deepest up, so each parent is still a root when it receives
+        # its children (attach checks the parent's path: cheap for a root).
+        made: list[tuple[BaseThing, BaseThing]] = []
+        stack: list[BaseThing] = [self]
+        while stack:
+            node = stack.pop()
+            new = node._copy_one(overrides if node is self else {})
+            memo[node.ID] = new
+            made.append((node, new))
+            stack.extend(reversed(node._children))
+        for node, new in reversed(made):
+            if node._children:
+                new.attach(*(memo[child.ID] for child in node._children))
+        return memo[self.ID]
+
+    def _copy_one(self, overrides: dict[str, Any]) -> BaseThing:
+        """A copy of this Thing alone (no children); ``overrides`` replace attributes."""
         args: dict[str, Any] = {}
         for key in self._BLUEPRINT_ATTR:
             if key in overrides or key in self._DERIVED_ATTR:
@@ -355,8 +379,4 @@ class BaseThing(metaclass=ThingType):
             value = self._name if key == "name" else self.__dict__.get(key)
             args[key] = value if key in self._NO_COPY_VALS else _copy.deepcopy(value)
         args.update(overrides)
-        new = type(self)(**args)
-        memo[self.ID] = new
-        for child in self._children:
-            new.attach(child._copy_tree(memo, {}))
-        return new
+        return type(self)(**args)

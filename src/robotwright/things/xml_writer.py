@@ -116,15 +116,16 @@ class _Writer:
                 seen.add(tex.ID)
                 requested.insert(requested.index(asset), tex)
         taken: set[tuple[str, str]] = set()
+        next_k: dict[tuple[str, str], int] = {}
         for asset in requested:
             self.asset_names[asset.ID] = _unique(
-                taken, asset._TAG, asset.__dict__.get("_name") or asset._TAG
+                taken, asset._TAG, asset.__dict__.get("_name") or asset._TAG, next_k
             )
         self.assets = requested
         unique: dict[str, str] = {}
         for geom, asset_tag, ident in owned:
             if ident not in unique:
-                unique[ident] = _unique(taken, asset_tag, self._owned_base[ident])
+                unique[ident] = _unique(taken, asset_tag, self._owned_base[ident], next_k)
                 self._owned_assets.append((unique[ident], geom))
             self.mesh_of_geom[geom.ID] = unique[ident]
 
@@ -254,12 +255,20 @@ def _hashable(value: Any) -> Any:
     return value
 
 
-def _unique(taken: set[tuple[str, str]], kind: str, base: str) -> str:
+def _unique(
+    taken: set[tuple[str, str]], kind: str, base: str, next_k: dict[tuple[str, str], int]
+) -> str:
+    """``base``, or ``base_k`` with the smallest ``k >= 1`` not ``taken`` yet. ``next_k``
+    remembers where each base's search stopped (``taken`` only grows), so many assets
+    of one name cost linear time, not quadratic."""
     name = base
-    k = 1
-    while (kind, name) in taken:
+    if (kind, name) in taken:
+        k = next_k.get((kind, base), 1)
         name = f"{base}_{k}"
-        k += 1
+        while (kind, name) in taken:
+            k += 1
+            name = f"{base}_{k}"
+        next_k[(kind, base)] = k + 1
     taken.add((kind, name))
     return name
 
