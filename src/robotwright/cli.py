@@ -15,6 +15,7 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 from robotwright import __version__
+from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, collect_notes, summary_line
 from robotwright._paths import trusted_asset_roots
 from robotwright._suggest import did_you_mean
@@ -145,6 +146,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; returns its exit code (2 for bad input, with a one-line error)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    # Text read from input files (names, CSV cells, paths) reaches the terminal in
+    # messages and listings: control and bidirectional characters are shown escaped
+    # (``\x1b``), never sent raw to the terminal.
+    out, err = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = PrintableStream(out), PrintableStream(err)
+    try:
+        return _run(args)
+    finally:
+        sys.stdout, sys.stderr = out, err
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         roots = getattr(args, "asset_roots", None) or []
         with trusted_asset_roots(roots), collect_notes() as caught:
