@@ -21,6 +21,7 @@ from pathlib import Path
 import defusedxml
 import defusedxml.ElementTree as SafeET
 
+from robotwright._names import name_problem
 from robotwright.errors import Problem, UnsafePathError
 from robotwright.hrdf.model import (
     ACTUATOR_TYPES,
@@ -515,10 +516,13 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             try:
                 source = hrdf.mesh_source(m)
             except UnsafePathError as exc:
+                # a NUL cannot escape anything: it is simply not a path
+                written = m.file if m.file is not None else m.name
+                refused = "refused" if "\0" in written else "escapes the robot folder"
                 out.append(
                     Problem(
                         "mesh.csv",
-                        f"mesh file escapes the robot folder: {exc.reason}",
+                        f"mesh file {refused}: {exc.reason}",
                         row=i,
                         column=column,
                     )
@@ -703,9 +707,9 @@ def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> lis
     out: list[Problem] = []
     for stem, schema in TABLES.items():
         table = f"{stem}.csv"
-        columns = [c for c in schema if c.kind == "float"]
-        scalars = [c.field for c in columns if c.size == 0]
-        vectors = [c.field for c in columns if c.size]
+        columns = [c for c in schema if c.kind in ("float", "floats")]
+        scalars = [c.field for c in columns if c.size == 0 and c.kind == "float"]
+        vectors = [c.field for c in columns if c.size or c.kind == "floats"]
         for row, record in enumerate(table_rows(hrdf, stem)):
             # Fast pass: a sum is finite exactly when every term is (or it overflowed,
             # which the cell-by-cell pass below then clears).
@@ -717,11 +721,93 @@ def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> lis
                 value = getattr(record, col.field)
                 if value is None or (table, row, col.field) in reported:
                     continue
-                values = (value,) if col.size == 0 else value
-                for header, v in zip(col.headers, values, strict=False):
+                values = (value,) if col.size == 0 and col.kind == "float" else value
+                headers = [col.csv] * len(values) if col.kind == "floats" else col.headers
+                for header, v in zip(headers, values, strict=False):
                     if not math.isfinite(v):
                         message = f"expected a finite number, got '{v!r}'"
                         out.append(Problem(table, message, row=row, column=header))
+    return out
+
+
+def _check_names(hrdf: HRDF) -> list[Problem]:
+    """Every name a table defines is one XML, CSV and terminals can hold (see
+    :mod:`robotwright._names`): a name with a control character would be written into
+    an MJCF or URDF that no reader accepts."""
+    from robotwright.hrdf.io import table_rows
+
+    out: list[Problem] = []
+    for stem in ("body", "joint", "actuator", "mesh", "simple_geom", "site", "sensor"):
+        for row, record in enumerate(table_rows(hrdf, stem)):
+            for field in ("name", "geom_name"):
+                value = getattr(record, field, None)
+                # Fast pass: most names are short ASCII words.
+                if not value or (value.isascii() and value.isprintable() and len(value) < 64):
+                    continue
+                problem = name_problem(value)
+                if problem is not None:
+                    out.append(
+                        Problem(f"{stem}.csv", f"name {value!r} {problem}", row=row, column=field)
+                    )
+    return out
+
+
+#: ``user`` data per table -> the ``mjcf_size`` key bounding its length.
+_NUSER_OF = {
+    "body": "nuser_body",
+    "joint": "nuser_jnt",
+    "mesh": "nuser_geom",
+    "simple_geom": "nuser_geom",
+    "site": "nuser_site",
+    "actuator": "nuser_actuator",
+    "sensor": "nuser_sensor",
+}
+
+
+def _check_physics_fields(hrdf: HRDF) -> list[Problem]:
+    """The MuJoCo fields MJCF refuses or we refuse as for ``range``: joint
+    ``actuatorfrcrange`` lower > upper, ``actuatorgravcomp`` other than 0/1, ``user``
+    data longer than ``mjcf_size``'s ``nuser_*`` (MuJoCo: "user has more values than
+    nuser")."""
+    from robotwright.hrdf.io import table_rows
+
+    out: list[Problem] = []
+    for row, j in enumerate(table_rows(hrdf, "joint")):
+        rng = j.actuatorfrcrange
+        if rng is not None and rng[0] > rng[1]:
+            out.append(
+                Problem(
+                    "joint.csv",
+                    f"actuatorfrcrange lower {rng[0]} > upper {rng[1]}",
+                    row=row,
+                    column="actuatorfrcrange0",
+                )
+            )
+        if j.actuatorgravcomp not in (0, 1):
+            out.append(
+                Problem(
+                    "joint.csv",
+                    f"actuatorgravcomp {j.actuatorgravcomp!r}: expected 0 or 1",
+                    row=row,
+                    column="actuatorgravcomp",
+                )
+            )
+    sizes = hrdf.meta.mjcf_size
+    for stem, key in _NUSER_OF.items():
+        limit = sizes.get(key)
+        if limit is None:
+            continue
+        for row, record in enumerate(table_rows(hrdf, stem)):
+            if len(record.user) > limit:
+                out.append(
+                    Problem(
+                        f"{stem}.csv",
+                        f"user has {len(record.user)} values, more than meta.yaml "
+                        f"mjcf_size.{key} = {limit}",
+                        row=row,
+                        column="user",
+                    )
+                )
     return out
 
 
@@ -737,6 +823,8 @@ def check_model(hrdf: HRDF, *, check_files: bool = True, finite: bool = True) ->
     problems += _check_geoms(hrdf, body_names, check_files)
     problems += _check_sites_sensors(hrdf, body_names)
     problems += _check_meta(hrdf, body_names)
+    problems += _check_physics_fields(hrdf)
+    problems += _check_names(hrdf)
     problems += check_extra(hrdf.mjcf_extra)
     if finite:
         reported = {(p.file, p.row, p.column) for p in problems if p.column is not None}

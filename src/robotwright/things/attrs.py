@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from robotwright._names import name_problem
 from robotwright.errors import RobotwrightError
 
 
@@ -214,7 +215,12 @@ class Ref(AttrType):
         self.kind = kind
 
     def convert(self, value: Any, owner: Any, name: str) -> Any:
-        if value is None or isinstance(value, str):
+        if value is None:
+            return value
+        if isinstance(value, str):
+            problem = name_problem(value)
+            if problem is not None:
+                raise self.fail(owner, name, value, f"a name (this one {problem})")
             return value
         if self.kind is None and hasattr(value, "_NAMESPACE") and hasattr(value, "ID"):
             return value

@@ -36,6 +36,7 @@ import copy as _copy
 from collections.abc import Iterator
 from typing import Any, ClassVar
 
+from robotwright._names import name_problem
 from robotwright.things.attrs import Extras, Ref, Text, ThingAttributeError
 from robotwright.things.registry import REGISTRY, bump_asset_epoch, next_version
 
@@ -279,6 +280,10 @@ class BaseThing(metaclass=ThingType):
             raise ThingAttributeError(
                 f"{self._label()}.name: got {value!r}, expected a non-empty string or None"
             )
+        problem = None if value is None else name_problem(value)
+        if problem is not None:
+            shown = value if len(value) <= 80 else f"{value[:80]}..."  # type: ignore[index]
+            raise ThingAttributeError(f"{self._label()}.name: {shown!r} {problem}")
         object.__setattr__(self, "_name", value)
         self._touch()
 
