@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-from robotwright._atomic import check_output_path
+from robotwright._atomic import atomic_dir, check_output_path
 from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import GrammarError, InputFileError, Problem
 
@@ -100,27 +100,18 @@ def _warn_long(estimate_s: float, what: str) -> None:
         )
 
 
-def _check_design_dir(out: Path, overwrite: bool) -> None:
+def _check_design_dir(out: Path, overwrite: bool, kind: str = "design") -> None:
     """Refuse an output that would replace something that is not a design folder.
 
-    With ``--overwrite`` the design commands replace an earlier design folder; a file,
-    or a non-empty folder without ``design.txt``, is the user's data and is never
-    replaced.
+    With ``--overwrite`` the design commands replace an earlier design folder (of
+    ``kind``: one design, or the designs of ``grammar sample``); a file, or a non-empty
+    folder robotwright did not write as such, is the user's data and is never replaced
+    (:func:`robotwright._outputs.check_folder_output`).
     """
     check_output_path(out, folder=True)
     if out.exists() and not out.is_dir():
         raise GrammarError([Problem(str(out), "is a file; expected a folder for the design")])
-    if out.is_dir() and any(out.iterdir()) and not (out / "design.txt").is_file():
-        raise GrammarError(
-            [
-                Problem(
-                    str(out),
-                    "folder is not empty and holds no design.txt: not replacing it; "
-                    "give a new or empty folder",
-                )
-            ]
-        )
-    check_overwrite(out, overwrite)
+    check_overwrite(out, overwrite, kind=kind)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -242,7 +233,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--workers",
         type=_int_at_least(1),
         default=None,
-        help="worker processes (default: CPU count)",
+        help="worker processes (default: CPU count; at most the CPU count unless "
+        "--force-workers is given)",
+    )
+    q.add_argument(
+        "--force-workers",
+        action="store_true",
+        help="allow --workers above the CPU count (each worker is a process started at once)",
     )
     q.add_argument(
         "-o", "--out", type=Path, default=None, help="write the best design's files here"
@@ -302,7 +299,12 @@ def _check(args: argparse.Namespace) -> int:
     try:
         print(f"  designs by number of links 0..3: {count_by_links(g, 3)}")
     except GrammarError as exc:
-        print(f"  counts: {exc}")
+        # Infinitely many designs of one link count: count, sample and search cannot
+        # work with it (--max-links bounds links only), so the grammar is not valid.
+        for p in exc.problems:
+            print(f"{p.severity}: {p}")
+        print(f"{args.file}: {sum(p.severity == 'error' for p in exc.problems)} error(s)")
+        return 1
     print(f"{args.file}: valid")
     return 0
 
@@ -344,18 +346,19 @@ def _sample(args: argparse.Namespace) -> int:
     check_output_path(args.out, folder=True)
     if args.out.exists() and not args.out.is_dir():
         raise GrammarError([Problem(str(args.out), "is a file; expected a folder for the designs")])
-    check_overwrite(args.out, args.overwrite)
-    args.out.mkdir(parents=True, exist_ok=True)
+    check_overwrite(args.out, args.overwrite, kind="designs")
     progress = Progress(args.n, "designs written")
-    for k in range(args.n):
-        d = sample(g, args.max_links, rng, counter)
-        folder = export_design(
-            g, d, args.out / f"{k:03d}_{d.hash()}", picture=not args.no_picture, overwrite=True
-        )
-        print(f"{folder}: {d}", flush=True)
-        if k == 0:
-            _warn_long((progress.eta(1) or 0.0), f"writing {args.n} designs")
-        progress.update(k + 1)
+    # All or nothing: the designs are written into a temporary folder that becomes
+    # args.out at the end (a full disk or Ctrl-C leaves the old output, or none).
+    with atomic_dir(args.out, kind="designs") as tmp:
+        for k in range(args.n):
+            d = sample(g, args.max_links, rng, counter)
+            name = f"{k:03d}_{d.hash()}"
+            export_design(g, d, tmp / name, picture=not args.no_picture, overwrite=True)
+            print(f"{args.out / name}: {d}", flush=True)
+            if k == 0:
+                _warn_long((progress.eta(1) or 0.0), f"writing {args.n} designs")
+            progress.update(k + 1)
     return 0
 
 
@@ -378,7 +381,7 @@ def _search_progress(budget: int, name: str):
 def _search(args: argparse.Namespace) -> int:
     from robotwright.grammar.export import export_design
     from robotwright.grammar.objectives import OBJECTIVES, make_constraint
-    from robotwright.grammar.search import beam_search, mcts_search, random_search
+    from robotwright.grammar.search import beam_search, check_workers, mcts_search, random_search
 
     g = _grammar(args)
     if args.out:
@@ -388,6 +391,11 @@ def _search(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    try:
+        check_workers(args.workers, args.force_workers, "--force-workers")
+    except ValueError as exc:
+        print(f"error: --workers: {exc}", file=sys.stderr)
+        return 2
     objective = OBJECTIVES[args.objective]()
     t0 = time.perf_counter()
     kw = dict(
@@ -395,6 +403,7 @@ def _search(args: argparse.Namespace) -> int:
         max_links=args.max_links,
         seed=args.seed,
         workers=args.workers,
+        force_workers=args.force_workers,
         progress=_search_progress(args.budget, objective.name),
     )
     if args.method == "beam":

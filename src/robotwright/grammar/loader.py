@@ -7,6 +7,7 @@ whose entries name the file, the rule or component, and the field.
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from importlib import resources
 from pathlib import Path
@@ -15,6 +16,7 @@ from typing import Any
 import yaml
 
 from robotwright._inputs import load_yaml
+from robotwright._names import name_problem
 from robotwright._paths import resolve_inside
 from robotwright.errors import GrammarError, InputFileError, Problem, UnsafePathError
 from robotwright.grammar.library import (
@@ -31,6 +33,31 @@ from robotwright.grammar.symbols import NodePattern, NodeState, Symbol, parse_ch
 
 class GrammarWarning(UserWarning):
     """Something in a grammar is suspicious but not wrong (e.g. a symbol never produced)."""
+
+
+#: The names a design file (design.txt, see robotwright.grammar.design) can hold: a
+#: rule, symbol or parameter name is a word, a component name may also hold '-', a
+#: grammar name holds no blank. A grammar with other names would write designs that
+#: cannot be read back.
+_WORD = re.compile(r"[A-Za-z_]\w*\Z")
+_COMPONENT_WORD = re.compile(r"[A-Za-z_][\w-]*\Z")
+_NO_BLANK = re.compile(r"\S+\Z")
+_EXPECTED = {
+    _WORD: "a letter or '_' followed by letters, digits or '_'",
+    _COMPONENT_WORD: "a letter or '_' followed by letters, digits, '_' or '-'",
+    _NO_BLANK: "a name without blanks",
+}
+
+
+def _name_error(name: object, pattern: re.Pattern[str]) -> str | None:
+    """Why ``name`` cannot name a grammar part (``pattern``: what design files hold)."""
+    text = str(name)
+    problem = name_problem(text)
+    if problem is not None:
+        return f"name {text!r} {problem}"
+    if pattern.match(text) is None:
+        return f"name {text!r}: expected {_EXPECTED[pattern]} (as design files write it)"
+    return None
 
 
 _GRAMMAR_KEYS = {"name", "start", "symbols", "rules", "link_symbols", "library", "description"}
@@ -137,6 +164,10 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
         )
         raw = {}
     for cname, spec in raw.items():
+        bad = _name_error(cname, _COMPONENT_WORD)
+        if bad is not None:
+            problems.append(Problem(f, bad, column="components"))
+            continue
         where = f"component '{cname}'"
 
         def err(msg: str, col: str | None = None, _w: str = where) -> None:
@@ -168,6 +199,10 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
             port_lists[key] = tuple(str(p) for p in vals)
         params: dict[str, ParamDomain] = {}
         for pname, pspec in (spec.get("params") or {}).items():
+            bad = _name_error(pname, _WORD)
+            if bad is not None:
+                err(bad, "params")
+                continue
             col = f"params.{pname}"
             if not isinstance(pspec, dict) or "range" not in pspec or "values" not in pspec:
                 err("expected {range: [low, high], values: [...]}", col)
@@ -354,6 +389,10 @@ def _parse_grammar(
         problems.append(Problem(f, "expected a non-empty mapping of symbols", column="symbols"))
         raw_syms = {}
     for sname, spec in raw_syms.items():
+        bad = _name_error(sname, _WORD)
+        if bad is not None:
+            problems.append(Problem(f, bad, column="symbols"))
+            continue
         spec = spec if isinstance(spec, dict) else {"kind": spec}
         try:
             symbols[str(sname)] = Symbol(
@@ -378,6 +417,10 @@ def _parse_grammar(
         problems.append(Problem(f, "expected a non-empty mapping of rules", column="rules"))
         raw_rules = {}
     for rname, spec in raw_rules.items():
+        bad = _name_error(rname, _WORD)
+        if bad is not None:
+            problems.append(Problem(f, bad, column="rules"))
+            continue
         where = f"rule '{rname}'"
         if not isinstance(spec, dict):
             problems.append(Problem(f, "expected {lhs, rhs}", element=where))
@@ -466,10 +509,15 @@ def _parse_grammar(
                     element=f"component '{comp.name}'",
                 )
             )
+    name = str(data.get("name", path.stem))
+    bad = _name_error(name, _NO_BLANK)
+    if bad is not None:
+        # The name of the file when it has no 'name' field.
+        problems.append(Problem(f, bad, column="name"))
     if start not in symbols:
         return None
     return Grammar(
-        name=str(data.get("name", path.stem)),
+        name=name,
         start=str(start),
         symbols=symbols,
         rules=rules,

@@ -20,6 +20,39 @@ from robotwright.grammar.objectives import Constraint, Evaluation, Objective, ev
 from robotwright.grammar.rules import Grammar
 
 
+def usable_cores() -> int:
+    """The number of CPU cores this process may run on (its affinity where the system
+    reports one, else the machine's count)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def check_workers(
+    workers: int | None, force: bool = False, how_to_force: str = "force_workers=True"
+) -> None:
+    """Refuse a worker count the machine cannot run at once.
+
+    Each worker is a process: a count far above the cores only costs memory and start-up
+    time (5,000 requested started 5,000 processes). At most :func:`usable_cores` workers
+    are accepted unless ``force`` is true (``how_to_force`` says how, in the message).
+
+    Raises:
+        ValueError: ``workers`` is below 1, or above the cores without ``force``.
+    """
+    if workers is None:
+        return
+    if workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    cores = usable_cores()
+    if workers > cores and not force:
+        raise ValueError(
+            f"{workers} worker processes requested, but this machine has {cores} core(s): "
+            f"expected at most {cores} ({how_to_force} starts more)"
+        )
+
+
 @dataclass
 class SearchResult:
     """Best design found and every evaluation made (in order)."""
@@ -44,7 +77,10 @@ class _Evaluator:
         executor: Executor | None,
         workers: int | None,
         progress: Callable[[int, Evaluation | None], None] | None = None,
+        force_workers: bool = False,
     ) -> None:
+        if executor is None:  # the pool started here has ``workers`` processes
+            check_workers(workers, force_workers)
         self.progress = progress
         self.fn = bind(
             evaluate, grammar, objectives=tuple(objectives), constraints=tuple(constraints)
@@ -58,7 +94,10 @@ class _Evaluator:
 
     def __enter__(self) -> _Evaluator:
         if self.executor is None:
-            self.executor = ProcessPoolExecutor(max_workers=self.workers or os.cpu_count() or 1)
+            # Never more processes than evaluations: a forced count above the budget
+            # would only start idle processes.
+            wanted = self.workers or usable_cores()
+            self.executor = ProcessPoolExecutor(max_workers=max(1, min(wanted, self.budget)))
         return self
 
     def __exit__(self, *exc) -> None:
@@ -105,11 +144,14 @@ def random_search(
     executor: Executor | None = None,
     workers: int | None = None,
     progress: Callable[[int, Evaluation | None], None] | None = None,
+    force_workers: bool = False,
 ) -> SearchResult:
     """Evaluate ``budget`` distinct designs drawn uniformly (baseline for beam search)."""
     rng = random.Random(seed)
     counter = Counter(grammar)
-    with _Evaluator(grammar, objectives, constraints, budget, executor, workers, progress) as ev:
+    with _Evaluator(
+        grammar, objectives, constraints, budget, executor, workers, progress, force_workers
+    ) as ev:
         tries = 0
         while ev.left > 0 and tries < 20 * budget:
             batch = [sample(grammar, max_links, rng, counter) for _ in range(ev.left)]
@@ -131,6 +173,7 @@ def beam_search(
     executor: Executor | None = None,
     workers: int | None = None,
     progress: Callable[[int, Evaluation | None], None] | None = None,
+    force_workers: bool = False,
 ) -> SearchResult:
     """Beam search over partial derivations in canonical order.
 
@@ -144,7 +187,9 @@ def beam_search(
     rng = random.Random(seed)
     counter = Counter(grammar)
     beam = [Partial.start(grammar)]
-    with _Evaluator(grammar, objectives, constraints, budget, executor, workers, progress) as ev:
+    with _Evaluator(
+        grammar, objectives, constraints, budget, executor, workers, progress, force_workers
+    ) as ev:
         while beam and ev.left > 0:
             children: list[Partial] = []
             for p in beam:
@@ -218,6 +263,7 @@ def mcts_search(
     executor: Executor | None = None,
     workers: int | None = None,
     progress: Callable[[int, Evaluation | None], None] | None = None,
+    force_workers: bool = False,
 ) -> SearchResult:
     """Monte Carlo tree search (UCT) over the decisions of canonical derivations.
 
@@ -245,7 +291,9 @@ def mcts_search(
     def value(n: _Node) -> float:
         return 0.5 * (n.total / n.visits) + 0.5 * n.best if n.visits else 0.0
 
-    with _Evaluator(grammar, objectives, constraints, budget, executor, workers, progress) as ev:
+    with _Evaluator(
+        grammar, objectives, constraints, budget, executor, workers, progress, force_workers
+    ) as ev:
         k = batch or max(1, 2 * (ev.workers or os.cpu_count() or 1))
         stalls = 0
         while ev.left > 0 and stalls < 50 and (root.untried or root.children):
