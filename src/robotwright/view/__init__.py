@@ -63,7 +63,7 @@ def show(
     source: str | os.PathLike[str] | HRDF | mujoco.MjModel,
     *,
     scene: str | os.PathLike[str] | None = None,
-    port: int = 8080,
+    port: int | None = None,
     host: str = "127.0.0.1",
     asset_roots: tuple[str | os.PathLike[str], ...] = (),
     **config: Any,
@@ -76,8 +76,10 @@ def show(
             or an ``HRDF`` / ``mujoco.MjModel`` object (see
             :func:`~robotwright.view.scene.load_source`).
         scene: the MJCF scene a scan was taken in.
-        port: TCP port (the next free one when taken; 0 for any).
-        host: address to listen on (``127.0.0.1``: this machine only).
+        port: TCP port, that one only (a :class:`ViewError` when it is taken); None:
+            8080 or the next free one; 0 for any free port.
+        host: address to listen on (``127.0.0.1``: this machine only; another address
+            warns that other machines can see the model).
         asset_roots: folders outside the source's folder its files may come from.
         config: other :class:`ViewerConfig` fields (``geom_groups``, ``body_frames``...).
     """
@@ -85,4 +87,9 @@ def show(
     from robotwright.view.server import Viewer, ViewerConfig
 
     cfg = ViewerConfig(host=host, port=port, **config)
-    return Viewer(load_source(source, scene=scene, asset_roots=asset_roots), cfg)
+    viewer = Viewer(load_source(source, scene=scene, asset_roots=asset_roots), cfg)
+    if viewer.exposure:
+        import warnings
+
+        warnings.warn(viewer.exposure, UserWarning, stacklevel=2)
+    return viewer

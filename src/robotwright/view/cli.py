@@ -25,6 +25,16 @@ def _port(text: str) -> int:
     return value
 
 
+def _origin(text: str) -> str:
+    from robotwright.view.gate import parse_origin
+
+    if parse_origin(text) is None:
+        raise argparse.ArgumentTypeError(
+            f"expected an origin scheme://host[:port] (http or https, no path), got {text!r}"
+        )
+    return text
+
+
 def _groups(text: str) -> tuple[int, ...]:
     try:
         groups = tuple(int(g) for g in text.split(",") if g.strip())
@@ -52,12 +62,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--scene", type=Path, help="MJCF scene a scan .npz was taken in")
     p.add_argument(
-        "--port", type=_port, default=8080, help="TCP port (default 8080; next free if taken)"
+        "--port",
+        type=_port,
+        default=None,
+        help="TCP port, an error when taken (default: 8080, or the next free one); 0 for any",
     )
     p.add_argument(
         "--host",
         default="127.0.0.1",
-        help="address to listen on (default 127.0.0.1, this machine only; 0.0.0.0 for all)",
+        help="address to listen on (default 127.0.0.1, this machine only; 0.0.0.0 for all, "
+        "with a warning)",
+    )
+    p.add_argument(
+        "--allow-origin",
+        action="append",
+        dest="allow_origins",
+        type=_origin,
+        default=[],
+        metavar="ORIGIN",
+        help="also let pages of ORIGIN (e.g. http://robot-pc.lan:8080) connect, and accept "
+        "its host name in requests; for deliberate remote use; repeatable",
     )
     p.add_argument(
         "--groups",
@@ -97,9 +121,12 @@ def _run(args: argparse.Namespace) -> int:
         body_frames=args.frames,
         site_frames=args.frames,
         plain=args.plain,
+        allowed_origins=tuple(args.allow_origins),
         **options,
     )
     viewer = Viewer(scene, config)
+    if viewer.exposure:
+        print(f"warning: {viewer.exposure}", file=sys.stderr)
     m = scene.model
     print(
         f"{scene.title}: {m.nbody - 1} bodies, {m.njnt} joints, {viewer.geom_count} geoms shown"

@@ -10,9 +10,12 @@ point cloud (``/scan/points``) in the world frame, coloured by class, with a leg
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import html
 import io
+import math
+import numbers
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -22,6 +25,8 @@ import mujoco
 import numpy as np
 
 from robotwright.sensors.plot import CLASS_COLORS
+from robotwright.view._serve import gated_viser
+from robotwright.view.gate import Gate, bind_listener, check_value, is_loopback, parse_origin
 from robotwright.view.geometry import (
     DEFAULT_GEOM_GROUPS,
     GeomShape,
@@ -56,9 +61,14 @@ class ViewerConfig:
 
     Attributes:
         host: address the server listens on; ``127.0.0.1`` (default) serves this
-            machine only, ``0.0.0.0`` every network interface.
-        port: TCP port; when taken, the next free one is used (the handle's ``url``
-            says which); 0 picks any free port.
+            machine only, ``0.0.0.0`` every network interface (anyone who can reach
+            the machine sees the model: :attr:`Viewer.exposure` says so).
+        port: TCP port, that one only (an error when it is taken); None (default):
+            8080, or the next free one up to 8179 (the handle's ``url`` says which);
+            0 picks any free port.
+        allowed_origins: web origins (``http://robot-pc.lan:8080``) other than the
+            page's own whose pages may connect, for deliberate remote use; their host
+            names are also accepted in the ``Host`` header.
         geom_groups: MuJoCo geom groups shown first (MuJoCo's viewer shows 0, 1, 2).
         body_frames: show the body frames (axes) first.
         site_frames: show the site frames first.
@@ -70,7 +80,8 @@ class ViewerConfig:
     """
 
     host: str = "127.0.0.1"
-    port: int = 8080
+    port: int | None = None
+    allowed_origins: tuple[str, ...] = ()
     geom_groups: tuple[int, ...] = DEFAULT_GEOM_GROUPS
     body_frames: bool = False
     site_frames: bool = False
@@ -80,8 +91,15 @@ class ViewerConfig:
     verbose: bool = False
 
     def __post_init__(self) -> None:
-        if not isinstance(self.port, int) or not 0 <= self.port <= 65535:
+        port_ok = isinstance(self.port, int) and not isinstance(self.port, bool)
+        if self.port is not None and not (port_ok and 0 <= self.port <= 65535):
             raise ViewError(f"port: expected an integer in 0..65535, got {self.port!r}")
+        for origin in self.allowed_origins:
+            if not isinstance(origin, str) or parse_origin(origin) is None:
+                raise ViewError(
+                    f"allowed origin {origin!r}: expected scheme://host[:port] "
+                    "(http or https, no path)"
+                )
         if not self.host or not isinstance(self.host, str):
             raise ViewError(f"host: expected an address, got {self.host!r}")
         bad = [g for g in self.geom_groups if not (isinstance(g, int) and 0 <= g < 6)]
@@ -98,6 +116,10 @@ class Viewer:
         scene: what is shown.
         server: the ``viser.ViserServer`` (add your own scene nodes or controls to it).
         data: the ``mujoco.MjData`` whose ``qpos`` the sliders set.
+        exposure: a warning when the server listens on an address other machines
+            reach (not loopback), else None.
+        refused: the last 100 requests and page messages refused (one line each);
+            ``refused_count`` counts all of them.
     """
 
     def __init__(self, scene: ViewScene, config: ViewerConfig | None = None) -> None:
@@ -118,14 +140,46 @@ class Viewer:
         self._sliders: dict[int, Any] = {}
         self._group_boxes: dict[int, Any] = {}
         self._quiet = False  # set while the code itself moves sliders
+        self.refused: collections.deque[str] = collections.deque(maxlen=100)
+        self.refused_count = 0
+        self._refusals = threading.Condition()
+        self._slider_joint: dict[str, int] = {}  # slider uuid -> joint id
+        listener = bind_listener(self.config.host, self.config.port)
+        address, port = listener.getsockname()[:2]
+        self.exposure = (
+            None
+            if is_loopback(address)
+            else f"listening on {self.config.host} (port {port}): anyone who can reach this "
+            "machine on that port can see the model and move its joints"
+        )
+        gate = Gate(
+            self.config.host,
+            port,
+            tuple(o for o in map(parse_origin, self.config.allowed_origins) if o is not None),
+            refused=self._note_refusal,
+        )
         # viser prints a banner on start; the caller prints the URL instead.
         quiet = contextlib.nullcontext() if self.config.verbose else _quiet_stdout()
-        with quiet:
-            self.server: viser.ViserServer = viser.ViserServer(
-                host=self.config.host,
-                port=self.config.port,
-                label=f"robotwright: {scene.title}",
-                verbose=self.config.verbose,
+        try:
+            with (
+                quiet,
+                gated_viser(listener, gate, self._check_message, self._refuse_message) as gated,
+            ):
+                self.server: viser.ViserServer = viser.ViserServer(
+                    host=self.config.host,
+                    port=port,
+                    label=f"robotwright: {scene.title}",
+                    verbose=self.config.verbose,
+                )
+        except BaseException:
+            listener.close()
+            raise
+        if not gated():
+            self.stop()
+            listener.close()
+            raise ViewError(
+                f"viser {viser.__version__} opens its server in a way robotwright cannot "
+                "guard (Host and Origin checks); use the viser version robotwright requires"
             )
         try:
             self._build()
@@ -155,19 +209,32 @@ class Viewer:
 
     def set_joint(self, name: str, value: float) -> None:
         """Move joint ``name`` to ``value`` (rad for a hinge, m for a slide), as its
-        slider does."""
+        slider does.
+
+        Raises:
+            ViewError (a ``ValueError``): no slider has that name, or ``value`` is not a
+                finite number inside the joint's range (a joint without limits takes
+                any finite value; its slider shows the nearest end of its range).
+        """
         jid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
         if jid < 0 or jid not in self._sliders:
             raise ViewError(f"joint '{name}': no slider for it; sliders: {self.joint_names()}")
+        problem = self._joint_value_problem(jid, value)
+        if problem:
+            raise ViewError(f"joint '{name}': {problem}")
         self._set_qpos_value(jid, float(value))
+        slider = self._sliders[jid]
         with self._sliders_quiet():
-            self._sliders[jid].value = float(value)
+            slider.value = float(np.clip(float(value), slider.min, slider.max))
 
     def set_qpos(self, qpos: np.ndarray) -> None:
-        """Show the configuration ``qpos`` (``model.nq`` values)."""
+        """Show the configuration ``qpos`` (``model.nq`` finite values)."""
         qpos = np.asarray(qpos, dtype=np.float64).reshape(-1)
         if qpos.shape != (self.model.nq,):
             raise ViewError(f"qpos: expected {self.model.nq} values, got {qpos.shape[0]}")
+        bad = np.flatnonzero(~np.isfinite(qpos))
+        if bad.size:
+            raise ViewError(f"qpos[{bad[0]}]: expected a finite number, got {qpos[bad[0]]}")
         with self._lock:
             self.data.qpos[:] = qpos
         with self._sliders_quiet():
@@ -380,7 +447,7 @@ class Viewer:
 
                 @reset.on_click
                 def _(_: Any) -> None:
-                    self.set_qpos(self.scene.initial_qpos())
+                    self._show_pose(self.scene.initial_qpos(), "the first pose")
 
                 if model.nkey:
                     self._add_keyframes()
@@ -398,7 +465,15 @@ class Viewer:
 
         @menu.on_update
         def _(_: Any) -> None:
-            self.set_qpos(model.key_qpos[labels.index(menu.value)])
+            self._show_pose(model.key_qpos[labels.index(menu.value)], f"keyframe {menu.value}")
+
+    def _show_pose(self, qpos: np.ndarray, what: str) -> None:
+        """``set_qpos`` for a control: a pose it cannot show (a model's keyframe may hold
+        NaN) is noted instead of raising in viser's callback thread."""
+        try:
+            self.set_qpos(qpos)
+        except ViewError as exc:
+            self._note_refusal(f"{what}: {exc}")
 
     def _joint_label(self, j: int) -> str:
         return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint {j}"
@@ -423,10 +498,78 @@ class Viewer:
 
         @slider.on_update
         def _(_: Any) -> None:
-            if not self._quiet:
-                self._set_qpos_value(j, float(slider.value))
+            if self._quiet:
+                return
+            # The page's messages were checked on arrival; this also covers a value
+            # set on the handle from Python.
+            problem = check_value(0.0, slider.value, slider.min, slider.max)
+            if problem:
+                self._note_refusal(f"joint '{self._joint_label(j)}': {problem}")
+                return
+            self._set_qpos_value(j, float(slider.value))
 
+        self._slider_joint[slider._impl.uuid] = j
         return slider
+
+    def _joint_value_problem(self, j: int, value: object) -> str | None:
+        """Why ``value`` cannot be joint ``j``'s position, or None."""
+        model = self.model
+        unit = "rad" if int(model.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_HINGE) else "m"
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+            return f"expected a number [{unit}], got {type(value).__name__}"
+        if not math.isfinite(float(value)):
+            return f"expected a finite number [{unit}], got {value}"
+        if model.jnt_limited[j]:
+            lo, hi = (float(x) for x in model.jnt_range[j])
+            if not lo <= float(value) <= hi:
+                return f"{float(value):g} {unit} is outside the joint's range [{lo:g}, {hi:g}]"
+        return None
+
+    # -- messages from the page ----------------------------------------------------------
+    def _check_message(self, message: Any) -> str | None:
+        """Why a message from the page is refused, or None: a control update must set
+        the value of one of this page's controls to a value of its kind (a slider's: a
+        finite number inside its range; a menu's: one of its entries)."""
+        if type(message).__name__ != "GuiUpdateMessage":
+            return None
+        handles = self.server.gui._gui_input_handle_from_uuid
+        handle = handles.get(message.uuid) if isinstance(message.uuid, str) else None
+        if handle is None:
+            return "update of a control this page does not have"
+        updates = message.updates
+        if not isinstance(updates, dict) or set(updates) != {"value"}:
+            return "a control update may set its value only"
+        value = updates["value"]
+        j = self._slider_joint.get(message.uuid)
+        label = f"joint '{self._joint_label(j)}'" if j is not None else f"control {handle.label!r}"
+        problem = check_value(
+            handle.value, value, getattr(handle, "min", None), getattr(handle, "max", None)
+        )
+        options = getattr(handle, "options", None)
+        if problem is None and options is not None and value not in options:
+            problem = f"{value!r} is not one of the menu's entries"
+        return f"{label}: {problem}" if problem else None
+
+    def _refuse_message(self, connection: Any, reason: str) -> None:
+        """Record a refused page message and tell that page why."""
+        self._note_refusal(f"message from the page: {reason}")
+        ws = self.server._websock_server
+        ids = [c for c, conn in list(ws._live_connections.items()) if conn is connection]
+        client = self.server.get_clients().get(ids[0]) if ids else None
+        if client is not None:
+            client.add_notification("Refused", reason, color="red", auto_close_seconds=10.0)
+
+    def _note_refusal(self, reason: str) -> None:
+        with self._refusals:
+            self.refused.append(reason)
+            self.refused_count += 1
+            self._refusals.notify_all()
+
+    def wait_for_refusals(self, count: int, timeout: float) -> bool:
+        """Wait until ``refused_count`` reaches ``count`` (at most ``timeout`` s); True
+        when it did. The page's messages are checked on the server's own thread."""
+        with self._refusals:
+            return self._refusals.wait_for(lambda: self.refused_count >= count, timeout)
 
     @contextlib.contextmanager
     def _sliders_quiet(self) -> Iterator[None]:
