@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 
 import robotwright._atomic as atomic_module
-import robotwright._inputs as inputs
 from robotwright._atomic import (
     atomic_dir,
     atomic_files,
@@ -125,7 +124,7 @@ def _full_disk(*args: object) -> None:
 def test_a_full_disk_names_the_output_and_the_copied_source(tmp_path: Path, monkeypatch) -> None:
     src = tmp_path / "src.bin"
     src.write_bytes(b"mesh")
-    monkeypatch.setattr(inputs, "copy_regular_file", _full_disk)
+    monkeypatch.setattr(atomic_module, "copy_mesh_file", _full_disk)
     dst = tmp_path / "out" / "dst.bin"
     full = f"{dst}: cannot write it: No space left on device (copying {src})"
     with pytest.raises(OutputPathError) as info:

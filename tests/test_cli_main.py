@@ -155,29 +155,37 @@ def test_one_overwrite_rule_for_every_command(tmp_path: Path, capsys) -> None:
         out = str(tmp_path / f"out{i}")
         argv = [a.replace("{out}", out) for a in argv]
         target = Path(str(output).replace("{out}", out))
-        # A file (or a non-empty folder) is kept as it is, with exit 2 naming the flag.
         if target.suffix:
+            # A file is kept as it is, with exit 2 naming the flag; --overwrite replaces it.
             target.write_text("mine", encoding="utf-8")
-        else:
-            target.mkdir()
-            (target / "mine.txt").write_text("mine", encoding="utf-8")
-        assert main(argv) == 2, argv
-        err = capsys.readouterr().err
-        assert f"{target}: " in err and "give --overwrite to replace it" in err, err
-        kept = target if target.suffix else target / "mine.txt"
-        assert kept.read_text(encoding="utf-8") == "mine"
-        # --overwrite replaces it.
-        assert main([*argv, "--overwrite"]) == 0, (argv, capsys.readouterr().err)
-        capsys.readouterr()
-        if target.suffix:
-            assert target.read_bytes() != b"mine"
-        # An empty folder holds nothing to lose: it is written into.
-        if not target.suffix:
-            empty = tmp_path / f"empty{i}"
-            empty.mkdir()
-            assert main([a.replace(out, str(empty)) for a in argv]) == 0, argv
-            assert any(empty.iterdir())
+            assert main(argv) == 2, argv
+            err = capsys.readouterr().err
+            assert f"{target}: " in err and "give --overwrite to replace it" in err, err
+            assert target.read_text(encoding="utf-8") == "mine"
+            assert main([*argv, "--overwrite"]) == 0, (argv, capsys.readouterr().err)
             capsys.readouterr()
+            assert target.read_bytes() != b"mine"
+            continue
+        # A folder of the user's is never replaced, --overwrite or not (exit 2).
+        target.mkdir()
+        (target / "mine.txt").write_text("mine", encoding="utf-8")
+        for flags in ([], ["--overwrite"]):
+            assert main([*argv, *flags]) == 2, argv
+            err = capsys.readouterr().err
+            assert f"{target}: " in err and "robotwright did not write" in err, err
+            assert (target / "mine.txt").read_text(encoding="utf-8") == "mine"
+        # An empty folder holds nothing to lose: it is written into; the output written
+        # there is refused without --overwrite and replaced with it.
+        empty = tmp_path / f"empty{i}"
+        empty.mkdir()
+        mine = [a.replace(out, str(empty)) for a in argv]
+        assert main(mine) == 0, argv
+        assert any(empty.iterdir())
+        capsys.readouterr()
+        assert main(mine) == 2
+        assert "give --overwrite to replace it" in capsys.readouterr().err
+        assert main([*mine, "--overwrite"]) == 0, (argv, capsys.readouterr().err)
+        capsys.readouterr()
 
 
 def test_interrupt_is_one_line_and_exit_130(monkeypatch, capsys) -> None:

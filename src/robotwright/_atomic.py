@@ -17,6 +17,13 @@ less the umask), not the private ``0o600``/``0o700`` of Python's temporary files
 
 A write that fails for lack of space (or a read-only or quota-limited file system)
 raises :class:`~robotwright.errors.OutputPathError` naming the output, not the source.
+
+Writers never follow a symbolic link they did not create: staged files are moved into
+the output through folders opened without following links (a link planted at
+``out/meshes`` is refused, not written through), and a link at an output's own name is
+replaced, not followed. A folder written with a ``kind`` gets the marker of
+:mod:`robotwright._outputs` and replaces only an earlier output of that kind. Mesh and
+asset files copied into an output are limited in size (:func:`mesh_size_limit`).
 """
 
 from __future__ import annotations
@@ -25,13 +32,15 @@ import errno
 import os
 import re
 import shutil
+import stat
 import tempfile
 from collections.abc import Iterator
 from contextlib import AbstractContextManager, contextmanager, suppress
+from contextvars import ContextVar
 from pathlib import Path
 from typing import IO, Any
 
-from robotwright.errors import OutputPathError
+from robotwright.errors import InputFileError, OutputPathError
 
 __all__ = [
     "atomic_dir",
@@ -40,6 +49,8 @@ __all__ = [
     "atomic_path",
     "check_output_path",
     "copy_file_atomic",
+    "copy_mesh_file",
+    "mesh_size_limit",
     "write_text_atomic",
 ]
 
@@ -51,6 +62,61 @@ WRITE_ERRNOS = frozenset(
 #: name of a temporary made here: ``.<target name>.<pid>.<8 random characters>[.tmp]``.
 _TEMP_NAME = re.compile(r"^\.(?P<target>.+)\.(?P<pid>\d+)\.[a-z0-9_]{8}(\.tmp)?$")
 _STAGE = "rw-stage"
+#: Default largest mesh (or other asset) file copied into an output, in MB (10**6 bytes).
+DEFAULT_MAX_MESH_MB = 512
+_MESH_LIMIT: ContextVar[int] = ContextVar("mesh_limit", default=DEFAULT_MAX_MESH_MB * 10**6)
+_NOFOLLOW_DIR = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW if hasattr(os, "O_NOFOLLOW") else 0
+
+
+@contextmanager
+def mesh_size_limit(mb: float | None) -> Iterator[None]:
+    """Copy mesh and asset files of at most ``mb`` megabytes (10**6 bytes) into outputs
+    within the block (``None``: the default, :data:`DEFAULT_MAX_MESH_MB`); a larger file
+    raises :class:`~robotwright.errors.InputFileError` naming it and the limit."""
+    if mb is not None and not mb > 0:
+        raise ValueError(f"mesh size limit must be a positive number of MB, got {mb}")
+    token = _MESH_LIMIT.set(int(mb * 10**6) if mb is not None else _MESH_LIMIT.get())
+    try:
+        yield
+    finally:
+        _MESH_LIMIT.reset(token)
+
+
+def _too_big(src: object, limit: int) -> InputFileError:
+    return InputFileError(
+        src,
+        f"is larger than the {limit / 10**6:g} MB limit for a mesh or asset file copied "
+        "into an output (--max-mesh-mb raises it)",
+    )
+
+
+def copy_mesh_file(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> None:
+    """Copy the regular file ``src`` to ``dst`` when it is within the mesh size limit
+    (:func:`mesh_size_limit`; checked before a byte is written, and again while copying
+    in case the file grows). A FIFO or device is refused unread."""
+    from robotwright._inputs import _open_regular
+
+    limit = _MESH_LIMIT.get()
+    fd, st = _open_regular(src)
+    with os.fdopen(fd, "rb") as fin:
+        if st.st_size > limit:
+            raise _too_big(src, limit)
+        with open(dst, "wb") as fout:
+            shutil.copyfileobj(_Capped(fin, limit, src), fout, 1 << 20)
+
+
+class _Capped:
+    """A reader of at most ``limit`` bytes: reading more raises the size error."""
+
+    def __init__(self, fin: IO[bytes], limit: int, src: object) -> None:
+        self.fin, self.left, self.src, self.limit = fin, limit, src, limit
+
+    def read(self, n: int = -1) -> bytes:
+        chunk = self.fin.read(n)
+        self.left -= len(chunk)
+        if self.left < 0:
+            raise _too_big(self.src, self.limit)
+        return chunk
 
 
 def check_output_path(path: str | os.PathLike[str], *, folder: bool = False) -> None:
@@ -255,10 +321,8 @@ def write_text_atomic(path: Path, text: str) -> None:
 
 
 def _copy(src: Path, tmp: Path, dst: Path) -> None:
-    from robotwright._inputs import copy_regular_file
-
     with _naming_output(dst, source=src):
-        copy_regular_file(src, tmp)
+        copy_mesh_file(src, tmp)
 
 
 def copy_file_atomic(src: Path, dst: Path) -> None:
@@ -287,6 +351,7 @@ class StagedFiles:
         rel_path = Path(rel)
         if rel_path.is_absolute() or ".." in rel_path.parts:
             raise ValueError(f"staged output path {rel!s} must stay inside {self.out_dir}")
+        _check_folders(self.out_dir, rel_path.parts[:-1])  # refused before any work
         target = self.stage / rel_path
         target.parent.mkdir(parents=True, exist_ok=True)
         self._files.append(str(rel_path))
@@ -304,12 +369,67 @@ class StagedFiles:
 
     def _commit(self) -> None:
         """Move every staged file onto its place, in the order staged (the caller stages
-        the file that names the others last, so it appears last)."""
-        for rel in dict.fromkeys(self._files):
-            dst = self.out_dir / rel
-            check_output_path(dst)
-            dst.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(self.stage / rel, dst)
+        the file that names the others last, so it appears last). Every destination is
+        checked before the first move; the moves go through folders opened without
+        following links, so a link planted meanwhile is not written through either."""
+        files = list(dict.fromkeys(self._files))
+        for rel in files:
+            check_output_path(self.out_dir / rel)
+            _check_folders(self.out_dir, Path(rel).parts[:-1])
+        for rel in files:
+            parts = Path(rel).parts
+            if not _NOFOLLOW_DIR or os.rename not in os.supports_dir_fd:
+                (self.out_dir / rel).parent.mkdir(parents=True, exist_ok=True)
+                os.replace(self.stage / rel, self.out_dir / rel)
+                continue
+            fd = _open_folder_inside(self.out_dir, parts[:-1])
+            try:
+                os.replace(self.stage / rel, parts[-1], dst_dir_fd=fd)
+            finally:
+                os.close(fd)
+
+
+def _check_folders(out_dir: Path, parts: tuple[str, ...]) -> None:
+    """Raise :class:`OutputPathError` when a folder ``out_dir/parts[0]/...`` that exists
+    is a symbolic link or not a folder: files are never written through it."""
+    p = out_dir
+    for part in parts:
+        p = p / part
+        try:
+            mode = os.lstat(p).st_mode
+        except FileNotFoundError:
+            return
+        if stat.S_ISLNK(mode):
+            raise OutputPathError(
+                f"{p}: is a symbolic link; not writing the output through it (remove it, "
+                "or give another output folder)"
+            )
+        if not stat.S_ISDIR(mode):
+            raise OutputPathError(f"{p}: is a file; expected a folder for the output's files")
+
+
+def _open_folder_inside(out_dir: Path, parts: tuple[str, ...]) -> int:
+    """A descriptor of the folder ``out_dir/parts...``, each part opened without
+    following a link (created when missing)."""
+    fd = os.open(out_dir, os.O_RDONLY | os.O_DIRECTORY)
+    p = out_dir
+    try:
+        for part in parts:
+            p = p / part
+            with suppress(FileExistsError):
+                os.mkdir(part, 0o777, dir_fd=fd)
+            try:
+                child = os.open(part, _NOFOLLOW_DIR, dir_fd=fd)
+            except OSError as exc:
+                if exc.errno in (errno.ELOOP, errno.ENOTDIR):
+                    _check_folders(p.parent, (part,))
+                raise
+            os.close(fd)
+            fd = child
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
 
 
 @contextmanager
@@ -343,16 +463,26 @@ def atomic_files(out_dir: str | os.PathLike[str]) -> Iterator[StagedFiles]:
 
 
 @contextmanager
-def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
+def atomic_dir(target: str | os.PathLike[str], *, kind: str | None = None) -> Iterator[Path]:
     """Yield an empty temporary folder next to ``target``; on success it becomes ``target``.
 
     An existing ``target`` (file or folder) is replaced only after the block succeeded;
     callers decide beforehand whether replacing is allowed. On any exception the
     temporary folder is removed and ``target`` is left as it was. Creates the parent
     folder (removed again on failure when it was created here).
+
+    With ``kind`` (``"hrdf"``, ``"design"``, ``"designs"``, ``"demo"``) the folder gets
+    the marker of :mod:`robotwright._outputs`, and an existing ``target`` is replaced only
+    when it is empty or an earlier output of that kind holding nothing else (checked
+    before the block and again before the replacement): anything else raises
+    :class:`~robotwright.errors.OutputExistsError` and nothing is written.
     """
+    from robotwright._outputs import check_folder_output, write_marker
+
     target = Path(target)
     check_output_path(target, folder=True)
+    if kind is not None:
+        check_folder_output(target, kind, overwrite=True)
     created = _make_parents(target.parent)
     _restore_moved_aside(target)
     remove_stale_temporaries(target.parent, target.name)
@@ -368,6 +498,9 @@ def atomic_dir(target: str | os.PathLike[str]) -> Iterator[Path]:
     try:
         with _naming_output(target):
             yield tmp
+            if kind is not None:
+                write_marker(tmp, kind)
+                check_folder_output(target, kind, overwrite=True)  # changed meanwhile?
             if target.exists() or target.is_symlink():
                 # Move the old one aside first: os.replace cannot overwrite a non-empty
                 # folder. (Killed between the two renames, the next atomic_dir puts it back.)

@@ -15,6 +15,7 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 from robotwright import __version__
+from robotwright._atomic import mesh_size_limit
 from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, collect_notes, summary_line
 from robotwright._paths import trusted_asset_roots
@@ -47,6 +48,10 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "view",
     "render",
 )
+
+#: Commands that copy mesh (and asset) files into their output: they take
+#: ``--max-mesh-mb MB`` (see :func:`robotwright._atomic.mesh_size_limit`).
+_MESH_COPY_COMMANDS: tuple[str, ...] = ("export", "compose", "convert", "things")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -124,7 +129,26 @@ def build_parser() -> argparse.ArgumentParser:
             help="trust folder DIR: mesh/asset paths of the input may point into it "
             "(by default they must stay inside the robot's own folder); repeatable",
         )
+    for name in _MESH_COPY_COMMANDS:
+        sub.choices[name].add_argument(
+            "--max-mesh-mb",
+            type=_positive_mb,
+            default=None,
+            metavar="MB",
+            help="largest mesh or asset file copied into the output, in MB (default 512): "
+            "a larger one is refused",
+        )
     return parser
+
+
+def _positive_mb(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a positive number of MB, got {text!r}")
+    return value
 
 
 def _report_notes(caught: CaughtNotes, verbose: bool) -> None:
@@ -160,7 +184,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     try:
         roots = getattr(args, "asset_roots", None) or []
-        with trusted_asset_roots(roots), collect_notes() as caught:
+        limit = mesh_size_limit(getattr(args, "max_mesh_mb", None))
+        with trusted_asset_roots(roots), limit, collect_notes() as caught:
             code = int(args.func(args) or 0)
         # Commands that only show a model (view, render) write no conversion: the notes
         # of loading it say nothing about the picture, so they are listed with -v only.

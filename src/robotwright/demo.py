@@ -39,7 +39,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--out",
         type=Path,
         default=DEFAULT_OUT,
-        help=f"output folder (default ./{DEFAULT_OUT}; an earlier demo output is refreshed)",
+        help=f"output folder (default ./{DEFAULT_OUT}): a new or empty folder, or an earlier "
+        "demo output, which is refreshed (any other folder is refused)",
     )
     p.set_defaults(func=_run)
 
@@ -259,13 +260,16 @@ def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
     """Run every demo step into ``out``; return step name -> one-line result.
 
     The folder is built next to ``out`` and replaces it only when every step succeeded:
-    a failed or interrupted run leaves the previous demo folder as it was."""
+    a failed or interrupted run leaves the previous demo folder as it was. Only an
+    earlier demo output holding nothing else is replaced: any other non-empty folder,
+    and a folder holding the working or home folder, raise
+    :class:`~robotwright.errors.OutputExistsError` before the first step."""
     from robotwright._atomic import atomic_dir
 
     ctx: dict[str, Any] = {}
     results: dict[str, str] = {}
     notes: list[str] = []
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, kind="demo") as tmp:
         for i, (title, step) in enumerate(STEPS, 1):
             t0 = time.perf_counter()
             print(f"[{i}/{len(STEPS)}] {title} ...", flush=True)
@@ -285,12 +289,14 @@ def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
 
 def _run(args: argparse.Namespace) -> int:
     from robotwright._atomic import check_output_path
+    from robotwright._outputs import check_folder_output
     from robotwright.errors import OutputPathError
 
     # Checked before the first step, so a wrong -o fails at once and writes nothing.
     check_output_path(args.out, folder=True)
     if args.out.exists() and not args.out.is_dir():
         raise OutputPathError(f"{args.out}: is a file; expected a folder for the demo output")
+    check_folder_output(args.out, "demo", overwrite=True)  # only its own output is replaced
     run_demo(args.out)
     print(f"demo written to {args.out.resolve()} (summary.json, conversion_notes.txt)")
     return 0

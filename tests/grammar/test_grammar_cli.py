@@ -74,7 +74,9 @@ def test_sample_writes_every_file_and_they_load(tmp_path, capsys):
         )
         == 0
     )
-    assert sorted(p.name for p in again.iterdir()) == [f.name for f in folders]
+    # The folder's hidden .robotwright marker is not a design.
+    designs = sorted(p.name for p in again.iterdir() if not p.name.startswith("."))
+    assert designs == [f.name for f in folders]
 
 
 @pytest.mark.filterwarnings("ignore::robotwright.errors.ConversionWarning")
@@ -164,7 +166,7 @@ def test_export_and_search_never_replace_a_file_or_a_foreign_folder(tmp_path, ca
     assert main(["grammar", "export", str(design), "-o", str(keep)]) == 2
     assert "notes.txt: is a file; expected a folder for the design" in capsys.readouterr().err
     assert main(["grammar", "export", str(design), "-o", str(foreign)]) == 2
-    assert "holds no design.txt: not replacing it" in capsys.readouterr().err
+    assert "holds files robotwright did not write (a.jpg)" in capsys.readouterr().err
     assert main(["grammar", "search", "--budget", "2", "-o", str(keep)]) == 2
     assert main(["grammar", "sample", "-o", str(keep), "--no-picture"]) == 2
     assert "is a file; expected a folder" in capsys.readouterr().err

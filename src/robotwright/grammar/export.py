@@ -58,7 +58,7 @@ def export_design(
     tree = replay(grammar, design)
     limb: Limb = build(grammar, design, name=name)
     hrdf = limb.to_hrdf()
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, kind="design") as tmp:  # replaces only a design output
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConversionWarning)
             export_mjcf(hrdf, tmp / f"{name}.xml")

@@ -20,12 +20,11 @@ from typing import Any
 
 import yaml
 
-from robotwright._atomic import atomic_dir
+from robotwright._atomic import atomic_dir, copy_mesh_file
 from robotwright._inputs import (
     MAX_TABLE_BYTES,
     MAX_XML_BYTES,
     MAX_YAML_BYTES,
-    copy_regular_file,
     load_yaml,
     read_text,
 )
@@ -920,7 +919,7 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
                     summary=f"cannot save robot '{hrdf.name}'",
                 )
             dest.parent.mkdir(parents=True, exist_ok=True)
-            copy_regular_file(source, dest)
+            copy_mesh_file(source, dest)  # regular files only, size-capped
         if hrdf.meta.joint_mapping is not None:
             (tmp / JOINT_MAPPING_FILE).write_text(
                 yaml.safe_dump(
@@ -935,6 +934,6 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
         raise OutputExistsError(
             f"{target} exists (replace it with overwrite=True, on the command line --overwrite)"
         )
-    with atomic_dir(target) as tmp:
+    with atomic_dir(target, kind="hrdf") as tmp:  # replaces only an HRDF output
         fill(tmp)
     return target

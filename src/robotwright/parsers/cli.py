@@ -235,7 +235,9 @@ def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
 def _convert(args: argparse.Namespace) -> int:
     from robotwright.parsers.convert import convert
 
-    check_overwrite(args.output, args.overwrite)
+    # A name without extension is an HRDF folder: --overwrite replaces only one we wrote.
+    folder = Path(args.output).suffix == ""
+    check_overwrite(args.output, args.overwrite, kind="hrdf" if folder else None)
     source = Path(args.src)
     if not source.exists() and source.suffix.lower() not in (".urdf", ".xml", ".xacro"):
         # Not a file: a robot name (bundled or under $HURODES_ASSETS_PATH), as export takes.

@@ -42,7 +42,7 @@ def _run(args: argparse.Namespace) -> int:
             f"{output}: expected a .xml file (MJCF) or a folder name without extension (HRDF)"
         )
     check_output_path(output, folder=not to_xml)
-    check_overwrite(output, args.overwrite)
+    check_overwrite(output, args.overwrite, kind=None if to_xml else "hrdf")
     if source.is_file() or source.suffix.lower() == ".xml":
         world = World.from_xml_path(source, strict=args.strict)
     else:  # an HRDF folder, or a robot name (bundled or under $HURODES_ASSETS_PATH)
