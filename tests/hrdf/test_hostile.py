@@ -279,7 +279,9 @@ def test_deeply_nested_meta_yaml_is_refused(robot) -> None:
     text = yaml.safe_dump(meta) + "deep: " + "[" * 50_000 + "]" * 50_000 + "\n"
     (robot / "meta.yaml").write_text(text)
     problems = validate_dir(robot)
-    assert any(p.file == "meta.yaml" and "nests more than" in p.message for p in problems)
+    # Our depth check or PyYAML's own (6.0.4 and later) may refuse it first: either way
+    # a problem located at meta.yaml, never a RecursionError.
+    assert [p.file for p in problems] == ["meta.yaml"], problems
 
 
 # ------------------------------------------------------------------ XML injection
