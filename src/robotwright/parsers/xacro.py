@@ -9,7 +9,10 @@ The macros are expanded by the ``xacro`` package from PyPI (install the ``xacro`
 - ``$(arg name)`` takes the ``xacro_args`` mapping (``--xacro-arg name:=value``), then
   the file's own ``<xacro:arg default=...>``;
 - ``$(env VAR)`` is refused and ``$(optenv VAR default)`` gives its default: the
-  environment is not read, so a file cannot copy it into its output.
+  environment is not read, so a file cannot copy it into its output;
+- ``${...}`` and ``$(eval ...)`` expressions are evaluated by
+  :mod:`robotwright.parsers.xacro_eval` (an allow-list over the syntax tree), never by
+  Python's ``eval``.
 
 The files xacro reads (the source, ``<xacro:include>``, ``xacro.load_yaml``) must lie
 inside the robot folder (:func:`~robotwright.parsers.packages.robot_root`), inside a
@@ -40,6 +43,7 @@ from robotwright._paths import resolve_inside, trusted_roots
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.parsers.packages import find_package, robot_root
 from robotwright.parsers.report import Reporter
+from robotwright.parsers.xacro_eval import ExpressionError, installed
 from robotwright.parsers.xmlsafe import parse_xml
 
 #: xacro keeps its state in module globals: one expansion at a time.
@@ -216,7 +220,12 @@ def _expand_here(
     guard = _Guard(src, package_map, trusted)
     args = {str(k): str(v) for k, v in (xacro_args or {}).items()}
     messages = io.StringIO()
-    with _LOCK, _patched(xacro, substitution_args, guard), contextlib.redirect_stderr(messages):
+    with (
+        _LOCK,
+        _patched(xacro, substitution_args, guard),
+        installed(xacro, substitution_args),
+        contextlib.redirect_stderr(messages),
+    ):
         try:
             guard.check(src, what="the xacro file")
             doc = xacro.process_file(str(src.resolve()), mappings=args)
@@ -224,9 +233,12 @@ def _expand_here(
         except ConversionError:
             raise
         except Exception as exc:  # xacro raises many types; each is a fault of the source
-            cause = _cause(exc, (_Refused, substitution_args.ArgException, MemoryError))
+            kinds = (_Refused, ExpressionError, substitution_args.ArgException, MemoryError)
+            cause = _cause(exc, kinds)
             if isinstance(cause, _Refused):
                 message = str(cause)
+            elif isinstance(cause, ExpressionError):
+                message = f"xacro expression refused: {cause}"
             elif isinstance(cause, MemoryError):
                 message = "xacro expansion ran out of memory; refused"
             elif isinstance(cause, substitution_args.ArgException):
