@@ -186,6 +186,7 @@ def _variants(rec, rng: random.Random, n: int) -> list:
         for f in dataclasses.fields(rec)
         if isinstance(getattr(rec, f.name), (int, float, tuple))
         and not isinstance(getattr(rec, f.name), bool)
+        and getattr(rec, f.name) != ()  # no user data to change
     ]
     for _ in range(n):
         name = rng.choice(numeric)

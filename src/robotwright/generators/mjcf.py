@@ -7,17 +7,22 @@ Mapping (HRDF record -> MJCF element), all values written exactly (see ``xmlfmt`
   -> ``<freejoint/>`` (unnamed when the HRDF has no name, like hurodes). ``range=None``
   writes no range (unlimited). ``dynamic_friction`` -> ``frictionloss``,
   ``viscous_friction`` -> ``damping``; ``armature``, ``stiffness``, ``springref``,
-  ``ref`` when non-zero.
+  ``ref`` when non-zero; margin, actuatorfrcrange, actuatorgravcomp, solreflimit,
+  solimplimit, solreffriction, solimpfriction, user where not MuJoCo's default (a free
+  joint with any of them is a ``<joint type="free">``). Body ``gravcomp``, ``user``;
+  site, sensor and actuator ``user``; ``meta.mjcf_size`` -> ``<size nuser_*>``.
 - ``Actuator`` -> ``<motor>``/``<position>``/``<velocity>`` in HRDF order. A motor's
   control range is ``ctrl_range``, else ``[-peak_torque, peak_torque]`` (hurodes);
   ``p_gain`` -> ``kp``, ``d_gain`` -> ``kv``; ``force_range`` -> ``forcerange`` (for
   position/velocity actuators ``peak_torque`` gives the force range when none is set).
 - ``MeshGeom``/``SimpleGeom`` -> ``<geom>`` with contype/conaffinity, condim, group,
-  friction (static, torsional, rolling), rgba; meshes become ``<mesh>`` assets (with
+  friction (static, torsional, rolling), rgba, and solref, solimp, margin, gap,
+  priority, solmix, user where not MuJoCo's default; meshes become ``<mesh>`` assets (with
   scale). ``Site`` -> ``<site>``; ``Sensor`` -> its sensor element.
 - ``meta.imu_config_list`` -> a site per IMU plus ``framequat``/``gyro``/
   ``accelerometer`` sensors named ``<imu>_quat``/``<imu>_angvel``/``<imu>_linacc``.
-- ``meta.simulator_config`` -> ``<option>`` and the scene; ``mjcf_extra`` sections
+- ``meta.simulator_config`` -> ``<option>`` (with its ``option`` attributes and
+  ``<flag>`` switches) and the scene; ``mjcf_extra`` sections
   (tendon, equality, contact, keyframe, ...) are merged in, names prefixed.
 
 What MJCF cannot hold (restitution, a static friction that differs from the dynamic one,
@@ -36,7 +41,15 @@ from robotwright.errors import ConversionError, ConversionWarning, GeneratorErro
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf_base import MJCFGeneratorBase, name_clashes, prefix_tree
 from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
-from robotwright.hrdf.model import HRDF, Actuator, Geom, Joint, SimpleGeom
+from robotwright.hrdf.model import (
+    HRDF,
+    MUJOCO_SOLIMP,
+    MUJOCO_SOLREF,
+    Actuator,
+    Geom,
+    Joint,
+    SimpleGeom,
+)
 from robotwright.hrdf.validate import check_extra
 
 #: IMU quantity -> (MuJoCo sensor, how it names its object).
@@ -164,6 +177,10 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         losses: list[Problem] = []
         self.add_compiler()
         self.add_option()
+        if hrdf.meta.mjcf_size:
+            self.get_elem("size").attrib.update(
+                {k: str(int(v)) for k, v in sorted(hrdf.meta.mjcf_size.items())}
+            )
         mesh_names = self._add_mesh_assets(hrdf, prefix)
         self._add_bodies(hrdf, prefix, mesh_names, losses)
         self._add_actuators(hrdf, prefix, losses)
@@ -241,6 +258,8 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             el.set("rgba", fmt_vec(s.rgba))
             if s.group:
                 el.set("group", str(s.group))
+            if s.user:
+                el.set("user", fmt_vec(s.user))
             sites.setdefault(s.body, []).append(el)
         for imu, (name, new) in zip(hrdf.meta.imu_config_list or [], imu_sites(hrdf), strict=True):
             if not new:
@@ -271,6 +290,10 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                 "body",
                 {"name": prefixed(prefix, b.name), "pos": fmt_vec(b.pos), "quat": fmt_vec(b.quat)},
             )
+            if b.gravcomp:
+                el.set("gravcomp", fmt_float(b.gravcomp))
+            if b.user:
+                el.set("user", fmt_vec(b.user))
             ET.SubElement(
                 el,
                 "inertial",
@@ -311,6 +334,18 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             attrs["group"] = str(g.group)
         attrs["friction"] = fmt_vec((g.static_friction, g.torsional_friction, g.rolling_friction))
         attrs["rgba"] = fmt_vec(g.rgba)
+        _solver_attrs(attrs, g, (("solref", "solref"), ("solimp", "solimp")))
+        for key, value, default in (
+            ("margin", g.margin, 0.0),
+            ("gap", g.gap, 0.0),
+            ("solmix", g.solmix, 1.0),
+        ):
+            if value != default:
+                attrs[key] = fmt_float(value)
+        if g.priority:
+            attrs["priority"] = str(int(g.priority))
+        if g.user:
+            attrs["user"] = fmt_vec(g.user)
         el = ET.Element("geom", attrs)
         if g.restitution is not None:
             losses.append(
@@ -337,6 +372,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
             "stiffness": j.stiffness,
             "springref": j.springref,
             "ref": j.ref,
+            "margin": j.margin,
         }
         if j.static_friction and j.static_friction != j.dynamic_friction:
             losses.append(
@@ -347,7 +383,25 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                     column="static_friction",
                 )
             )
-        if j.type == "free" and not any(dyn.values()) and j.range is None:
+        more: dict[str, str] = {}
+        _solver_attrs(
+            more,
+            j,
+            (
+                ("solreflimit", "solreflimit"),
+                ("solimplimit", "solimplimit"),
+                ("solreffriction", "solreffriction"),
+                ("solimpfriction", "solimpfriction"),
+            ),
+        )
+        if j.actuatorfrcrange is not None:
+            more["actuatorfrcrange"] = fmt_vec(j.actuatorfrcrange)
+            more["actuatorfrclimited"] = "true"
+        if j.actuatorgravcomp:
+            more["actuatorgravcomp"] = "true"
+        if j.user:
+            more["user"] = fmt_vec(j.user)
+        if j.type == "free" and not any(dyn.values()) and j.range is None and not more:
             el = ET.Element("freejoint")
             if j.name:
                 el.set("name", prefixed(prefix, j.name))
@@ -366,6 +420,7 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         for key, value in dyn.items():
             if value:
                 el.set(key, fmt_float(value))
+        el.attrib.update(more)
         return el
 
     def _add_actuators(self, hrdf: HRDF, prefix: str | None, losses: list[Problem]) -> None:
@@ -411,6 +466,8 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
                 attrs["noise"] = fmt_float(s.noise)
             if s.cutoff:
                 attrs["cutoff"] = fmt_float(s.cutoff)
+            if s.user:
+                attrs["user"] = fmt_vec(s.user)
             ET.SubElement(section, s.type, attrs)
 
 
@@ -458,6 +515,8 @@ def _actuator_elem(a: Actuator, prefix: str | None, row: int, losses: list[Probl
     if force is not None:
         el.set("forcerange", fmt_vec(force))
         el.set("forcelimited", "true")
+    if a.user:
+        el.set("user", fmt_vec(a.user))
     if a.peak_velocity is not None:
         losses.append(
             Problem(
@@ -468,6 +527,16 @@ def _actuator_elem(a: Actuator, prefix: str | None, row: int, losses: list[Probl
             )
         )
     return el
+
+
+def _solver_attrs(attrs: dict[str, str], record: object, fields: tuple) -> None:
+    """Set each ``(attribute, field)`` of ``record`` that is not MuJoCo's default
+    (``solref*`` fields: :data:`MUJOCO_SOLREF`; ``solimp*``: :data:`MUJOCO_SOLIMP`)."""
+    for key, name in fields:
+        value = tuple(getattr(record, name))
+        default = MUJOCO_SOLREF if name.startswith("solref") else MUJOCO_SOLIMP
+        if value != default:
+            attrs[key] = fmt_vec(value)
 
 
 def _report(hrdf: HRDF, fmt: str, losses: list[Problem], strict: bool) -> None:

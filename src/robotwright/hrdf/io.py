@@ -84,7 +84,30 @@ HURODES_META_KEYS: tuple[str, ...] = (
     "motor_config_list",
 )
 #: meta.yaml keys robotwright adds.
-EXTENSION_META_KEYS: tuple[str, ...] = ("format_version", "floating_base", "base_joint_name")
+EXTENSION_META_KEYS: tuple[str, ...] = (
+    "format_version",
+    "floating_base",
+    "base_joint_name",
+    "base_joint",
+    "mjcf_size",
+)
+#: ``joint.csv`` columns that the root's free joint keeps in ``meta.yaml``'s
+#: ``base_joint`` mapping (its dof and constraint properties; a free joint has no
+#: anchor, axis, range or spring reference of its own).
+BASE_JOINT_FIELDS: tuple[str, ...] = (
+    "armature",
+    "static_friction",
+    "dynamic_friction",
+    "viscous_friction",
+    "stiffness",
+    "margin",
+    "actuatorgravcomp",
+    "solreflimit",
+    "solimplimit",
+    "solreffriction",
+    "solimpfriction",
+    "user",
+)
 EXTRA_MJCF_FILE = "extra.xml"
 JOINT_MAPPING_FILE = "joint_mapping.yaml"
 #: Where hurodes' generators export a robot by default (``<folder>/exported/robot.xml``):
@@ -143,6 +166,18 @@ def _flat_columns(lines: list[str], width: int) -> list[list[str]] | None:
     return [flat[j::width] for j in range(width)]
 
 
+def _csv_rows(text: str, fname: str, problems: list[Problem]) -> list[list[str]] | None:
+    """The rows ``csv.reader`` reads from ``text``, or ``None`` after reporting (naming
+    the file and line) what the csv module refuses: a cell longer than its field limit
+    (131,072 characters)."""
+    reader = csv.reader(io.StringIO(text))
+    try:
+        return list(reader)
+    except csv.Error as exc:
+        problems.append(Problem(fname, f"line {reader.line_num}: cannot read the CSV table: {exc}"))
+        return None
+
+
 def _folder_read(path: Path, read: Callable[[Path], Any], problems: list[Problem]) -> Any:
     """``read(path)`` for a file of the robot folder (``path.parent``), or ``None`` after
     reporting why it cannot be read: a symbolic link leading out of the folder, not a
@@ -182,13 +217,13 @@ def _read_table(
         columns = _flat_columns(lines[1:], len(header))
         body_rows: Any = (line.split(",") for line in lines[1:])
     else:
-        reader = csv.reader(io.StringIO(text))
-        try:
-            header = next(reader)
-        except StopIteration:
+        parsed = _csv_rows(text, fname, problems)
+        if parsed is None:
+            return None
+        if not parsed:
             problems.append(Problem(fname, "file is empty: expected a header row"))
             return None
-        body_rows = reader
+        header, body_rows = parsed[0], parsed[1:]
     header = [h.strip() for h in header]
     index = {h: i for i, h in enumerate(header)}
     known: set[str] = set()
@@ -342,6 +377,13 @@ def _convert_table_fast(
                             vals.append(vec)
             elif col.kind == "int":
                 vals = list(map(int, columns[idx[0]]))
+            elif col.kind == "floats":
+                vals = []
+                for text in columns[idx[0]]:
+                    vec = tuple(map(float, text.split()))
+                    if not isfinite(sum(vec)):
+                        return None
+                    vals.append(vec)
             else:
                 cells = columns[idx[0]]
                 if cells != list(map(str.strip, cells)):
@@ -424,6 +466,88 @@ def _text(value: Any, key: str, problems: list[Problem]) -> Any:
     return _checked(value, isinstance(value, str) and value != "", key, "a name", problems)
 
 
+def _option_and_flag(sim: dict, problems: list[Problem]) -> tuple[dict[str, Any], dict[str, str]]:
+    """``simulator_config.option`` and ``.flag``: every name and value checked against
+    :mod:`robotwright.hrdf.options` (they are written into MJCF as attributes)."""
+    from robotwright.hrdf.options import flag_problem, option_problem
+
+    out: list[dict[str, Any]] = []
+    for key, check in (("option", option_problem), ("flag", flag_problem)):
+        raw = sim.get(key)
+        kept: dict[str, Any] = {}
+        if raw is not None and not isinstance(raw, dict):
+            problems.append(
+                Problem("meta.yaml", "expected a mapping", column=f"simulator_config.{key}")
+            )
+        for name, value in (raw or {}).items() if isinstance(raw, dict) else ():
+            why = check(str(name), value)
+            if why is not None:
+                problems.append(Problem("meta.yaml", why, column=f"simulator_config.{key}.{name}"))
+            else:
+                kept[str(name)] = list(value) if isinstance(value, list) else value
+        out.append(kept)
+    return out[0], out[1]
+
+
+def _base_joint(raw: Any, problems: list[Problem]) -> dict[str, Any]:
+    """``base_joint``: the root free joint's properties, each checked like its
+    ``joint.csv`` column (see :data:`BASE_JOINT_FIELDS`)."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        problems.append(Problem("meta.yaml", "expected a mapping", column="base_joint"))
+        return {}
+    columns = {c.csv: c for c in TABLES["joint"] if c.field in BASE_JOINT_FIELDS}
+    out: dict[str, Any] = {}
+    for name, value in raw.items():
+        key = f"base_joint.{name}"
+        col = columns.get(name)
+        if col is None:
+            problems.append(Problem("meta.yaml", f"expected one of {sorted(columns)}", column=key))
+            continue
+        if col.kind == "floats" or col.size:
+            size = len(value) if col.kind == "floats" and isinstance(value, list) else col.size
+            got = _float_list(value, size, key, problems)
+            if got is not None and not all(map(math.isfinite, got)):
+                problems.append(Problem("meta.yaml", "expected finite numbers", column=key))
+                got = None
+            if got is not None:
+                out[col.field] = got
+        elif col.kind == "int":
+            if value in (0, 1) and not isinstance(value, float):
+                out[col.field] = bool(value)
+            else:
+                problems.append(Problem("meta.yaml", f"{value!r}: expected 0 or 1", column=key))
+        else:
+            got = _number(value, key, problems)
+            if got is not None:
+                out[col.field] = float(got)
+    return out
+
+
+def _mjcf_size(raw: Any, problems: list[Problem]) -> dict[str, int]:
+    """``mjcf_size``: MJCF ``<size>`` ``nuser_*`` values (integers >= 0)."""
+    from robotwright.hrdf.model import NUSER_KEYS
+
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        problems.append(Problem("meta.yaml", "expected a mapping", column="mjcf_size"))
+        return {}
+    out: dict[str, int] = {}
+    for name, value in raw.items():
+        key = f"mjcf_size.{name}"
+        if name not in NUSER_KEYS:
+            problems.append(Problem("meta.yaml", f"expected one of {list(NUSER_KEYS)}", column=key))
+        elif isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 2**31:
+            out[name] = value
+        else:
+            problems.append(
+                Problem("meta.yaml", f"{value!r}: expected an integer >= 0", column=key)
+            )
+    return out
+
+
 def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | None, dict]:
     """Returns (meta, body_parent_id, robotwright keys)."""
     meta = Meta(format_version=None, imu_config_list=None)
@@ -478,6 +602,7 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
                 Problem("meta.yaml", "expected a mapping", column="simulator_config.ground")
             )
         integrator = sim.get("integrator")
+        option, flag = _option_and_flag(sim, problems)
         meta.simulator_config = SimulatorConfig(
             timestep=_number(sim.get("timestep"), "simulator_config.timestep", problems),
             gravity=_float_list(sim.get("gravity"), 3, "simulator_config.gravity", problems),
@@ -489,9 +614,11 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
                 f"one of {list(INTEGRATORS)}",
                 problems,
             ),
+            option=option,
+            flag=flag,
         )
         for key in sim:
-            if key not in ("timestep", "gravity", "ground", "integrator"):
+            if key not in ("timestep", "gravity", "ground", "integrator", "option", "flag"):
                 problems.append(
                     Problem(
                         "meta.yaml",
@@ -569,6 +696,8 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
     ext = {k: raw[k] for k in ("floating_base", "base_joint_name") if k in raw}
     if "base_joint_name" in ext:
         ext["base_joint_name"] = _text(ext["base_joint_name"], "base_joint_name", problems)
+    ext["base_joint"] = _base_joint(raw.get("base_joint"), problems)
+    meta.mjcf_size = _mjcf_size(raw.get("mjcf_size"), problems)
     meta.extra = {k: v for k, v in raw.items() if k not in HURODES_META_KEYS + EXTENSION_META_KEYS}
     for key in meta.extra:
         problems.append(
@@ -691,7 +820,19 @@ def collect_hrdf_dir(
     if len(roots) == 1:
         root_name = roots[0].name
     if floating and root_name is not None:
-        joints.insert(0, Joint(name=ext.get("base_joint_name"), body=root_name, type="free"))
+        joints.insert(
+            0,
+            Joint(
+                name=ext.get("base_joint_name"),
+                body=root_name,
+                type="free",
+                **ext.get("base_joint", {}),
+            ),
+        )
+    elif ext.get("base_joint"):
+        problems.append(
+            Problem("meta.yaml", "base_joint given but the base is fixed", column="base_joint")
+        )
 
     joint_mapping = None
     if JOINT_MAPPING_FILE in present:
@@ -793,6 +934,17 @@ def table_csv(hrdf: HRDF, stem: str) -> str | None:
     return out.getvalue()
 
 
+def _yaml_value(value: Any) -> Any:
+    """A plain YAML value: tuples and numpy numbers become lists and Python numbers."""
+    if isinstance(value, (tuple, list)):
+        return [_yaml_value(v) for v in value]
+    if isinstance(value, bool):
+        return int(value)
+    if hasattr(value, "item"):
+        return value.item()
+    return value
+
+
 def meta_dict(hrdf: HRDF) -> dict[str, Any]:
     """The ``meta.yaml`` mapping (hurodes keys, then robotwright's)."""
     meta = hrdf.meta
@@ -820,6 +972,10 @@ def meta_dict(hrdf: HRDF) -> dict[str, Any]:
             }
         if sim.integrator is not None:
             sim_d["integrator"] = sim.integrator
+        if sim.option:
+            sim_d["option"] = {k: _yaml_value(v) for k, v in sim.option.items()}
+        if sim.flag:
+            sim_d["flag"] = dict(sim.flag)
         out["simulator_config"] = sim_d
     if meta.body_name_config is not None:
         b = meta.body_name_config
@@ -846,6 +1002,17 @@ def meta_dict(hrdf: HRDF) -> dict[str, Any]:
     free = [j for j in hrdf.joints if j.type == "free"]
     if free and free[0].name is not None:
         out["base_joint_name"] = free[0].name
+    if free:
+        base = {
+            c.csv: _yaml_value(getattr(free[0], c.field))
+            for c in TABLES["joint"]
+            if c.field in BASE_JOINT_FIELDS
+            and getattr(free[0], c.field) != (0.0 if c.default is NO_DEFAULT else c.default)
+        }
+        if base:
+            out["base_joint"] = base
+    if meta.mjcf_size:
+        out["mjcf_size"] = dict(meta.mjcf_size)
     out.update(meta.extra)
     return out
 

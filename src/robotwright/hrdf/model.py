@@ -108,6 +108,22 @@ FORMAT_VERSION = "robotwright-hrdf/1"
 
 IDENTITY_QUAT: Quat = (1.0, 0.0, 0.0, 0.0)
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
+#: MuJoCo's default constraint solver parameters (``solref``: time constant (s), damping
+#: ratio; ``solimp``: dmin, dmax, width (m), midpoint, power).
+MUJOCO_SOLREF: tuple[float, float] = (0.02, 1.0)
+MUJOCO_SOLIMP: tuple[float, float, float, float, float] = (0.9, 0.95, 0.001, 0.5, 2.0)
+#: ``<size>`` attributes ``meta.yaml``'s ``mjcf_size`` holds: the length of each ``user``
+#: array (MuJoCo pads every object's ``user`` values with zeros to this length).
+NUSER_KEYS: tuple[str, ...] = (
+    "nuser_body",
+    "nuser_jnt",
+    "nuser_geom",
+    "nuser_site",
+    "nuser_cam",
+    "nuser_tendon",
+    "nuser_actuator",
+    "nuser_sensor",
+)
 #: MuJoCo's default torsional and rolling friction coefficients.
 MUJOCO_TORSIONAL_FRICTION = 0.005
 MUJOCO_ROLLING_FRICTION = 0.0001
@@ -127,6 +143,9 @@ class Body:
         inertial_pos: centre of mass in the body frame (m).
         inertial_quat: orientation of the principal inertia frame in the body frame.
         diag_inertia: principal moments of inertia about the centre of mass (kg m^2).
+        gravcomp: MuJoCo ``gravcomp``: the fraction of the body's weight cancelled by
+            a force at its centre of mass (0 = none, 1 = weightless).
+        user: MuJoCo ``user`` data (numbers MuJoCo stores but does not use).
     """
 
     name: str
@@ -137,6 +156,8 @@ class Body:
     inertial_pos: Vec3
     inertial_quat: Quat
     diag_inertia: Vec3
+    gravcomp: float = 0.0
+    user: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -158,6 +179,17 @@ class Joint:
         stiffness: joint spring stiffness (N m/rad or N/m).
         springref: spring reference position (rad or m).
         ref: reference position (rad or m) at which the body is at its ``pos``/``quat``.
+        margin: distance (rad or m) before the limit at which the limit becomes active.
+        actuatorfrcrange: (lower, upper) clamp of the total actuator force at the joint
+            (N m or N), ``None`` = unclamped (MuJoCo ``actuatorfrcrange``).
+        actuatorgravcomp: gravity compensation (``gravcomp``) acts through actuators
+            (counts against ``actuatorfrcrange``) instead of as a passive force.
+        solreflimit, solimplimit: solver parameters of the joint limit.
+        solreffriction, solimpfriction: solver parameters of the dry friction.
+        user: MuJoCo ``user`` data.
+
+    The dof fields (``armature``, ``dynamic_friction``, ``viscous_friction``) apply to
+    every degree of freedom of a ball or free joint.
     """
 
     name: str | None
@@ -173,6 +205,14 @@ class Joint:
     stiffness: float = 0.0
     springref: float = 0.0
     ref: float = 0.0
+    margin: float = 0.0
+    actuatorfrcrange: Range | None = None
+    actuatorgravcomp: bool = False
+    solreflimit: tuple[float, float] = MUJOCO_SOLREF
+    solimplimit: tuple[float, float, float, float, float] = MUJOCO_SOLIMP
+    solreffriction: tuple[float, float] = MUJOCO_SOLREF
+    solimpfriction: tuple[float, float, float, float, float] = MUJOCO_SOLIMP
+    user: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -194,6 +234,7 @@ class Actuator:
         gear: transmission ratio.
         ctrl_range: control range, or ``None`` (derived from peak_torque for motors).
         force_range: actuator force range, or ``None``.
+        user: MuJoCo ``user`` data.
     """
 
     joint: str
@@ -206,6 +247,7 @@ class Actuator:
     gear: float = 1.0
     ctrl_range: Range | None = None
     force_range: Range | None = None
+    user: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -227,6 +269,15 @@ class Geom:
         group: MuJoCo visualisation group (0..5).
         condim: contact dimensionality (1, 3, 4 or 6).
         geom_name: the geom's own name, or ``None``.
+        solref: contact solver reference (time constant s, damping ratio; or negative
+            stiffness, damping).
+        solimp: contact solver impedance (dmin, dmax, width m, midpoint, power).
+        margin: distance (m) at which contacts are detected.
+        gap: contacts within ``margin - gap`` of touching are active (m).
+        priority: contact priority (the higher geom's parameters win).
+        solmix: weight of this geom's solref/solimp when two geoms of equal priority
+            touch.
+        user: MuJoCo ``user`` data.
     """
 
     body: str
@@ -243,6 +294,13 @@ class Geom:
     group: int = 0
     condim: int = 3
     geom_name: str | None = None
+    solref: tuple[float, float] = MUJOCO_SOLREF
+    solimp: tuple[float, float, float, float, float] = MUJOCO_SOLIMP
+    margin: float = 0.0
+    gap: float = 0.0
+    priority: int = 0
+    solmix: float = 1.0
+    user: tuple[float, ...] = ()
 
 
 #: MuJoCo's ``<mesh inertia>`` modes.
@@ -298,6 +356,7 @@ class Site:
         size: MuJoCo half-sizes for drawing (m).
         rgba: colour for drawing.
         group: visualisation group.
+        user: MuJoCo ``user`` data.
     """
 
     name: str
@@ -308,6 +367,7 @@ class Site:
     size: Vec3 = (0.005, 0.0, 0.0)
     rgba: RGBA = (0.5, 0.5, 0.5, 1.0)
     group: int = 0
+    user: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -326,6 +386,7 @@ class Sensor:
         refname: reference frame object name, or ``None``.
         noise: standard deviation of sensor noise (sensor units).
         cutoff: absolute-value cutoff (0 = none).
+        user: MuJoCo ``user`` data.
     """
 
     name: str
@@ -336,6 +397,7 @@ class Sensor:
     refname: str | None = None
     noise: float = 0.0
     cutoff: float = 0.0
+    user: tuple[float, ...] = ()
 
 
 @dataclass
@@ -351,12 +413,20 @@ class GroundConfig:
 @dataclass
 class SimulatorConfig:
     """Simulation settings: ``timestep`` (s), ``gravity`` (m/s^2, world frame),
-    ``integrator`` (MuJoCo integrator name or ``None`` for MuJoCo's default)."""
+    ``integrator`` (MuJoCo integrator name or ``None`` for MuJoCo's default).
+
+    ``option`` holds the other MJCF ``<option>`` attributes the robot sets (MJCF names
+    and units, see :data:`robotwright.hrdf.options.OPTION_FIELDS`: ``impratio``,
+    ``cone``, ``o_solref``, ``wind`` ...); ``flag`` the ``<option><flag>`` switches it
+    sets (``{"contact": "disable", "energy": "enable"}``). Absent keys mean MuJoCo's
+    default."""
 
     timestep: float | None = 0.002
     gravity: Vec3 | None = (0.0, 0.0, -9.81)
     ground: GroundConfig | None = field(default_factory=GroundConfig)
     integrator: str | None = None
+    option: dict[str, Any] = field(default_factory=dict)
+    flag: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -409,6 +479,8 @@ class Meta:
         motor_config_list: hurodes motor device configs, kept verbatim.
         joint_mapping: contents of ``joint_mapping.yaml``, kept verbatim, or ``None``.
         format_version: the HRDF format version read, or ``None`` for a hurodes folder.
+        mjcf_size: MJCF ``<size>`` ``nuser_*`` values (see :data:`NUSER_KEYS`) the
+            robot sets: the length of each object type's ``user`` array.
         extra: other top-level keys of ``meta.yaml``, kept verbatim.
     """
 
@@ -419,6 +491,7 @@ class Meta:
     motor_config_list: list[dict[str, Any]] | None = None
     joint_mapping: dict[str, Any] | None = None
     format_version: str | None = FORMAT_VERSION
+    mjcf_size: dict[str, int] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
 
 

@@ -16,6 +16,8 @@ from typing import Any
 
 from robotwright.hrdf.model import (
     MUJOCO_ROLLING_FRICTION,
+    MUJOCO_SOLIMP,
+    MUJOCO_SOLREF,
     MUJOCO_TORSIONAL_FRICTION,
 )
 
@@ -29,7 +31,8 @@ class Column:
 
     Attributes:
         field: the dataclass field name.
-        kind: ``float``, ``int`` or ``str`` (type of each cell).
+        kind: ``float``, ``int``, ``str`` (type of each cell) or ``floats`` (one cell
+            holding any number of space-separated numbers, e.g. MuJoCo ``user`` data).
         size: 0 for a scalar column named ``csv``; n for ``csv0..csv{n-1}``.
         csv: the CSV column name (or prefix for vectors).
         required: the column must be present in the header (hurodes' columns).
@@ -82,7 +85,19 @@ def _geom_ext() -> list[Column]:
         Column("group", "int", "group", required=False, default=0),
         Column("condim", "int", "condim", required=False, default=3),
         Column("geom_name", "str", "geom_name", required=False, default=None, empty_ok=True),
+        Column("solref", "float", "solref", 2, required=False, default=MUJOCO_SOLREF),
+        Column("solimp", "float", "solimp", 5, required=False, default=MUJOCO_SOLIMP),
+        Column("margin", "float", "margin", required=False, default=0.0),
+        Column("gap", "float", "gap", required=False, default=0.0),
+        Column("priority", "int", "priority", required=False, default=0),
+        Column("solmix", "float", "solmix", required=False, default=1.0),
+        _user(),
     ]
+
+
+def _user() -> Column:
+    """MuJoCo ``user`` data: one cell of space-separated numbers, empty = none."""
+    return Column("user", "floats", "user", required=False, default=(), empty_ok=True)
 
 
 BODY_COLUMNS: list[Column] = [
@@ -94,6 +109,8 @@ BODY_COLUMNS: list[Column] = [
     Column("quat", "float", "quat", 4),
     Column("name", "str", "name"),
     Column("id", "int", "id"),
+    Column("gravcomp", "float", "gravcomp", required=False, default=0.0),
+    _user(),
 ]
 
 JOINT_COLUMNS: list[Column] = [
@@ -112,6 +129,22 @@ JOINT_COLUMNS: list[Column] = [
     Column("stiffness", "float", "stiffness", required=False, default=0.0),
     Column("springref", "float", "springref", required=False, default=0.0),
     Column("ref", "float", "ref", required=False, default=0.0),
+    Column("margin", "float", "margin", required=False, default=0.0),
+    Column(
+        "actuatorfrcrange",
+        "float",
+        "actuatorfrcrange",
+        2,
+        required=False,
+        default=None,
+        empty_ok=True,
+    ),
+    Column("actuatorgravcomp", "int", "actuatorgravcomp", required=False, default=False),
+    Column("solreflimit", "float", "solreflimit", 2, required=False, default=MUJOCO_SOLREF),
+    Column("solimplimit", "float", "solimplimit", 5, required=False, default=MUJOCO_SOLIMP),
+    Column("solreffriction", "float", "solreffriction", 2, required=False, default=MUJOCO_SOLREF),
+    Column("solimpfriction", "float", "solimpfriction", 5, required=False, default=MUJOCO_SOLIMP),
+    _user(),
 ]
 
 ACTUATOR_COLUMNS: list[Column] = [
@@ -125,6 +158,7 @@ ACTUATOR_COLUMNS: list[Column] = [
     Column("gear", "float", "gear", required=False, default=1.0),
     Column("ctrl_range", "float", "ctrl_range", 2, required=False, default=None, empty_ok=True),
     Column("force_range", "float", "force_range", 2, required=False, default=None, empty_ok=True),
+    _user(),
 ]
 
 MESH_COLUMNS: list[Column] = [
@@ -161,6 +195,7 @@ SITE_COLUMNS: list[Column] = [
     Column("size", "float", "size", 3, required=False, default=(0.005, 0.0, 0.0)),
     Column("rgba", "float", "rgba", 4, required=False, default=(0.5, 0.5, 0.5, 1.0)),
     Column("group", "int", "group", required=False, default=0),
+    _user(),
 ]
 
 SENSOR_COLUMNS: list[Column] = [
@@ -172,6 +207,7 @@ SENSOR_COLUMNS: list[Column] = [
     Column("refname", "str", "refname", required=False, default=None, empty_ok=True),
     Column("noise", "float", "noise", required=False, default=0.0),
     Column("cutoff", "float", "cutoff", required=False, default=0.0),
+    _user(),
 ]
 
 #: table file stem -> schema, in the order tables are read and written.
@@ -197,6 +233,8 @@ def parse_cell(text: str, kind: str) -> Any:
     """Convert one CSV cell (already known non-empty) to ``kind``."""
     if kind == "str":
         return text
+    if kind == "floats":
+        return tuple(parse_cell(part, "float") for part in text.split())
     if kind == "int":
         try:
             value = float(text)
@@ -222,4 +260,6 @@ def format_cell(value: Any) -> str:
         return "1" if value else "0"
     if isinstance(value, float):
         return repr(value)
+    if isinstance(value, (tuple, list)):  # a ``floats`` cell
+        return " ".join(repr(float(v)) for v in value)
     return str(value)

@@ -37,6 +37,7 @@ from robotwright.hrdf.model import (
     SimulatorConfig,
     Site,
 )
+from robotwright.hrdf.options import nuser_from_model, options_from_model
 from robotwright.parsers import inertia as inr
 from robotwright.parsers import mjcf_extra
 from robotwright.parsers.meshes import (
@@ -113,24 +114,13 @@ _MATERIAL_UNHELD = (
 )  # fmt: skip
 #: Joint fields HRDF has no column for: (MJCF attribute, model array, per-dof?).
 _JOINT_UNHELD = (
-    ("solreflimit", "jnt_solref", False),
-    ("solimplimit", "jnt_solimp", False),
-    ("margin", "jnt_margin", False),
     ("group", "jnt_group", False),
-    ("actuatorgravcomp", "jnt_actgravcomp", False),
     ("stiffnesspoly", "jnt_stiffnesspoly", False),
     ("springyield", "jnt_springyield", False),
-    ("solreffriction", "dof_solref", True),
-    ("solimpfriction", "dof_solimp", True),
     ("dampingpoly", "dof_dampingpoly", True),
 )
 #: Geom fields HRDF has no column for.
-_GEOM_UNHELD = (
-    "geom_solref", "geom_solimp", "geom_solmix", "geom_margin", "geom_gap",
-    "geom_priority", "geom_fluid",
-)  # fmt: skip
-#: Option fields carried by SimulatorConfig; the others are reported when not default.
-_OPTION_HELD = {"timestep", "gravity", "integrator"}
+_GEOM_UNHELD = ("geom_fluid",)
 
 
 def _differs(model: mujoco.MjModel, attr: str, i: int, j: int = 0) -> bool:
@@ -139,17 +129,20 @@ def _differs(model: mujoco.MjModel, attr: str, i: int, j: int = 0) -> bool:
     return bool(np.any(getattr(model, attr)[i] != getattr(_DEFAULT_MODEL, attr)[j]))
 
 
-def _unheld_option_fields(model: mujoco.MjModel) -> list[str]:
-    out = []
-    for name in dir(model.opt):
-        if name.startswith("_") or name in _OPTION_HELD:
-            continue
-        a, b = getattr(model.opt, name), getattr(_DEFAULT_MODEL.opt, name)
-        if callable(a):
-            continue
-        if np.any(np.asarray(a) != np.asarray(b)):
-            out.append(name)
-    return out
+def _user(values) -> tuple[float, ...]:
+    """MuJoCo ``user`` data without its trailing zeros (``<size nuser_*>`` pads them)."""
+    vals = [float(v) for v in values]
+    while vals and vals[-1] == 0.0:
+        vals.pop()
+    return tuple(vals)
+
+
+def _pair(v) -> tuple[float, float]:
+    return (float(v[0]), float(v[1]))
+
+
+def _five(v) -> tuple[float, float, float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]), float(v[3]), float(v[4]))
 
 
 def _t3(v) -> tuple[float, float, float]:
@@ -227,6 +220,7 @@ def _actuator_record(model: mujoco.MjModel, i: int) -> Actuator | None:
         )
         if model.actuator_forcelimited[i]
         else None,
+        user=_user(model.actuator_user[i]),
     )
 
 
@@ -271,6 +265,8 @@ def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
         attrs["actearly"] = "true"
     if np.any(model.actuator_lengthrange[i] != 0):
         attrs["lengthrange"] = _fmt(model.actuator_lengthrange[i])
+    if _user(model.actuator_user[i]):
+        attrs["user"] = _fmt(_user(model.actuator_user[i]))
     return ET.Element("general", attrs)
 
 
@@ -452,8 +448,6 @@ def _bodies(
     for b in bodies_ids:
         if model.body_mocapid[b] >= 0:
             rep.warn("mocap flag dropped", f'<body name="{body_name(model, b)}">')
-        if model.body_gravcomp[b] != 0:
-            rep.warn("gravcomp dropped", f'<body name="{body_name(model, b)}">')
         if not model.body(b).name:
             rep.warn(f"unnamed body named '{body_name(model, b)}'", f"body #{b}")
         bodies.append(
@@ -466,6 +460,8 @@ def _bodies(
                 inertial_pos=_t3(model.body_ipos[b]),
                 inertial_quat=_t4(model.body_iquat[b]),
                 diag_inertia=_t3(model.body_inertia[b]),
+                gravcomp=float(model.body_gravcomp[b]),
+                user=_user(model.body_user[b]),
             )
         )
 
@@ -504,12 +500,6 @@ def _joints(
         for attr, field_name, per_dof in _JOINT_UNHELD:
             if _differs(model, field_name, dof if per_dof else j):
                 unheld_joint.setdefault(attr, []).append(name or joint_name(model, j))
-        if model.jnt_actfrclimited[j]:
-            rep.warn(
-                f"actuatorfrcrange {model.jnt_actfrcrange[j].tolist()} dropped (HRDF joints "
-                "have no actuator force range; use actuator force_range)",
-                where,
-            )
         if jt in ("hinge", "slide"):
             springref = float(model.qpos_spring[qadr])
             ref = float(model.qpos0[qadr])
@@ -531,6 +521,16 @@ def _joints(
                 stiffness=float(model.jnt_stiffness[j]),
                 springref=springref,
                 ref=ref,
+                margin=float(model.jnt_margin[j]),
+                actuatorfrcrange=_pair(model.jnt_actfrcrange[j])
+                if model.jnt_actfrclimited[j]
+                else None,
+                actuatorgravcomp=bool(model.jnt_actgravcomp[j]),
+                solreflimit=_pair(model.jnt_solref[j]),
+                solimplimit=_five(model.jnt_solimp[j]),
+                solreffriction=_pair(model.dof_solref[dof]),
+                solimpfriction=_five(model.dof_solimp[dof]),
+                user=_user(model.jnt_user[j]),
             )
         )
 
@@ -594,6 +594,13 @@ def _geoms(
             "group": int(model.geom_group[g]),
             "condim": int(model.geom_condim[g]),
             "geom_name": gname,
+            "solref": _pair(model.geom_solref[g]),
+            "solimp": _five(model.geom_solimp[g]),
+            "margin": float(model.geom_margin[g]),
+            "gap": float(model.geom_gap[g]),
+            "priority": int(model.geom_priority[g]),
+            "solmix": float(model.geom_solmix[g]),
+            "user": _user(model.geom_user[g]),
         }
         if gt == 7:
             mid = int(model.geom_dataid[g])
@@ -758,6 +765,7 @@ def _sites(
                 size=_t3(model.site_size[s]),
                 rgba=_t4(np.clip(model.site_rgba[s], 0.0, 1.0)),
                 group=int(model.site_group[s]),
+                user=_user(model.site_user[s]),
             )
         )
 
@@ -822,6 +830,8 @@ def _sensors(
                 attrs["noise"] = repr(float(model.sensor_noise[s]))
             if model.sensor_cutoff[s]:
                 attrs["cutoff"] = repr(float(model.sensor_cutoff[s]))
+            if _user(model.sensor_user[s]):
+                attrs["user"] = _fmt(_user(model.sensor_user[s]))
             extra_sensors.append(ET.Element(stype, attrs))
             continue
         sensors.append(
@@ -834,6 +844,7 @@ def _sensors(
                 refname=refname,
                 noise=float(model.sensor_noise[s]),
                 cutoff=float(model.sensor_cutoff[s]),
+                user=_user(model.sensor_user[s]),
             )
         )
 
@@ -916,11 +927,9 @@ def parse_mjcf(
         if section is not None:
             extra_parts.append(section)
     actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
-    option_fields = _unheld_option_fields(model)
-    if option_fields:
-        rep.warn(
-            f"<option> fields {option_fields} dropped (HRDF keeps timestep, gravity, integrator)"
-        )
+    option, flag, option_unheld = options_from_model(model)
+    if option_unheld:
+        rep.warn(f"<option> fields {option_unheld} dropped (no HRDF key)")
     kept_names = {
         "body": {body_name(model, b) for b in keep if b not in frames},
         "xbody": {body_name(model, b) for b in keep if b not in frames},
@@ -955,6 +964,8 @@ def parse_mjcf(
         gravity=_t3(model.opt.gravity),
         ground=None,
         integrator=_INTEGRATORS.get(int(model.opt.integrator)),
+        option=option,
+        flag=flag,
     )
     hrdf = HRDF(
         name=spec.modelname or path.stem,
@@ -965,7 +976,7 @@ def parse_mjcf(
         simple_geoms=simple,
         sites=sites,
         sensors=sensors,
-        meta=Meta(simulator_config=sim, body_name_config=None),
+        meta=Meta(simulator_config=sim, body_name_config=None, mjcf_size=nuser_from_model(model)),
         mjcf_extra=extra,
         root_dir=store.root,
         temp_assets=store.lifetime,
