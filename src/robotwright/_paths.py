@@ -23,17 +23,21 @@ are the caller's own.
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
-from robotwright.errors import UnsafePathError
+from robotwright._inputs import MAX_XML_BYTES, _kind, read_bytes
+from robotwright.errors import InputFileError, UnsafePathError
 
 __all__ = [
     "check_mjcf_includes",
     "check_mjcf_spec",
+    "check_regular",
+    "checked_mjcf_spec",
     "resolve_inside",
     "trusted_asset_roots",
     "trusted_roots",
@@ -126,6 +130,25 @@ def resolve_inside(
     )
 
 
+def check_regular(path: Path) -> Path:
+    """``path`` if it is a regular file or does not exist (its reader then reports it).
+
+    MuJoCo and mesh readers open the files a model names with a blocking ``open``: a
+    FIFO named as a mesh would hang them, and ``/dev/zero`` would be read until memory
+    runs out. ``stat`` answers without opening the file.
+
+    Raises:
+        UnsafePathError: ``path`` is a FIFO, a device, a socket or a folder.
+    """
+    try:
+        mode = path.stat().st_mode
+    except (OSError, ValueError):
+        return path
+    if not stat.S_ISREG(mode):
+        raise UnsafePathError(f"'{path}' is {_kind(mode)}; expected a regular file")
+    return path
+
+
 # ------------------------------------------------------------------------------- MJCF
 
 #: MJCF asset elements whose files MuJoCo reads at compile time, and the compiler folder
@@ -196,7 +219,10 @@ def check_mjcf_includes(
                         element=elem,
                     )
                 try:
-                    child = SafeET.parse(str(path)).getroot()
+                    # Regular file, size cap: a FIFO or /dev/zero include never blocks.
+                    child = SafeET.fromstring(read_bytes(path, MAX_XML_BYTES))
+                except InputFileError as exc:
+                    raise UnsafePathError(exc.reason, file=where, element=elem) from None
                 except (defusedxml.DefusedXmlException, SafeET.ParseError, OSError) as exc:
                     raise UnsafePathError(
                         f"the included file cannot be read as safe XML: {exc}",
@@ -211,8 +237,10 @@ def check_mjcf_includes(
                 if attr.startswith("file") and value:
                     for folder in dirs:
                         try:
-                            resolve_inside(
-                                Path(folder) / value, base=model_dir, root=root, trusted=trusted
+                            check_regular(
+                                resolve_inside(
+                                    Path(folder) / value, base=model_dir, root=root, trusted=trusted
+                                )
                             )
                         except UnsafePathError as exc:
                             elem = _element(el.tag, el.get("name"), attr, value)
@@ -250,9 +278,38 @@ def check_mjcf_spec(
                     continue
                 file = os.path.basename(value) if strip else value
                 try:
-                    resolve_inside(
-                        Path(folder or "") / file, base=model_dir, root=root, trusted=trusted
+                    check_regular(
+                        resolve_inside(
+                            Path(folder or "") / file, base=model_dir, root=root, trusted=trusted
+                        )
                     )
                 except UnsafePathError as exc:
                     elem = _element(tag, item.name, attr, value)
                     raise UnsafePathError(exc.reason, file=source, element=elem) from None
+
+
+def checked_mjcf_spec(path: PathLike, *, trusted: Sequence[Path] | None = None) -> Any:
+    """The ``mujoco.MjSpec`` of the MJCF file ``path``, after the checks every MJCF
+    reader makes before MuJoCo opens a file: the XML is read safely (regular file, size
+    cap, no entities), and every file it names (includes, meshes, textures, height
+    fields) resolves inside the file's folder or a trusted one and is a regular file.
+
+    Raises:
+        UnsafePathError: a named file leaves the folder or is not a regular file (file
+            and element named).
+        robotwright.errors.ConversionError: the file itself is missing, not a regular
+            file, too large, unsafe or not well-formed XML.
+        ValueError: MuJoCo's parser refuses the file.
+    """
+    import mujoco
+
+    from robotwright.parsers.xmlsafe import parse_xml
+
+    path = Path(path)
+    tree = parse_xml(path)
+    folder = path.resolve().parent
+    where = {"source": str(path), "model_dir": folder, "root": folder}
+    check_mjcf_includes(tree, **where, trusted=trusted)
+    spec = mujoco.MjSpec.from_file(str(path))
+    check_mjcf_spec(spec, **where, trusted=trusted)
+    return spec

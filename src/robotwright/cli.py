@@ -21,6 +21,7 @@ from robotwright._notes import CaughtNotes, collect_notes, summary_line
 from robotwright._paths import trusted_asset_roots
 from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
+from robotwright.parsers.packages import given_packages
 
 # Modules that expose ``register(subparsers: argparse._SubParsersAction) -> None``.
 _COMMAND_MODULES: tuple[str, ...] = (
@@ -47,7 +48,12 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "things",
     "view",
     "render",
+    "lidar",
 )
+
+#: Commands that read URDF/xacro files: they take ``--package NAME=DIR`` (see
+#: :mod:`robotwright.parsers.packages`).
+_PACKAGE_COMMANDS: tuple[str, ...] = ("convert", "roundtrip", "view", "render")
 
 #: Commands that copy mesh (and asset) files into their output: they take
 #: ``--max-mesh-mb MB`` (see :func:`robotwright._atomic.mesh_size_limit`).
@@ -129,6 +135,17 @@ def build_parser() -> argparse.ArgumentParser:
             help="trust folder DIR: mesh/asset paths of the input may point into it "
             "(by default they must stay inside the robot's own folder); repeatable",
         )
+    for name in _PACKAGE_COMMANDS:
+        sub.choices[name].add_argument(
+            "--package",
+            action="append",
+            dest="packages",
+            type=_package_arg,
+            metavar="NAME=DIR",
+            default=[],
+            help="URDF/xacro: package://NAME/... and $(find NAME) name folder DIR (by default "
+            "only packages inside the robot's own folder or ROS package are found); repeatable",
+        )
     for name in _MESH_COPY_COMMANDS:
         sub.choices[name].add_argument(
             "--max-mesh-mb",
@@ -149,6 +166,19 @@ def _positive_mb(text: str) -> float:
     if not (value > 0 and value != float("inf")):
         raise argparse.ArgumentTypeError(f"expected a positive number of MB, got {text!r}")
     return value
+
+
+def _package_arg(value: str) -> tuple[str, str]:
+    """``--package NAME=DIR`` as ``(NAME, DIR)`` (argparse reports a malformed value)."""
+    from robotwright.parsers.packages import check_package_name
+
+    name, sep, folder = value.partition("=")
+    if not sep or not folder:
+        raise argparse.ArgumentTypeError(f"{value!r}: expected NAME=DIR (a package and its folder)")
+    try:
+        return check_package_name(name), folder
+    except RobotwrightError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _report_notes(caught: CaughtNotes, verbose: bool) -> None:
@@ -184,8 +214,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     try:
         roots = getattr(args, "asset_roots", None) or []
+        packages = given_packages(dict(getattr(args, "packages", None) or []))
         limit = mesh_size_limit(getattr(args, "max_mesh_mb", None))
-        with trusted_asset_roots(roots), limit, collect_notes() as caught:
+        with trusted_asset_roots(roots), packages, limit, collect_notes() as caught:
             code = int(args.func(args) or 0)
         # Commands that only show a model (view, render) write no conversion: the notes
         # of loading it say nothing about the picture, so they are listed with -v only.

@@ -174,9 +174,13 @@ def test_urdf_package_found_among_ancestors_must_be_a_package(tmp_path: Path) ->
     with pytest.raises(ConversionError, match="package 'outside' not found") as exc:
         urdf_to_hrdf(path)
     assert '<link name="base">' in str(exc.value)
-    # A real ROS package (package.xml) beside the robot is still found.
+    # A real ROS package (package.xml) beside the robot is a sibling: found only when the
+    # user names it (package_map / --package).
     (tmp_path / "outside" / "package.xml").write_text("<package><name>outside</name></package>")
-    assert len(urdf_to_hrdf(path).meshes) == 1
+    with pytest.raises(ConversionError, match="package 'outside' not found"):
+        urdf_to_hrdf(path)
+    named = urdf_to_hrdf(path, package_map={"outside": tmp_path / "outside"})
+    assert len(named.meshes) == 1
 
 
 def test_urdf_symlinked_mesh_is_refused(tmp_path: Path, capsys) -> None:
@@ -185,6 +189,7 @@ def test_urdf_symlinked_mesh_is_refused(tmp_path: Path, capsys) -> None:
     (tmp_path / "robot" / "meshes").mkdir(parents=True)
     (tmp_path / "robot" / "meshes" / "m.stl").symlink_to(secret)
     path.parent.mkdir(parents=True)
+    (tmp_path / "robot" / "package.xml").write_text("<package><name>robot</name></package>")
     path.write_text(URDF.format(uri="../meshes/m.stl"))
     with pytest.raises(ConversionError, match="through a symbolic link") as exc:
         urdf_to_hrdf(path)

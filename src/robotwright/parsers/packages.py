@@ -1,27 +1,44 @@
 """Resolution of mesh URIs in URDF files: ``package://``, ``file://`` and relative paths.
 
-``package://NAME/rest`` is looked up, in this order:
+A URDF or xacro file downloaded from the web is untrusted: the paths it names must not
+make robotwright read or copy files next to it that are not part of the robot (a
+``robot.urdf`` saved in ``~/Downloads`` must not copy ``~/work/private.stl``). Its
+*root* (:func:`robot_root`) is the folder it may read from: the ROS package folder that
+holds it (the nearest ancestor with a ``package.xml``: ``my_robot_description/urdf/``
++ ``my_robot_description/meshes/``), else the URDF's own folder. Sibling and parent
+folders are reachable only when the user names them: ``asset_roots`` /
+``--asset-root DIR``, or a package given with ``package_map`` / ``--package NAME=DIR``.
 
-1. the ``package_map`` argument (``{"NAME": folder}``);
+``package://NAME/rest`` (and xacro's ``$(find NAME)``) is looked up, in this order:
+
+1. the ``package_map`` argument (``{"NAME": folder}``), then the packages given with
+   :func:`given_packages` (``robotwright --package NAME=DIR``);
 2. ``ROS_PACKAGE_PATH`` entries (a folder named ``NAME``, or one holding a
    ``package.xml`` whose ``<name>`` is ``NAME``, up to three levels below each entry);
 3. ``AMENT_PREFIX_PATH`` entries (``<prefix>/share/NAME``);
-4. the URDF's ancestor folders: an ancestor called ``NAME``, an ancestor holding a
-   ``NAME`` sub-folder, or an ancestor whose ``package.xml`` names ``NAME``.
+4. inside the root only: the root itself when its ``package.xml`` names ``NAME``, an
+   ancestor of the URDF inside the root called ``NAME``, or a sub-folder ``NAME`` of
+   such an ancestor (symbolic links followed: it must lie inside the root);
+5. the ROS layout without its ``package.xml``: a URDF in a folder ``urdf`` whose parent
+   folder is called ``NAME`` (``jvrc_description/urdf/jvrc1.urdf`` naming
+   ``package://jvrc_description/meshes/...``) gets that parent folder.
+
+Steps 1 to 3 are the user's choice (arguments, command line, environment); step 4 never
+leaves the root, and step 5 only takes a folder that the URI names exactly, one level
+above the URDF's ``urdf`` folder.
 
 A resolved path must stay inside its package folder (``..`` may not climb out), and a
-relative or ``file://`` path must stay inside the robot folder (see :func:`robot_root`),
-symbolic links followed, unless it lies in a folder trusted explicitly (see
-:mod:`robotwright._paths`). A package found among the URDF's ancestors (step 4) must
-hold a ``package.xml`` or lie inside the robot folder, so that ``package://etc/passwd``
-cannot name ``/etc``.
+relative or ``file://`` path must stay inside the root, symbolic links followed, unless
+it lies in a folder trusted explicitly (see :mod:`robotwright._paths`).
 """
 
 from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
 from functools import lru_cache
 from pathlib import Path
 from urllib.parse import unquote, urlparse
@@ -30,6 +47,66 @@ from robotwright._paths import resolve_inside
 from robotwright.errors import UnsafePathError
 
 _NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
+
+_GIVEN: ContextVar[tuple[tuple[str, Path], ...]] = ContextVar(
+    "robotwright_given_packages", default=()
+)
+
+
+@contextmanager
+def given_packages(packages: Mapping[str, str | os.PathLike[str]]) -> Iterator[dict[str, Path]]:
+    """Within the block, ``package://NAME`` and ``$(find NAME)`` of every reader resolve
+    to the folder ``packages[NAME]`` (after a reader's own ``package_map`` argument):
+    the packages the user named (``robotwright --package NAME=DIR``). Yields every
+    package given in the block.
+
+    Raises:
+        UnsafePathError: a folder does not exist, or a name is not a package name.
+    """
+    added = []
+    for name, folder in packages.items():
+        check_package_name(name)
+        path = Path(folder).expanduser()
+        try:
+            resolved = path.resolve()
+        except (OSError, RuntimeError) as exc:
+            raise UnsafePathError(f"package '{name}': {folder} cannot be resolved: {exc}") from None
+        if not resolved.is_dir():
+            raise UnsafePathError(f"package '{name}': {folder} is not a folder")
+        added.append((name, resolved))
+    token = _GIVEN.set(tuple(added) + _GIVEN.get())
+    try:
+        yield dict(reversed(_GIVEN.get()))
+    finally:
+        _GIVEN.reset(token)
+
+
+def given_package_map(
+    package_map: Mapping[str, str | os.PathLike] | None = None,
+) -> dict[str, str]:
+    """``package_map`` over the packages of the enclosing :func:`given_packages` blocks
+    (for a reader that runs in another process: the xacro expansion)."""
+    merged = {name: str(folder) for name, folder in reversed(_GIVEN.get())}
+    merged.update({str(k): str(v) for k, v in (package_map or {}).items()})
+    return merged
+
+
+_PACKAGE_NAME_RE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]*")
+
+
+def check_package_name(name: str) -> str:
+    """``name`` if it can name a package (letters, digits, ``_ . + -``, not starting with
+    ``.`` or ``-``; no ``/``).
+
+    Raises:
+        UnsafePathError: otherwise.
+    """
+    if not _PACKAGE_NAME_RE.fullmatch(name or ""):
+        raise UnsafePathError(
+            f"package name {name!r}: expected letters, digits, '_', '.', '+' or '-' "
+            "(not starting with '.' or '-')"
+        )
+    return name
 
 
 class UnresolvedMesh(Exception):
@@ -70,9 +147,15 @@ def _search_root(root: Path, name: str, depth: int = 3) -> Path | None:
 def find_package(
     name: str, urdf_path: Path, package_map: Mapping[str, str | os.PathLike] | None = None
 ) -> Path | None:
-    """Folder of ROS package ``name`` (see the module docstring for the order)."""
+    """Folder of ROS package ``name`` (see the module docstring for the order), or
+    ``None``: not found, or only outside the URDF's root and not named by the user."""
     if package_map and name in package_map:
         return Path(package_map[name])
+    for given, folder in _GIVEN.get():
+        if given == name:
+            return folder
+    if not name or name in (".", "..") or "/" in name or "\0" in name:
+        return None
     for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
         if entry:
             found = _search_root(Path(entry), name)
@@ -81,32 +164,37 @@ def find_package(
     for entry in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
         if entry and (Path(entry) / "share" / name).is_dir():
             return Path(entry) / "share" / name
+    return _package_inside_root(name, urdf_path)
+
+
+def _package_inside_root(name: str, urdf_path: Path) -> Path | None:
+    """Steps 4 and 5 of the module docstring: no folder outside the URDF's root, but the
+    ``NAME/urdf/`` layout's ``NAME``."""
+    resolved = urdf_path.resolve()
     root = robot_root(urdf_path)
-
-    def is_package(folder: Path) -> bool:
-        # Any folder on the way up (/etc, /home) is not a package: it needs a package.xml
-        # or must lie inside the robot folder.
-        return folder.resolve().is_relative_to(root) or (folder / "package.xml").is_file()
-
-    for ancestor in urdf_path.resolve().parents:
-        if ancestor.name == name and is_package(ancestor):
+    for ancestor in resolved.parents:
+        if not ancestor.is_relative_to(root):
+            break
+        if ancestor.name == name or (ancestor == root and _package_xml_name(str(root)) == name):
             return ancestor
-        if (ancestor / name).is_dir() and is_package(ancestor / name):
-            return ancestor / name
-        if _package_xml_name(str(ancestor)) == name:
-            return ancestor
+        child = ancestor / name
+        if child.is_dir() and child.resolve().is_relative_to(root):
+            return child
+    folder = resolved.parent
+    if root == folder and folder.name == "urdf" and folder.parent.name == name:
+        return folder.parent
     return None
 
 
 def robot_root(urdf_path: Path) -> Path:
-    """The folder relative and ``file://`` mesh paths must stay inside: the nearest
-    ancestor of the URDF holding a ``package.xml``, else the parent of the URDF's folder
-    (the usual ``urdf/`` + ``meshes/`` layout)."""
+    """The folder a URDF or xacro file may read from (relative and ``file://`` mesh
+    paths, xacro includes and ``load_yaml``): the nearest ancestor of the file holding a
+    ``package.xml`` (the ROS package it belongs to), else the file's own folder."""
     resolved = urdf_path.resolve()
     for ancestor in resolved.parents:
         if (ancestor / "package.xml").is_file():
             return ancestor
-    return resolved.parent.parent
+    return resolved.parent
 
 
 def resolve_uri(
@@ -125,10 +213,7 @@ def resolve_uri(
         name, _, sub = rest.partition("/")
         pkg = find_package(name, urdf_path, package_map)
         if pkg is None:
-            raise UnresolvedMesh(
-                f"package '{name}' not found (package_map, ROS_PACKAGE_PATH, "
-                f"AMENT_PREFIX_PATH, ancestors of {urdf_path})"
-            )
+            raise UnresolvedMesh(package_not_found(name, urdf_path))
         try:
             path = resolve_inside(
                 unquote(sub), base=pkg, root=pkg, what=f"the folder of package '{name}'"
@@ -144,5 +229,22 @@ def resolve_uri(
         except UnsafePathError as exc:
             raise UnresolvedMesh(str(exc) if str(raw) == uri else f"'{uri}': {exc}") from None
     if not path.is_file():
+        if path.exists():
+            raise UnresolvedMesh(f"'{uri}' resolves to {path}, which is not a regular file")
         raise UnresolvedMesh(f"'{uri}' resolves to {path}, which does not exist")
     return path
+
+
+def package_not_found(name: str, urdf_path: Path) -> str:
+    """Why package ``name`` named by the file at ``urdf_path`` was not found, and how
+    to name it."""
+    return (
+        f"package '{name}' not found inside {robot_root(urdf_path)} (the folder of "
+        f"{urdf_path.name}, or the ROS package holding it), nor in package_map, "
+        "ROS_PACKAGE_PATH or AMENT_PREFIX_PATH; name its folder with --package "
+        f"{_shown_name(name)}=DIR (package_map in Python)"
+    )
+
+
+def _shown_name(name: str) -> str:
+    return name if _PACKAGE_NAME_RE.fullmatch(name or "") else "NAME"

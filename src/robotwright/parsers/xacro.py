@@ -41,7 +41,12 @@ import defusedxml.ElementTree as DET
 from robotwright._inputs import MAX_XML_BYTES, MAX_YAML_BYTES, decode, read_bytes
 from robotwright._paths import resolve_inside, trusted_roots
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
-from robotwright.parsers.packages import find_package, robot_root
+from robotwright.parsers.packages import (
+    find_package,
+    given_package_map,
+    package_not_found,
+    robot_root,
+)
 from robotwright.parsers.report import Reporter
 from robotwright.parsers.xacro_eval import ExpressionError, installed
 from robotwright.parsers.xmlsafe import parse_xml
@@ -118,7 +123,8 @@ def expand_xacro(
     request = {
         "path": str(src),
         "xacro_args": {str(k): str(v) for k, v in (xacro_args or {}).items()},
-        "package_map": {str(k): str(v) for k, v in (package_map or {}).items()},
+        # The packages named with --package travel with the request (another process).
+        "package_map": given_package_map(package_map),
         "trusted": [str(p) for p in trusted_roots(asset_roots)],
         "limits": [XACRO_CPU_S, XACRO_MEMORY_BYTES],
     }
@@ -290,10 +296,7 @@ class _Guard:
     def find(self, name: str) -> str:
         folder = find_package(name, self.src, self.package_map)
         if folder is None:
-            raise _Refused(
-                f"$(find {name}): package '{name}' not found (package_map, ROS_PACKAGE_PATH, "
-                f"AMENT_PREFIX_PATH, ancestors of {self.src})"
-            )
+            raise _Refused(f"$(find {name}): {package_not_found(name, self.src)}")
         resolved = folder.resolve()
         self.packages[name] = resolved
         return str(resolved)

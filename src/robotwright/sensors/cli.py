@@ -5,13 +5,17 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from robotwright._atomic import check_output_path
 from robotwright._outputs import add_overwrite_flag, check_overwrite
-from robotwright.errors import ConversionError, SensorError
+from robotwright.errors import ConversionError, InputFileError, SensorError, UnsafePathError
 from robotwright.sensors._names import PATTERN_NAMES
 
-__all__ = ["register", "run"]
+if TYPE_CHECKING:
+    import mujoco
+
+__all__ = ["load_scene", "read_mapping", "register", "run"]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -63,15 +67,73 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+#: Largest ``--mapping`` file (a mapping of a hundred classes is a few kB).
+MAX_MAPPING_BYTES = 1 << 20
+
+
+def read_mapping(path: Path) -> dict[str, list[str]]:
+    """The ``--mapping`` JSON file ``{class name: [keywords]}``, read as every untrusted
+    input is (regular file, size cap, UTF-8, bounded nesting) and checked as the Python
+    API checks a mapping (a keyword string, an empty list, a class named ``unknown``
+    are refused).
+
+    Raises:
+        SensorError: naming the file and what is wrong.
+    """
+    from robotwright._inputs import load_json, read_text
+    from robotwright.sensors.config import check_class_mapping
+
+    expected = "expected a JSON object {class: [keywords]}"
+    try:
+        mapping = load_json(read_text(path, MAX_MAPPING_BYTES), path)
+    except InputFileError as exc:
+        raise SensorError(f"--mapping {exc}") from None
+    except OSError as exc:
+        raise SensorError(f"--mapping {path}: {exc.strerror or exc}") from None
+    except json.JSONDecodeError as exc:
+        raise SensorError(f"--mapping {path}: not valid JSON ({exc}); {expected}") from None
+    if not isinstance(mapping, dict):
+        raise SensorError(f"--mapping {path}: {expected}, got a JSON {type(mapping).__name__}")
+    check_class_mapping(mapping, f"--mapping {path}")
+    return mapping
+
+
+def load_scene(path: Path) -> mujoco.MjModel:
+    """The compiled MJCF scene at ``path``, through the gate every MJCF reader uses
+    (:func:`robotwright._paths.checked_mjcf_spec`): no XML entities, every file it names
+    a regular file inside its folder or a folder trusted with ``--asset-root``.
+
+    Raises:
+        SensorError: the scene is unreadable, not MJCF, or refused by MuJoCo.
+        UnsafePathError: a file it names leaves its folder or is not a regular file.
+    """
+    from robotwright._paths import checked_mjcf_spec
+    from robotwright.parsers.xmlsafe import parse_xml
+
+    try:
+        root = parse_xml(path)
+    except ConversionError as exc:
+        raise SensorError(f"{path}: {exc.problems[0].message}") from None
+    if root.tag != "mujoco":
+        raise SensorError(f"{path}: root element <{root.tag}>: expected <mujoco> (an MJCF scene)")
+    try:
+        return checked_mjcf_spec(path).compile()
+    except ConversionError as exc:
+        raise SensorError(f"{path}: {exc.problems[0].message}") from None
+    except UnsafePathError:
+        raise
+    except ValueError as exc:  # MuJoCo reports parse and compile errors as ValueError
+        raise SensorError(f"{path}: MuJoCo cannot load the scene: {exc}") from None
+
+
 def run(args: argparse.Namespace) -> int:
     import mujoco
 
-    from robotwright.parsers.xmlsafe import parse_xml
     from robotwright.sensors.scan import scan_to_files
 
     if args.output is None and args.png is None:
         raise SensorError("nothing to write: give -o SCAN.npz and/or --png SCAN.png")
-    if not args.scene.is_file():
+    if not args.scene.exists():
         raise SensorError(f"{args.scene}: scene file not found")
     if args.view_radius is not None and not args.view_radius > 0:
         raise SensorError(
@@ -86,25 +148,8 @@ def run(args: argparse.Namespace) -> int:
             if not out.parent.is_dir():
                 raise SensorError(f"{out}: folder {out.parent} does not exist")
     check_overwrite([args.output, args.png], args.overwrite)
-    try:
-        # MuJoCo's own parser expands XML entities: refuse them first (entity bombs).
-        parse_xml(args.scene)
-    except ConversionError as exc:
-        raise SensorError(f"{args.scene}: {exc.problems[0].message}") from exc
-    mapping = None
-    if args.mapping is not None:
-        try:
-            mapping = json.loads(args.mapping.read_text(encoding="utf-8"))
-        except (OSError, json.JSONDecodeError) as exc:
-            raise SensorError(
-                f"{args.mapping}: expected a JSON object {{class: [keywords]}}: {exc}"
-            ) from exc
-        if not isinstance(mapping, dict):
-            raise SensorError(f"{args.mapping}: expected a JSON object {{class: [keywords]}}")
-    try:
-        model = mujoco.MjModel.from_xml_path(str(args.scene))
-    except ValueError as exc:  # MuJoCo reports compile errors as ValueError
-        raise SensorError(f"{args.scene}: MuJoCo cannot load the scene: {exc}") from exc
+    mapping = None if args.mapping is None else read_mapping(args.mapping)
+    model = load_scene(args.scene)
     data = mujoco.MjData(model)
     if model.nkey:
         mujoco.mj_resetDataKeyframe(model, data, 0)

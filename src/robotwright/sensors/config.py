@@ -11,7 +11,12 @@ import numpy as np
 from robotwright.errors import SensorError
 from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
 
-__all__ = ["LidarCfg", "SemanticLidarCfg", "DEFAULT_SEMANTIC_CLASS_MAPPING"]
+__all__ = [
+    "DEFAULT_SEMANTIC_CLASS_MAPPING",
+    "LidarCfg",
+    "SemanticLidarCfg",
+    "check_class_mapping",
+]
 
 #: Most CPU threads a sensor may start.
 MAX_THREADS = 256
@@ -226,24 +231,39 @@ class SemanticLidarCfg(LidarCfg):
             self.semantic_class_mapping = {
                 k: list(v) for k, v in DEFAULT_SEMANTIC_CLASS_MAPPING.items()
             }
-        if not isinstance(self.semantic_class_mapping, dict):
+        check_class_mapping(self.semantic_class_mapping, f"{name}.semantic_class_mapping")
+
+
+#: The name of class id 0 (a miss, or a geom no class names): no class may take it.
+UNKNOWN_CLASS = "unknown"
+
+
+def check_class_mapping(mapping: object, where: str) -> None:
+    """Check a semantic class mapping: a dict of non-empty class names (not
+    :data:`UNKNOWN_CLASS`, whatever its case) to non-empty lists of non-empty keyword
+    strings (a string is refused: it is not split into letters).
+
+    Raises:
+        SensorError: naming ``where`` (a config field or a file) and the class.
+    """
+    if not isinstance(mapping, dict):
+        raise SensorError(
+            f"{where}: expected a dict of class name -> keywords, got {type(mapping).__name__}"
+        )
+    for cls, keywords in mapping.items():
+        if not isinstance(cls, str) or not cls:
+            raise SensorError(f"{where}: class names must be non-empty strings, got {cls!r}")
+        if cls.casefold() == UNKNOWN_CLASS:
             raise SensorError(
-                f"{name}.semantic_class_mapping: expected a dict of class name -> keywords"
+                f"{where}: class name {cls!r} is reserved for id 0 (misses and geoms no class "
+                "names); choose another name"
             )
-        for cls, keywords in self.semantic_class_mapping.items():
-            if not isinstance(cls, str) or not cls:
-                raise SensorError(
-                    f"{name}.semantic_class_mapping: class names must be non-empty strings, got {cls!r}"
-                )
-            if isinstance(keywords, str) or not isinstance(keywords, (list, tuple)):
-                raise SensorError(
-                    f"{name}.semantic_class_mapping[{cls!r}]: expected a list of keywords, got {keywords!r}"
-                )
-            if not keywords:
-                raise SensorError(
-                    f"{name}.semantic_class_mapping[{cls!r}]: empty keyword list (class can never match)"
-                )
-            if any(not isinstance(k, str) or not k for k in keywords):
-                raise SensorError(
-                    f"{name}.semantic_class_mapping[{cls!r}]: keywords must be non-empty strings"
-                )
+        if isinstance(keywords, str) or not isinstance(keywords, (list, tuple)):
+            raise SensorError(
+                f"{where}[{cls!r}]: expected a list of keywords, got "
+                f"{type(keywords).__name__} {keywords!r:.80}"
+            )
+        if not keywords:
+            raise SensorError(f"{where}[{cls!r}]: empty keyword list (class can never match)")
+        if any(not isinstance(k, str) or not k for k in keywords):
+            raise SensorError(f"{where}[{cls!r}]: keywords must be non-empty strings")

@@ -60,9 +60,11 @@ def scan_to_files(
     cfg = SemanticLidarCfg(
         prim_path=sensor,
         pattern_cfg=pattern_from_name(pattern_name),
-        semantic_class_mapping={k: list(v) for k, v in semantic_class_mapping.items()}
-        if semantic_class_mapping is not None
-        else None,
+        # Passed as given: the config refuses a keyword string ({"terrain": "floor"})
+        # instead of splitting it into letters.
+        semantic_class_mapping=dict(semantic_class_mapping)
+        if isinstance(semantic_class_mapping, Mapping)
+        else semantic_class_mapping,
         max_distance=max_distance,
         offset_pos=offset_pos,
         mesh_prim_paths=list(mesh_prim_paths),
