@@ -18,6 +18,7 @@ from robotwright import __version__
 from robotwright._atomic import mesh_size_limit
 from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, collect_notes, summary_line
+from robotwright._npz import npz_limit
 from robotwright._paths import trusted_asset_roots
 from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
@@ -58,6 +59,10 @@ _PACKAGE_COMMANDS: tuple[str, ...] = ("convert", "roundtrip", "view", "render")
 #: Commands that copy mesh (and asset) files into their output: they take
 #: ``--max-mesh-mb MB`` (see :func:`robotwright._atomic.mesh_size_limit`).
 _MESH_COPY_COMMANDS: tuple[str, ...] = ("export", "compose", "convert", "things")
+
+#: Commands that read scan ``.npz`` files: they take ``--max-scan-mb MB`` (see
+#: :func:`robotwright._npz.npz_limit`).
+_SCAN_COMMANDS: tuple[str, ...] = ("view", "render")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -155,6 +160,15 @@ def build_parser() -> argparse.ArgumentParser:
             help="largest mesh or asset file copied into the output, in MB (default 512): "
             "a larger one is refused",
         )
+    for name in _SCAN_COMMANDS:
+        sub.choices[name].add_argument(
+            "--max-scan-mb",
+            type=_positive_mb,
+            default=None,
+            metavar="MB",
+            help="largest size of a scan's arrays once loaded, in MB (default 1000): a "
+            "scan .npz declaring more is refused before it is loaded",
+        )
     return parser
 
 
@@ -216,7 +230,8 @@ def _run(args: argparse.Namespace) -> int:
         roots = getattr(args, "asset_roots", None) or []
         packages = given_packages(dict(getattr(args, "packages", None) or []))
         limit = mesh_size_limit(getattr(args, "max_mesh_mb", None))
-        with trusted_asset_roots(roots), packages, limit, collect_notes() as caught:
+        scans = npz_limit(getattr(args, "max_scan_mb", None))
+        with trusted_asset_roots(roots), packages, limit, scans, collect_notes() as caught:
             code = int(args.func(args) or 0)
         # Commands that only show a model (view, render) write no conversion: the notes
         # of loading it say nothing about the picture, so they are listed with -v only.

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from robotwright.errors import RobotwrightError
+from robotwright.errors import InputFileError, RobotwrightError
 
 if TYPE_CHECKING:
     from robotwright.hrdf.model import HRDF
@@ -284,20 +284,22 @@ def read_scan(path: Path) -> ScanCloud:
         raise ViewError(f"{path}: no such scan file")
     if path.stat().st_size > MAX_SCAN_BYTES:
         raise ViewError(f"{path}: larger than {MAX_SCAN_BYTES >> 20} MiB; not a scan file")
+    from robotwright._npz import load_npz
+
     try:
-        # allow_pickle=False: a scan holds plain arrays; a pickled object is refused.
-        with np.load(path, allow_pickle=False) as npz:
-            missing = [k for k in _SCAN_FIELDS if k not in npz.files]
-            if missing:
-                raise ViewError(
-                    f"{path}: scan file lacks array(s) {', '.join(missing)}; "
-                    f"expected a scan written by 'robotwright lidar' (has {npz.files})"
-                )
-            arrays = {k: npz[k] for k in npz.files}
-    except ViewError:
-        raise
-    except (OSError, ValueError) as exc:
+        # Declared array sizes are checked against a limit before anything is loaded,
+        # and pickled objects are refused (see robotwright._npz).
+        arrays = load_npz(path, (*_SCAN_FIELDS, "hit_mask", "sensor_pos", "sensor_quat"))
+    except InputFileError as exc:
+        raise ViewError(f"{path}: not a readable .npz scan file: it {exc.reason}") from None
+    except OSError as exc:
         raise ViewError(f"{path}: not a readable .npz scan file: {exc}") from None
+    missing = [k for k in _SCAN_FIELDS if k not in arrays]
+    if missing:
+        raise ViewError(
+            f"{path}: scan file lacks array(s) {', '.join(missing)}; "
+            f"expected a scan written by 'robotwright lidar' (has {list(arrays)})"
+        )
     points = np.asarray(arrays["points"], dtype=np.float64)
     labels = np.asarray(arrays["labels"])
     names = tuple(str(n) for n in np.asarray(arrays["class_names"]).reshape(-1))
