@@ -28,6 +28,7 @@ if TYPE_CHECKING:
         RayTable,
         SpinningLidarPatternCfg,
         pattern_from_name,
+        ray_limit,
     )
     from robotwright.sensors.raycast import warp_available
     from robotwright.sensors.scan import scan_to_files
@@ -58,6 +59,7 @@ __all__ = [
     "geom_class_table",
     "geom_paths",
     "pattern_from_name",
+    "ray_limit",
     "scan_to_files",
     "warp_available",
 ]

@@ -18,7 +18,10 @@ on the GPU. ``rays(f)`` equals ``ray_table().window(f)`` for every frame.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Literal
@@ -38,6 +41,7 @@ __all__ = [
     "FilePatternCfg",
     "spherical_to_directions",
     "pattern_from_name",
+    "ray_limit",
     "PATTERN_NAMES",
 ]
 
@@ -121,16 +125,39 @@ def _check_positive(name: str, value: float, cls: str) -> None:
 
 #: Most rays one frame may cast (a 4096-env batch of these is already 40 GB of rays), and
 #: most rows of a precomputed table: larger requests are refused before any allocation.
+#: :func:`ray_limit` changes the first (and the second to at least twice it).
 MAX_RAYS_PER_FRAME = 10_000_000
 MAX_TABLE_RAYS = 20_000_000
 
+_RAY_LIMIT: contextvars.ContextVar[int] = contextvars.ContextVar(
+    "ray_limit", default=MAX_RAYS_PER_FRAME
+)
+
+
+@contextlib.contextmanager
+def ray_limit(max_rays: int | None) -> Iterator[None]:
+    """Within the block, patterns may cast up to ``max_rays`` rays per frame (``None``:
+    the default, :data:`MAX_RAYS_PER_FRAME`)."""
+    if max_rays is None:
+        yield
+        return
+    if isinstance(max_rays, bool) or not isinstance(max_rays, int) or max_rays < 1:
+        raise SensorError(f"max_rays: expected an integer >= 1, got {max_rays!r}")
+    token = _RAY_LIMIT.set(max_rays)
+    try:
+        yield
+    finally:
+        _RAY_LIMIT.reset(token)
+
 
 def _check_ray_count(count: float, cls: str, what: str = "rays per frame") -> None:
-    limit = MAX_RAYS_PER_FRAME if what == "rays per frame" else MAX_TABLE_RAYS
+    frame_limit = _RAY_LIMIT.get()
+    limit = frame_limit if what == "rays per frame" else max(MAX_TABLE_RAYS, 2 * frame_limit)
     if count > limit:
         raise SensorError(
             f"{cls}: {count:.3g} {what} requested; at most {limit:,} are allowed "
-            "(check the resolution, size or field of view)"
+            "(check the resolution, size or field of view; "
+            "robotwright.sensors.ray_limit raises the limit)"
         )
 
 
