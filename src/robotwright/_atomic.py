@@ -75,7 +75,7 @@ def mesh_size_limit(mb: float | None) -> Iterator[None]:
     raises :class:`~robotwright.errors.InputFileError` naming it and the limit."""
     if mb is not None and not mb > 0:
         raise ValueError(f"mesh size limit must be a positive number of MB, got {mb}")
-    token = _MESH_LIMIT.set(int(mb * 10**6) if mb is not None else _MESH_LIMIT.get())
+    token = _MESH_LIMIT.set(round(mb * 10**6) if mb is not None else _MESH_LIMIT.get())
     try:
         yield
     finally:

@@ -160,7 +160,9 @@ class GeneratorBase(ABC):
             copy_meshes = True
         if copy_meshes and file_path is None:
             raise GeneratorError("export(copy_meshes=True) needs a file_path to copy next to")
-        path = Path(file_path).resolve() if file_path is not None else None
+        # The folder is resolved, not the file: a link at the output's name is replaced,
+        # never written through.
+        path = _output_path(file_path) if file_path is not None else None
         if path is not None:
             check_output_path(path)  # before any work: a folder, or a file as a parent
         saved_dir, saved_copy = self.output_dir, self._mesh_copy
@@ -209,6 +211,12 @@ class GeneratorBase(ABC):
         if relative and self.output_dir is not None:
             return os.path.relpath(path, self.output_dir).replace(os.sep, "/")
         return str(path).replace(os.sep, "/")
+
+
+def _output_path(file_path: str | Path) -> Path:
+    """``file_path`` made absolute with its folder's links resolved (its own name kept)."""
+    p = Path(file_path)
+    return p.absolute().parent.resolve() / p.name
 
 
 def _plan_mesh_copies(sources: list[tuple[str, Path]], out_dir: Path) -> dict[Path, Path]:
