@@ -174,9 +174,62 @@ def install_chromium() -> None:
         print("apt-get could not install chromium: the viewer's browser test will skip")
 
 
+def fetch_xacro_tests() -> Path:
+    """The test folder of the installed xacro's source release (its own ``.xacro`` files
+    and YAML, ~100 kB) into ``.testdata/xacro-tests``: the xacro tests expand them with
+    our expression evaluator and with Python's, and compare."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    dest = TESTDATA / "xacro-tests"
+    try:
+        xacro_version = version("xacro")
+    except PackageNotFoundError:
+        print("xacro is not installed: its test files are not fetched")
+        return dest
+    marker = dest / f".xacro-{xacro_version}"
+    if marker.exists():
+        print(f"xacro {xacro_version} test files already in {dest}")
+        return dest
+    import tarfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--quiet"]
+        cmd += ["--no-binary", ":all:", "-d", tmp, f"xacro=={xacro_version}"]
+        print("fetching:", " ".join(cmd[2:]))
+        if subprocess.run(cmd).returncode != 0:
+            print(f"xacro {xacro_version}: no source release here; its tests will skip")
+            return dest
+        archives = list(Path(tmp).glob("xacro-*.tar.gz"))
+        if not archives:
+            raise SystemExit("pip download produced no xacro source release")
+        root = dest.resolve()
+        with tarfile.open(archives[0]) as tf:
+            for member in tf.getmembers():
+                parts = member.name.split("/")
+                if (
+                    not member.isfile()
+                    or len(parts) < 3
+                    or parts[1] != "test"
+                    or member.name.endswith(".py")
+                ):
+                    continue
+                target = (dest / "/".join(parts[2:])).resolve()
+                if not target.is_relative_to(root):
+                    raise SystemExit(f"refusing to extract {member.name}: escapes {dest}")
+                data = tf.extractfile(member)
+                if data is None:
+                    continue
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(data.read())
+    marker.write_text(xacro_version)
+    print(f"xacro {xacro_version} test files unpacked into {dest}")
+    return dest
+
+
 def main() -> int:
     TESTDATA.mkdir(exist_ok=True)
     fetch_mjlab()
+    fetch_xacro_tests()
     for name in WHEEL_CORPORA:
         fetch_wheel_data(name)
     make_hurodes_fixtures(TESTDATA, make_hurodes_venv())

@@ -5,7 +5,11 @@ environment, no XML entities)."""
 
 from __future__ import annotations
 
+import builtins
+import math
+import sysconfig
 import textwrap
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import mujoco
@@ -355,3 +359,156 @@ def test_xacro_source_text_is_not_mistaken_for_urdf(tmp_path: Path) -> None:
         our_mjcf_model(urdf_to_hrdf(folder / "p.xacro")),
         our_mjcf_model(urdf_to_hrdf(folder / "p.urdf")),
     )
+
+
+# ---------------------------------------------------------------- expressions without eval
+ROOT = Path(__file__).resolve().parents[2]
+ERD_SHARE = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data"
+#: xacro's own test files (tools/fetch_test_data.py), robosuite's and example-robot-data's.
+CORPUS = sorted(
+    p
+    for folder in (ROOT / ".testdata/xacro-tests", PANDA, ERD_SHARE)
+    if folder.is_dir()
+    for p in folder.rglob("*.xacro")
+)
+
+
+class _AgainstPython:
+    """Installs our evaluator, but checks each ``${...}`` value against Python's ``eval``
+    (a trusted helper for trusted corpus files only), counting the expressions."""
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.mismatches: list[tuple[str, str, str]] = []
+
+    def __call__(self, xacro, substitution_args):  # noqa: ANN001, ANN204 - xacro's modules
+        from robotwright.parsers.xacro_eval import installed
+
+        hook = installed(xacro, substitution_args)
+        ours = hook.safe_eval
+
+        def both(expr: str, symbols, _locals=None):  # noqa: ANN001, ANN202
+            mine = ours(expr, symbols)
+            dict.update(symbols, __builtins__={})  # as xacro's own safe_eval does
+            try:
+                theirs = builtins.eval(compile(expr.strip(), "<expr>", "eval"), symbols)
+            finally:
+                dict.pop(symbols, "__builtins__", None)
+            self.count += 1
+            if type(mine) is not type(theirs) or str(mine) != str(theirs):
+                self.mismatches.append((expr, repr(mine), repr(theirs)))
+            return mine
+
+        hook.safe_eval = both
+        return hook
+
+
+def _expand(path: Path, installer) -> str:  # noqa: ANN001
+    import robotwright.parsers.xacro as X
+
+    saved = X.installed
+    X.installed = installer
+    try:
+        return X._expand_here(path, xacro_args={}, package_map=None, trusted=())[0]
+    except ConversionError as exc:
+        return f"refused: {exc}"
+    finally:
+        X.installed = saved
+
+
+@pytest.mark.skipif(not CORPUS, reason="no xacro corpus (run tools/fetch_test_data.py)")
+def test_corpus_expands_as_with_python_eval() -> None:
+    # Every corpus file expands with our evaluator exactly as with Python's eval (the
+    # xacro package as shipped): same URDF (canonical XML), and every ${...} value the
+    # same type and text.
+    import contextlib
+
+    checker = _AgainstPython()
+    expanded = 0
+    for path in CORPUS:
+        shipped = _expand(path, lambda *_: contextlib.nullcontext())
+        ours = _expand(path, checker)
+        if shipped.startswith("refused:"):
+            assert ours.startswith("refused:"), path  # fragments needing arguments
+            continue
+        assert not ours.startswith("refused:"), (path, ours)
+        assert ET.canonicalize(ours, strip_text=True) == ET.canonicalize(shipped, strip_text=True)
+        expanded += 1
+    assert checker.mismatches == []
+    # All of robosuite's and example-robot-data's files expand, and most of xacro's own.
+    assert expanded >= len([p for p in CORPUS if "xacro-tests" not in str(p)])
+    assert checker.count > 0
+
+
+PROPS = {"a": 2, "b": 0.5, "s": "Link_A", "l": [1, 2, 3], "t": (1, "x"), "d": {"k": 1, "m": [4]}}
+BENIGN = (
+    "1 + 2 * 3 - 4 / 8",
+    "7 // 2 + 7 % 3 - -a",
+    "2 ** 10 + 2 ** -1 + a ** b",
+    "(1 << 4) | 3 ^ 5 & 6 >> 1",
+    "~a",
+    "1 < a <= 2 != 3",
+    "a if b > 1 else -a",
+    "not a or b and s",
+    "a in l and 'x' in t and 'k' in d and 'k' not in l",
+    "[1, 2.5, 'x', True, None]",
+    "(1,)",
+    "{'x': a, **d}",
+    "[*l, *t]",
+    "l[-1] + l[0:2][1] + d['m'][0]",
+    "s[::-1] + s[1:3]",
+    "[x * 2 for x in l if x > 1]",
+    "[i * j for i in l for j in range(2)]",
+    "{k: v for k, v in d.items()}",
+    "python.sum(x for x in l)",
+    "python.sum([x ** 2 for x in l])",
+    "sin(pi / 4) + cos(0) + math.sqrt(2) + radians(90) + degrees(1)",
+    "math.atan2(1, 2) + fabs(-1) + floor(2.5) + ceil(2.5) + log(e) + exp(1) + tau",
+    "min(l) + max(l) + len(l) + round(2.567, 2) + int('7') + float('1.5')",
+    "str(a) + str(b) + str(l) + str(True)",
+    "list(t) + list(map(float, ['1', '2']))",
+    "dict(a=1, b=2)",
+    "sorted(l, reverse=True)",
+    "sorted(['bb', 'a'], key=len)",
+    "list(range(0, 10, 3))",
+    "bool(0) or bool([])",
+    "s.lower() + s.upper() + s.replace('_', '-') + s.strip('L')",
+    "s.split('_') + 'a b  c'.split()",
+    "'-'.join(['x', 'y']) + s.zfill(10) + s.center(9, '*')",
+    "s.startswith('Li') and s.endswith('A') and s.find('_') == 4",
+    "'%s_%d_%.3f' % (s, a, b)",
+    "'%(k)s' % d",
+    "d.get('z', 5) + len(d.keys()) + len(list(d.values()))",
+    "l.index(2) + l.count(1) + t.count('x')",
+    "python.abs(-a) + python.divmod(7, 2)[0]",
+    "python.all(l) and python.any([0, a])",
+    "python.zip(l, l)",
+    "python.enumerate(['x'])",
+    "python.reversed(l)",
+    "python.ord('a')",
+    "b.is_integer()",
+    "2.0 * 3",
+    "1e-3 + 1.5e2",
+    "'caf\\u00e9' + s",
+    "10 ** 100",
+    "-0.0",
+    "pi",
+    "inf > 1e308",
+    "(a, b) == (2, 0.5)",
+)
+
+
+@pytest.mark.parametrize("expr", BENIGN)
+def test_benign_expressions_equal_pythons(expr: str) -> None:
+    from robotwright.parsers.xacro_eval import Evaluator, default_names
+
+    ours = Evaluator(lambda name: PROPS[name], default_names()).evaluate(expr)
+    # Python's eval over the same names, with xacro's symbols (the real builtins).
+    env = {k: v for k, v in vars(math).items() if not k.startswith("_")}
+    env.update(vars(builtins))
+    env.update(PROPS, math=math, python=builtins)
+    theirs = builtins.eval(expr, {**env, "__builtins__": {}})  # globals, as xacro passes
+    if hasattr(theirs, "__next__"):
+        theirs = list(theirs)  # ours are lists (documented); the items must be equal
+    assert type(ours) is type(theirs)
+    assert ours == theirs or (ours != ours and theirs != theirs)
