@@ -72,9 +72,15 @@ def convert(
     *,
     strict: bool = False,
     overwrite: bool = False,
+    proof: bool = True,
     **options: Any,
 ) -> list[str]:
     """Convert ``src`` to ``dst``; returns every warning (parser and writer) as text.
+
+    With ``proof`` (the default), an MJCF or URDF source that MuJoCo compiles is compared
+    with the output, compiled, field by field (:mod:`robotwright.parsers.proof`): each
+    difference no warning reports becomes one; under ``strict`` any fails the conversion
+    before anything is written.
 
     ``options`` go to the parser (see ``URDFOptions`` / ``MJCFOptions``), except
     ``collision_max_faces`` and ``convex_decomposition``, which repair the collision
@@ -85,10 +91,12 @@ def convert(
     if dst_p.exists() and not overwrite:
         raise OutputExistsError(f"{dst_p} exists (pass overwrite=True / --overwrite)")
     if "work_dir" in options or file_kind(src_p, existing=True) == "hrdf":
-        return _convert(src_p, dst_p, out_kind, strict, overwrite, options)
+        return _convert(src_p, dst_p, out_kind, strict, overwrite, options, proof)
     # The output gets its own copies of the meshes: staging lives only for the call.
     with tempfile.TemporaryDirectory(prefix="robotwright-convert-") as tmp:
-        return _convert(src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp})
+        return _convert(
+            src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp}, proof
+        )
 
 
 def _convert(
@@ -98,7 +106,9 @@ def _convert(
     strict: bool,
     overwrite: bool,
     options: dict[str, Any],
+    proof: bool = True,
 ) -> list[str]:
+    from robotwright.hrdf.compiles import require_compiles
     from robotwright.parsers.collision import pop_config, repair_collision_meshes
 
     options = dict(options)
@@ -110,6 +120,10 @@ def _convert(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
+            # What MuJoCo refuses is not written (validate calls such a folder invalid).
+            require_compiles(hrdf, f"cannot write {dst_p}")
+            if proof:
+                messages += _proof(src_p, hrdf, out_kind, messages, strict, options)
             if out_kind == "hrdf":
                 hrdf.save(dst_p, overwrite=overwrite)
             else:
@@ -130,3 +144,35 @@ def _convert(
             ) from exc
     messages += [str(w.message) for w in caught]
     return messages
+
+
+def _proof(
+    src_p: Path,
+    hrdf: HRDF,
+    out_kind: str,
+    notes: list[str],
+    strict: bool,
+    options: dict[str, Any],
+) -> list[str]:
+    """The proof's notes (see :func:`robotwright.parsers.proof.prove`); under ``strict``
+    any of them is a ConversionError, raised before the output is written."""
+    from robotwright.parsers.proof import prove
+    from robotwright.parsers.xacro import is_xacro, xacro_as_urdf
+
+    kind = file_kind(src_p, existing=True)
+    if kind == "hrdf":
+        return []  # the output is the folder's own export: nothing else to compare with
+    path, opts = src_p, options
+    if is_xacro(src_p):
+        path, opts = xacro_as_urdf(src_p, options)
+    work = opts.get("work_dir")
+    found = prove(
+        path, kind, hrdf, out_kind, notes, options=opts, work_dir=Path(work) if work else None
+    )
+    if strict and found:
+        raise ConversionError(
+            found,
+            summary=f"strict conversion of {src_p}: {len(found)} value(s) differ between the "
+            "source and the output, compiled by MuJoCo",
+        )
+    return [str(p) for p in found]

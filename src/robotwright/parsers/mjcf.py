@@ -349,7 +349,8 @@ def _select_robot(
     """The robot's root body id and its subtree's body ids (model order)."""
     top = [i for i in range(1, model.nbody) if model.body_parentid[i] == 0]
     if opt.root_body is not None:
-        ids = [i for i in top if model.body(i).name == opt.root_body]
+        # By the name the refusal lists: an unnamed body is 'body_<id>'.
+        ids = [i for i in top if body_name(model, i) == opt.root_body]
         if not ids:
             names = [body_name(model, i) for i in top]
             raise ConversionError(
@@ -786,7 +787,10 @@ def _sites(
 
 
 def _sensors(
-    model: mujoco.MjModel, kept_names: dict[str, set[str]], rep: Reporter
+    model: mujoco.MjModel,
+    kept_names: dict[str, set[str]],
+    rep: Reporter,
+    in_extra: dict[str, set[str]] | None = None,
 ) -> tuple[list[Sensor], list[ET.Element]]:
     """Sensor records; from the first sensor naming the world body on, ``<sensor>``
     elements for ``mjcf_extra`` (order kept)."""
@@ -813,7 +817,10 @@ def _sensors(
         oname = oname or ""
         refs = [(objtype, oname)] + ([(reftype, refname)] if reftype else [])
         lost = [f"{t} '{n}'" for t, n in refs if t in kept_names and n not in kept_names[t]]
-        if extra_sensors or lost:
+        # A sensor of an object carried in mjcf_extra (an actuatorfrc of a <general>
+        # actuator) goes with it: the sensor table names table objects only.
+        moved = [n for t, n in refs if n in (in_extra or {}).get(t or "", set())]
+        if extra_sensors or lost or moved:
             if any("'world'" not in x for x in lost):
                 rep.warn(f"sensor dropped: it reads {lost} outside the robot", where)
                 continue
@@ -939,7 +946,8 @@ def parse_mjcf(
         "geom": {x.geom_name for x in [*meshes, *simple] if x.geom_name},
         "tendon": names["tendon"],
     }
-    sensors, extra_sensors = _sensors(model, kept_names, rep)
+    in_extra = {"actuator": {e.get("name") for e in carried_actuators if e.get("name")}}
+    sensors, extra_sensors = _sensors(model, kept_names, rep, in_extra)
     _report_scene(model, rep)
 
     if carried_actuators:

@@ -103,6 +103,13 @@ def tendons(
         attrs["limited"] = "true" if model.tendon_limited[t] else "false"
         if model.tendon_limited[t]:
             attrs["range"] = _f(model.tendon_range[t])
+        elif np.any(model.tendon_range[t]):
+            # MuJoCo ignores the range of an unlimited tendon: harmless, but said.
+            warn(
+                f"range {model.tendon_range[t].tolist()} of an unlimited tendon dropped "
+                "(MuJoCo ignores it)",
+                where,
+            )
         if hasattr(model, "tendon_actfrclimited") and model.tendon_actfrclimited[t]:
             attrs["actuatorfrclimited"] = "true"
             attrs["actuatorfrcrange"] = _f(model.tendon_actfrcrange[t])
@@ -118,6 +125,8 @@ def tendons(
             "armature": _f(model.tendon_armature[t]),
             "margin": _f(model.tendon_margin[t]),
         }
+        if np.any(model.tendon_user[t] != 0):  # padded to <size nuser_tendon> (mjcf_size)
+            attrs["user"] = _f(model.tendon_user[t])
         if not fixed:
             attrs["width"] = _f(model.tendon_width[t])
             attrs["rgba"] = _f(model.tendon_rgba[t])

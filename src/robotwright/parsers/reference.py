@@ -114,7 +114,8 @@ def view_from_model(
     top = [i for i in range(1, model.nbody) if model.body_parentid[i] == 0]
     if root is None and len(top) != 1:
         return view
-    rid = top[0] if root is None else model.body(root).id
+    # ``root`` as the parsers name it: an unnamed top-level body is 'body_<id>'.
+    rid = top[0] if root is None else next(i for i in top if body_name(model, i) == root)
     keep = {body_name(model, i) for i in range(1, model.nbody) if model.body_rootid[i] == rid}
     view.bodies = [b for b in view.bodies if b in keep]
     view.mass = {k: v for k, v in view.mass.items() if k in keep}

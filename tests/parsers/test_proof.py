@@ -1,0 +1,302 @@
+"""The proof of a conversion (issue 20): every per-object array of MjModel compared
+between the source and the output, matched by name and structure; each difference no
+note reports becomes a note naming field, object and both values; ``strict`` fails."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from robotwright.cli import main
+from robotwright.errors import ConversionError
+from robotwright.hrdf.model import HRDF
+from robotwright.parsers import proof
+from robotwright.parsers.convert import convert
+
+pytestmark = pytest.mark.usefixtures("quiet_parsers")
+
+ROBOT = """<mujoco model="r">
+  <size nuser_jnt="1" nuser_geom="2"/>
+  <option timestep="0.004" impratio="3" cone="elliptic"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="5 5 0.1"/>
+    <body name="base" pos="0 0 1">
+      <freejoint name="root"/>
+      <geom name="torso" type="box" size="0.1 0.2 0.3" mass="2" solref="0.03 1.1"
+            friction="0.8 0.01 0.002" user="1 2"/>
+      <site name="imu" size="0.01"/>
+      <body name="arm" pos="0 0.3 0">
+        <joint name="shoulder" axis="0 1 0" range="-1 1" damping="0.5" armature="0.01"
+               stiffness="3" user="7"/>
+        <geom type="capsule" size="0.03" fromto="0 0 0 0 0 -0.3" mass="0.5"/>
+        <geom type="sphere" size="0.04" pos="0 0 -0.3" mass="0.1"/>
+        <body name="hand" pos="0 0 -0.3">
+          <joint name="wrist" type="slide" axis="1 0 0" range="-0.1 0.1"/>
+          <geom type="box" size="0.02 0.02 0.02" mass="0.05"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="t"><joint joint="shoulder" coef="1"/></fixed></tendon>
+  <actuator>
+    <motor name="m" joint="shoulder" gear="20" ctrlrange="-1 1" ctrllimited="true"/>
+    <position name="p" joint="wrist" kp="50"/>
+  </actuator>
+  <sensor>
+    <jointpos name="q" joint="shoulder" noise="0.01"/>
+    <actuatorfrc name="f" actuator="m"/>
+  </sensor>
+  <keyframe><key name="k" qpos="0 0 1 1 0 0 0 0.2 0.05"/></keyframe>
+</mujoco>
+"""
+
+
+def _model(xml: str) -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+def test_fields_are_derived_from_mujoco() -> None:
+    m = _model(ROBOT)
+    found = proof.fields(m)
+    # Every family has fields, each of that family's count, named as MuJoCo names them.
+    for fam, attrs in found.items():
+        assert attrs, fam
+        n = getattr(m, proof.FAMILIES[fam][0])
+        assert all(getattr(m, a).shape[0] == n for a in attrs)
+    assert "geom_solref" in found["geom"] and "jnt_user" in found["jnt"]
+    assert "jnt_qposadr" not in found["jnt"]  # addresses follow from the rest
+    assert "impratio" in proof.option_fields(m)
+
+
+def test_same_model_has_no_difference() -> None:
+    assert proof.compare_models(_model(ROBOT), _model(ROBOT)) == []
+
+
+def test_reordered_model_matches_by_name_and_structure() -> None:
+    # Bodies, geoms of a body, actuators and sensors in another order: still equal.
+    reordered = ROBOT.replace(
+        '<geom type="capsule" size="0.03" fromto="0 0 0 0 0 -0.3" mass="0.5"/>\n'
+        '        <geom type="sphere" size="0.04" pos="0 0 -0.3" mass="0.1"/>',
+        '<geom type="sphere" size="0.04" pos="0 0 -0.3" mass="0.1"/>\n'
+        '        <geom type="capsule" size="0.03" fromto="0 0 0 0 0 -0.3" mass="0.5"/>',
+    ).replace(
+        '<motor name="m" joint="shoulder" gear="20" ctrlrange="-1 1" ctrllimited="true"/>\n'
+        '    <position name="p" joint="wrist" kp="50"/>',
+        '<position name="p" joint="wrist" kp="50"/>\n'
+        '    <motor name="m" joint="shoulder" gear="20" ctrlrange="-1 1" ctrllimited="true"/>',
+    )
+    assert reordered != ROBOT
+    # (the keyframe's ctrl follows the actuators: compared per actuator)
+    assert proof.compare_models(_model(ROBOT), _model(reordered)) == []
+
+
+#: (what is changed in the source text, by what, the field the proof must name)
+CHANGES = [
+    ('solref="0.03 1.1"', 'solref="0.05 1.1"', "geom_solref", "geom 'torso'"),
+    ('friction="0.8 0.01 0.002"', 'friction="0.5 0.01 0.002"', "geom_friction", "geom 'torso'"),
+    ('user="1 2"', 'user="1 3"', "geom_user", "geom 'torso'"),
+    ('stiffness="3" user="7"', 'stiffness="4" user="7"', "jnt_stiffness", "joint 'shoulder'"),
+    ('stiffness="3" user="7"', 'stiffness="3" user="8"', "jnt_user", "joint 'shoulder'"),
+    ('damping="0.5"', 'damping="0.6"', "dof_damping", "joint 'shoulder'"),
+    ('armature="0.01"', 'armature="0.02"', "dof_armature", "joint 'shoulder'"),
+    ('range="-0.1 0.1"', 'range="-0.2 0.1"', "jnt_range", "joint 'wrist'"),
+    ('mass="0.05"', 'mass="0.06"', "body_mass", "body 'hand'"),
+    ('<site name="imu" size="0.01"/>', '<site name="imu" size="0.01" pos="0 0 0.1"/>',
+     "site_pos", "site 'imu'"),
+    ('gear="20"', 'gear="21"', "actuator_gear", "actuator 'm'"),
+    ('kp="50"', 'kp="60"', "actuator_gainprm", "actuator 'p'"),
+    ('noise="0.01"', 'noise="0.02"', "sensor_noise", "sensor 'q'"),
+    ('coef="1"', 'coef="1"/></fixed><fixed name="u"><joint joint="wrist" coef="1"', "(object)",
+     "tendon 'u'"),
+    ('impratio="3"', 'impratio="4"', "opt.impratio", "<option>"),
+    ('cone="elliptic"', 'cone="pyramidal"', "opt.cone", "<option>"),
+    ('qpos="0 0 1 1 0 0 0 0.2 0.05"', 'qpos="0 0 1 1 0 0 0 0.3 0.05"', "key_qpos", "key 'k'"),
+    ('<actuatorfrc name="f" actuator="m"/>', '<actuatorfrc name="f" actuator="p"/>',
+     "sensor_objid", "sensor 'f'"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("old", "new", "field", "obj"), CHANGES, ids=[c[2] for c in CHANGES])
+def test_each_changed_value_is_named(old: str, new: str, field: str, obj: str) -> None:
+    assert ROBOT.count(old) == 1
+    changed = ROBOT.replace(old, new)
+    diffs = proof.compare_models(_model(ROBOT), _model(changed))
+    assert any(d.field == field and obj in d.obj for d in diffs), diffs
+    # Nothing else is blamed on an unrelated object.
+    assert all(obj in d.obj or d.field == "(object)" for d in diffs), diffs
+
+
+def test_root_body_leaves_the_scene_out() -> None:
+    scene = ROBOT.replace(
+        "</worldbody>",
+        '<body name="ball" pos="2 0 0"><freejoint/><geom size="0.1"/></body></worldbody>',
+    )
+    diffs = proof.compare_models(_model(scene), _model(ROBOT), root_body="base")
+    assert diffs == []
+    assert any(d.obj == "body 'ball'" for d in proof.compare_models(_model(scene), _model(ROBOT)))
+
+
+def test_tolerance_has_an_absolute_floor() -> None:
+    a = np.array([[0.0, 1.0], [1e9, 2.0]])
+    assert proof._bad_rows(a, a + np.array([[6e-36, 0.0], [0.5, 0.0]])).tolist() == []
+    assert proof._bad_rows(a, a + np.array([[1e-6, 0.0], [0.0, 0.0]])).tolist() == [0]
+    # NaN equals NaN (MuJoCo keeps what it read); NaN against a number differs.
+    n = np.array([[np.nan]])
+    assert proof._bad_rows(n, n).tolist() == [] and proof._bad_rows(
+        n, np.ones((1, 1))
+    ).tolist() == [0]
+
+
+def test_a_note_naming_object_and_field_covers_the_difference() -> None:
+    diffs = proof.compare_models(_model(ROBOT), _model(ROBOT.replace('stiffness="3"', "")))
+    assert [d.field for d in diffs] == ["jnt_stiffness"]
+    assert proof.uncovered(diffs, ['r.xml: <joint name="shoulder">: stiffness dropped']) == []
+    # A note about another joint, or another field of this one, does not.
+    assert proof.uncovered(diffs, ['r.xml: <joint name="wrist">: stiffness dropped']) == diffs
+    assert proof.uncovered(diffs, ['r.xml: <joint name="shoulder">: damping dropped']) == diffs
+    problems = proof.as_problems("r.xml", diffs)
+    assert len(problems) == 1
+    text = str(problems[0])
+    assert "jnt_stiffness" in text and "shoulder" in text and "3.0" in text and "0.0" in text
+
+
+def _write(tmp_path: Path, xml: str, name: str = "r.xml") -> Path:
+    p = tmp_path / name
+    p.write_text(xml)
+    return p
+
+
+@pytest.mark.parametrize("out", ["hrdf", "r_out.xml"])
+def test_faithful_conversion_has_no_unreported_difference(tmp_path: Path, out: str) -> None:
+    src = _write(tmp_path, ROBOT)
+    messages = convert(src, tmp_path / out)
+    assert not [m for m in messages if "proof:" in m], messages
+
+
+#: A robot whose conversion has no note at all (strict passes it).
+PLAIN = """<mujoco model="p">
+  <worldbody>
+    <body name="base">
+      <geom type="box" size="0.1 0.1 0.1" mass="1"/>
+      <body name="arm" pos="0 0 0.2">
+        <joint name="shoulder" axis="0 1 0" range="-1 1" damping="0.5"/>
+        <geom type="capsule" size="0.03" fromto="0 0 0 0 0 0.3" mass="0.5"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_plain_robot_converts_strictly(tmp_path: Path) -> None:
+    assert convert(_write(tmp_path, PLAIN), tmp_path / "out.xml", strict=True) == []
+
+
+def _lose_shoulder_damping(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A writer that loses one value silently (what the proof is for)."""
+    real = HRDF.save
+
+    def save(self: HRDF, path, **kw):
+        joints = [
+            dataclasses.replace(j, viscous_friction=0.0) if j.name == "shoulder" else j
+            for j in self.joints
+        ]
+        return real(dataclasses.replace(self, joints=joints), path, **kw)
+
+    monkeypatch.setattr(HRDF, "save", save)
+
+
+def test_a_silent_loss_becomes_a_note(tmp_path: Path, monkeypatch) -> None:
+    _lose_shoulder_damping(monkeypatch)
+    messages = convert(_write(tmp_path, ROBOT), tmp_path / "out")
+    lost = [m for m in messages if "proof:" in m]
+    assert len(lost) == 1 and "dof_damping" in lost[0] and "'shoulder'" in lost[0], messages
+    assert "source 0.5" in lost[0] and "result 0.0" in lost[0]
+
+
+def test_strict_fails_on_a_silent_loss_and_writes_nothing(tmp_path: Path, monkeypatch) -> None:
+    _lose_shoulder_damping(monkeypatch)
+    src = _write(tmp_path, PLAIN)
+    with pytest.raises(ConversionError, match="dof_damping"):
+        convert(src, tmp_path / "out", strict=True)
+    assert not (tmp_path / "out").exists()
+
+
+def test_proof_can_be_turned_off(tmp_path: Path, monkeypatch) -> None:
+    _lose_shoulder_damping(monkeypatch)
+    messages = convert(_write(tmp_path, ROBOT), tmp_path / "out", proof=False)
+    assert not [m for m in messages if "proof:" in m]
+
+
+def test_cli_strict_exit_2_on_a_silent_loss(tmp_path: Path, monkeypatch, capsys) -> None:
+    _lose_shoulder_damping(monkeypatch)
+    src = _write(tmp_path, PLAIN)
+    assert main(["convert", str(src), "-o", str(tmp_path / "out"), "--strict"]) == 2
+    err = capsys.readouterr().err
+    assert "dof_damping" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+# -- the silent faults of issue 20 ---------------------------------------------------------
+CARRIED = """<mujoco>
+  <worldbody>
+    <body name="a"><joint name="j"/><geom size="0.1"/>
+      <body name="b"><joint name="k"/><geom size="0.1" pos="0 0 0.3"/></body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="t"><joint joint="j" coef="1"/><joint joint="k" coef="-1"/></fixed></tendon>
+  <actuator>
+    <motor name="m" joint="j"/>
+    <general name="g" tendon="t" dyntype="filter" dynprm="0.1"/>
+  </actuator>
+  <sensor>
+    <actuatorfrc name="fm" actuator="m"/>
+    <actuatorfrc name="fg" actuator="g"/>
+    <jointpos name="after" joint="k"/>
+  </sensor>
+</mujoco>
+"""
+
+
+def test_actuatorfrc_of_a_carried_actuator_moves_with_it(tmp_path: Path) -> None:
+    messages = convert(_write(tmp_path, CARRIED), tmp_path / "out")
+    assert not [m for m in messages if "proof:" in m], messages
+    out = HRDF.from_dir(tmp_path / "out")
+    from robotwright.parsers.roundtrip import our_mjcf_model
+
+    model = our_mjcf_model(out)
+    # Every sensor kept, in order, reading the same objects (the proof compared them).
+    names = [model.sensor(i).name for i in range(model.nsensor)]
+    assert names == ["fm", "fg", "after"]
+    fg = model.sensor("fg")
+    assert model.actuator(int(fg.objid[0])).name == "g"
+
+
+UNNAMED = """<mujoco>
+  <worldbody>
+    <body><joint name="h"/><geom size="0.1"/></body>
+    <body name="box" pos="1 0 0"><freejoint/><geom type="box" size="0.1 0.1 0.1"/></body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_unnamed_top_level_body_selectable_by_the_listed_name(tmp_path: Path, capsys) -> None:
+    src = _write(tmp_path, UNNAMED)
+    assert main(["convert", str(src), "-o", str(tmp_path / "x")]) == 2
+    assert "'body_1'" in capsys.readouterr().err
+    assert main(["convert", str(src), "-o", str(tmp_path / "x"), "--root-body", "body_1"]) == 0
+    hrdf = HRDF.from_dir(tmp_path / "x")
+    assert [j.name for j in hrdf.joints] == ["h"]
+    assert main(["roundtrip", str(src), "--root-body", "body_1", "--configs", "3"]) == 0
+
+
+def test_range_of_an_unlimited_tendon_is_noted(tmp_path: Path) -> None:
+    xml = CARRIED.replace('<fixed name="t">', '<fixed name="t" limited="false" range="-1 1">')
+    messages = convert(_write(tmp_path, xml), tmp_path / "out")
+    assert any("unlimited tendon" in m and "'t'" not in m and '"t"' in m for m in messages)
+    assert not [m for m in messages if "proof:" in m], messages
