@@ -51,7 +51,7 @@ _DEFAULT_OPT = mujoco.MjModel.from_xml_string("<mujoco/>").opt
 
 ROBOT = """
   <size nuser_body="3" nuser_jnt="2" nuser_geom="4" nuser_site="1" nuser_sensor="2"
-        nuser_actuator="2"/>
+        nuser_actuator="2" nuser_tendon="3"/>
   <worldbody>
     <body name="base" pos="0 0 1" gravcomp="0.5" user="1 2 3">
       <joint name="root" type="free" damping="2" armature="0.1" frictionloss="0.3"
@@ -75,6 +75,7 @@ ROBOT = """
       </body>
     </body>
   </worldbody>
+  <tendon><fixed name="t1" user="2 3"><joint joint="j1" coef="1"/></fixed></tendon>
   <actuator><motor name="m1" joint="j1" user="1 1"/></actuator>
   <sensor><jointpos name="p1" joint="j1" user="3"/></sensor>
 """
@@ -115,6 +116,8 @@ FIELDS = [
     "nuser_site",
     "nuser_sensor",
     "nuser_actuator",
+    "tendon_user",
+    "nuser_tendon",
 ]
 
 
@@ -235,3 +238,69 @@ def test_defaults_write_no_new_columns(tmp_path: Path) -> None:
     meta = (tmp_path / "robot" / "meta.yaml").read_text()
     for key in ("option:", "flag:", "mjcf_size", "base_joint:"):
         assert key not in meta
+
+
+URDF_ARM = """<robot name="arm">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="upper"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="{effort}" velocity="2"/></joint>
+  <joint name="slide" type="prismatic"><parent link="upper"/><child link="tip"/>
+    <axis xyz="1 0 0"/><limit lower="0" upper="0.5" velocity="1"/></joint>
+</robot>"""
+
+
+@pytest.mark.parametrize("effort", ["7", "-3", "0.25"])
+def test_urdf_effort_is_the_joint_force_range(tmp_path: Path, effort: str) -> None:
+    from robotwright.parsers import urdf_to_hrdf_with_warnings
+
+    source = tmp_path / "arm.urdf"
+    source.write_text(URDF_ARM.format(effort=effort))
+    hrdf, notes = urdf_to_hrdf_with_warnings(source)
+    folder = tmp_path / "robot"
+    hrdf.save(folder)
+    loaded = HRDF.from_dir(folder)
+    limit = abs(float(effort))
+    byname = {j.name: j for j in loaded.joints}
+    assert byname["shoulder"].actuatorfrcrange == (-limit, limit)
+    assert byname["slide"].actuatorfrcrange is None  # no effort: unclamped
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ours = MJCFHumanoidGenerator.from_hrdf(loaded).to_model(add_scene=False)
+    np.testing.assert_array_equal(ours.jnt_actfrcrange[0], [-limit, limit])
+    assert ours.jnt_actfrclimited.tolist() == [True, False]
+    mujoco_import = mujoco.MjModel.from_xml_path(str(source))
+    if int(mujoco.__version__.split(".")[0]) >= 4:
+        # MuJoCo 4's own URDF import gives the same joint force ranges.
+        np.testing.assert_array_equal(mujoco_import.jnt_actfrcrange, ours.jnt_actfrcrange)
+        np.testing.assert_array_equal(mujoco_import.jnt_actfrclimited, ours.jnt_actfrclimited)
+    else:
+        # MuJoCo 3's import ignores effort: the difference is a note naming the joint.
+        assert any("actuatorfrcrange" in str(n) and "shoulder" in str(n) for n in notes)
+
+
+def test_urdf_export_carries_options_and_effort(tmp_path: Path) -> None:
+    from robotwright.generators.urdf import URDFHumanoidGenerator
+
+    source = _write(tmp_path, _option_xml().replace("/>", "><flag energy='enable'/></option>"))
+    hrdf, _ = mjcf_to_hrdf_with_warnings(source)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        text = URDFHumanoidGenerator.from_hrdf(hrdf).export(None, add_mujoco_tag=True)
+    lost = "\n".join(str(w.message) for w in caught)
+    # URDF holds no contact or solver parameters: each is named as not written.
+    for name in ("solref", "solimp", "margin", "gap", "priority", "solmix", "gravcomp"):
+        assert name in lost, name
+    urdf = tmp_path / "out.urdf"
+    urdf.write_text(text)
+    want = mujoco.MjModel.from_xml_path(str(source))
+    got = mujoco.MjModel.from_xml_path(str(urdf))
+    for name in ("impratio", "cone", "o_solref", "wind", "enableflags", "iterations"):
+        assert np.array_equal(getattr(want.opt, name), getattr(got.opt, name)), name
+    assert got.nuser_body == want.nuser_body
+    # (-4, 5) is not symmetric: URDF cannot hold it, reported above.
+    assert "actuatorfrcrange (-4.0, 5.0)" in lost

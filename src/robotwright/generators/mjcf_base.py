@@ -129,6 +129,22 @@ def name_clashes(root: ET.Element) -> dict[str, list[str]]:
     return out
 
 
+def fill_option(option: ET.Element, sim: SimulatorConfig) -> None:
+    """Set ``sim.option``'s attributes on ``option`` and add its ``<flag>`` switches
+    (names and values were checked against :mod:`robotwright.hrdf.options` at load)."""
+    for key, value in sorted(sim.option.items()):
+        if isinstance(value, str):
+            option.set(key, value)
+        elif isinstance(value, int) and not isinstance(value, bool):
+            option.set(key, str(value))
+        elif isinstance(value, (list, tuple)):
+            option.set(key, fmt_vec(value))
+        else:
+            option.set(key, fmt_float(value))
+    if sim.flag:
+        ET.SubElement(option, "flag", dict(sorted(sim.flag.items())))
+
+
 class MJCFGeneratorBase(GeneratorBase):
     """Base of MJCF generators: holds ``simulator_config`` and adds the scene.
 
@@ -167,18 +183,7 @@ class MJCFGeneratorBase(GeneratorBase):
                 option.set("gravity", fmt_vec(sim.gravity))
             if sim.integrator is not None:
                 option.set("integrator", sim.integrator)
-            # Names and values were checked against robotwright.hrdf.options at load.
-            for key, value in sorted(sim.option.items()):
-                if isinstance(value, str):
-                    option.set(key, value)
-                elif isinstance(value, int) and not isinstance(value, bool):
-                    option.set(key, str(value))
-                elif isinstance(value, (list, tuple)):
-                    option.set(key, fmt_vec(value))
-                else:
-                    option.set(key, fmt_float(value))
-            if sim.flag:
-                ET.SubElement(option, "flag", {k: v for k, v in sorted(sim.flag.items())})
+            fill_option(option, sim)
         return option
 
     def add_scene(self, skybox: bool = True) -> None:

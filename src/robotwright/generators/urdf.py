@@ -46,6 +46,7 @@ from typing import Any
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf import _report, imu_sites
+from robotwright.generators.mjcf_base import fill_option
 from robotwright.generators.placement import qmul
 from robotwright.generators.urdf_base import (
     WORLD_LINK,
@@ -55,7 +56,18 @@ from robotwright.generators.urdf_base import (
     rotate,
 )
 from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
-from robotwright.hrdf.model import HRDF, Actuator, Body, Geom, Joint, MeshGeom, SimpleGeom
+from robotwright.hrdf.model import (
+    HRDF,
+    MUJOCO_SOLIMP,
+    MUJOCO_SOLREF,
+    Actuator,
+    Body,
+    Geom,
+    Joint,
+    MeshGeom,
+    SimpleGeom,
+    SimulatorConfig,
+)
 
 #: Mass (kg) and inertia (kg m^2) of the links that split a multi-joint body: MuJoCo
 #: rejects massless moving bodies and SDFormat (Gazebo) drops massless links with their
@@ -141,6 +153,25 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
         if add_mujoco_tag:
             mj = ET.SubElement(root, "mujoco")
             ET.SubElement(mj, "compiler", self.mujoco_compiler_attrs())
+            # MuJoCo's URDF import reads <option> (with <flag>) and <size> here too.
+            sim = hrdf.meta.simulator_config
+            if sim is not None and (sim.option or sim.flag):
+                option = ET.SubElement(mj, "option")
+                fill_option(option, SimulatorConfig(None, None, None, None, sim.option, sim.flag))
+            if hrdf.meta.mjcf_size:
+                ET.SubElement(
+                    mj, "size", {k: str(int(v)) for k, v in sorted(hrdf.meta.mjcf_size.items())}
+                )
+        else:
+            sim = hrdf.meta.simulator_config
+            if sim is not None and (sim.option or sim.flag):
+                losses.append(
+                    Problem(
+                        "meta.yaml",
+                        "<option> attributes and flags need the <mujoco> tag (add_mujoco_tag)",
+                        column="simulator_config.option",
+                    )
+                )
         if world_link:
             ET.SubElement(root, "link", {"name": WORLD_LINK})
         writer = _RobotWriter(self, hrdf, prefix, relative_mesh_path, losses)
@@ -474,6 +505,18 @@ class _RobotWriter:
                 )
             )
         effort, velocity = _effort_velocity(act)
+        frc = j.actuatorfrcrange
+        if effort is None and frc is not None and frc[0] == -frc[1] and frc[1] > 0:
+            effort = frc[1]  # MuJoCo 4's URDF import makes +-effort the joint's range
+        elif frc is not None and (effort is None or (-effort, effort) != tuple(frc)):
+            self.losses.append(
+                Problem(
+                    "joint.csv",
+                    f"joint '{j.name}': actuatorfrcrange {tuple(frc)} has no URDF form "
+                    "(only a symmetric range, as <limit effort>)",
+                    column="actuatorfrcrange0",
+                )
+            )
         if effort is not None:
             attrs["effort"] = fmt_float(effort)
         if velocity is not None:
@@ -512,6 +555,15 @@ class _RobotWriter:
                     "joint.csv",
                     f"joint '{j.name}': static_friction {j.static_friction} (friction = dynamic)",
                     column="static_friction",
+                )
+            )
+        lost = [f for f, default in _JOINT_MUJOCO_ONLY if getattr(j, f) != default]
+        if lost:
+            self.losses.append(
+                Problem(
+                    "joint.csv",
+                    f"joint '{j.name}': {', '.join(lost)} have no URDF form",
+                    column=lost[0],
                 )
             )
         if j.type == "free" and (j.viscous_friction or j.dynamic_friction):
@@ -560,6 +612,11 @@ class _RobotWriter:
         self, b: Body, off: tuple[float, float, float], geoms: list[tuple[Geom, str, int]]
     ) -> ET.Element:
         link = ET.Element("link", {"name": self.p(b.name)})
+        lost = [f for f, value in (("gravcomp", b.gravcomp), ("user", b.user)) if value]
+        if lost:
+            self.losses.append(
+                Problem("body.csv", f"body '{b.name}': {', '.join(lost)} have no URDF form")
+            )
         inertial = ET.SubElement(link, "inertial")
         _origin(inertial, _sub(b.inertial_pos, off))
         ET.SubElement(inertial, "mass", {"value": fmt_float(b.mass)})
@@ -689,10 +746,32 @@ class _RobotWriter:
             )
         if g.restitution is not None:
             lost.append("restitution")
+        lost += [f for f, default in _GEOM_MUJOCO_ONLY if getattr(g, f) != default]
         if lost:
             self.losses.append(
                 Problem(table, f"geom on '{g.body}': {', '.join(lost)} not written", row)
             )
+
+
+#: MuJoCo fields URDF cannot hold, with their defaults (reported when set).
+_JOINT_MUJOCO_ONLY = (
+    ("margin", 0.0),
+    ("actuatorgravcomp", False),
+    ("solreflimit", MUJOCO_SOLREF),
+    ("solimplimit", MUJOCO_SOLIMP),
+    ("solreffriction", MUJOCO_SOLREF),
+    ("solimpfriction", MUJOCO_SOLIMP),
+    ("user", ()),
+)
+_GEOM_MUJOCO_ONLY = (
+    ("solref", MUJOCO_SOLREF),
+    ("solimp", MUJOCO_SOLIMP),
+    ("margin", 0.0),
+    ("gap", 0.0),
+    ("priority", 0),
+    ("solmix", 1.0),
+    ("user", ()),
+)
 
 
 def _effort_velocity(act: Actuator | None) -> tuple[float | None, float | None]:

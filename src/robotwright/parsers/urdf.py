@@ -19,7 +19,7 @@ import os
 import xml.etree.ElementTree as ET
 from collections import Counter
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -522,6 +522,9 @@ def _joint_record(
     )
     effort = _num(limit, "effort", 0.0, where, rep)
     velocity = _num(limit, "velocity", 0.0, where, rep)
+    if effort and jtype != "spherical":
+        # MuJoCo 4's URDF importer clamps the joint's actuator force to +-|effort|.
+        joint = replace(joint, actuatorfrcrange=(-abs(effort), abs(effort)))
     actuator = None
     if opt.actuators == "motor" and effort > 0 and jtype != "spherical":
         actuator = Actuator(
@@ -791,9 +794,19 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         dropped_limits = [n for n in dropped_limits if n not in kept]
     if dropped_limits:
         rep.warn(
-            f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept (HRDF joints "
-            "carry no force limit; keep them as motors with actuators='motor', "
-            "on the command line --actuators motor): " + name_list(dropped_limits)
+            f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept as motors "
+            "(effort is kept as the joint's actuatorfrcrange, velocity dropped; keep both "
+            "on motors with actuators='motor', on the command line --actuators motor): "
+            + name_list(dropped_limits)
+        )
+    clamped = [j.name for j in hrdf_joints if j.actuatorfrcrange is not None]
+    import mujoco  # the running version decides what its own URDF import does
+
+    if clamped and int(mujoco.__version__.split(".")[0]) < 4:
+        rep.warn(
+            f"actuatorfrcrange +-effort set on {len(clamped)} joint(s) from <limit effort>, "
+            f"as MuJoCo 4's URDF import does; MuJoCo {mujoco.__version__}'s URDF import "
+            "leaves them unclamped: " + name_list(clamped)
         )
 
     hrdf_bodies: list[Body] = []
