@@ -175,9 +175,10 @@ def install_chromium() -> None:
 
 
 def fetch_xacro_tests() -> Path:
-    """The test folder of the installed xacro's source release (its own ``.xacro`` files
-    and YAML, ~100 kB) into ``.testdata/xacro-tests``: the xacro tests expand them with
-    our expression evaluator and with Python's, and compare."""
+    """The test folder and ``package.xml`` of the installed xacro's source release (its
+    own ``.xacro`` files and YAML, ~100 kB) into ``.testdata/xacro-tests`` (the package
+    folder that their ``$(find xacro)`` names): the xacro tests expand them with our
+    expression evaluator and with Python's, and compare."""
     from importlib.metadata import PackageNotFoundError, version
 
     dest = TESTDATA / "xacro-tests"
@@ -206,14 +207,10 @@ def fetch_xacro_tests() -> Path:
         with tarfile.open(archives[0]) as tf:
             for member in tf.getmembers():
                 parts = member.name.split("/")
-                if (
-                    not member.isfile()
-                    or len(parts) < 3
-                    or parts[1] != "test"
-                    or member.name.endswith(".py")
-                ):
+                wanted = parts[1:2] == ["test"] or parts[1:] == ["package.xml"]
+                if not member.isfile() or not wanted or member.name.endswith(".py"):
                     continue
-                target = (dest / "/".join(parts[2:])).resolve()
+                target = (dest / "/".join(parts[1:])).resolve()
                 if not target.is_relative_to(root):
                     raise SystemExit(f"refusing to extract {member.name}: escapes {dest}")
                 data = tf.extractfile(member)
