@@ -2,6 +2,10 @@
 
 __version__ = "0.1.0"
 
-from robotwright._paths import trusted_asset_roots
+from robotwright._mujoco_gl import import_mujoco
+
+import_mujoco()  # before any module imports mujoco: an unusable MUJOCO_GL must not stop it
+
+from robotwright._paths import trusted_asset_roots  # noqa: E402
 
 __all__ = ["__version__", "trusted_asset_roots"]

@@ -103,9 +103,14 @@ def resolve_inside(
 
     Raises:
         UnsafePathError: the path leaves ``root`` (the message says where it resolves
-            to, and whether a symbolic link took it there) or cannot be resolved (a
-            link loop). The caller adds the file and element the path came from.
+            to, and whether a symbolic link took it there), cannot be resolved (a
+            link loop) or holds a NUL character. The caller adds the file and element
+            the path came from.
     """
+    if "\0" in os.fspath(file):  # no file name holds one; the OS refuses it outright
+        raise UnsafePathError(
+            f"{ascii(os.fspath(file))}: contains a NUL character; expected a file path"
+        )
     given = Path(file)
     full = given if given.is_absolute() else Path(base) / given
     try:

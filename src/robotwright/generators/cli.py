@@ -102,11 +102,14 @@ def _export(args: argparse.Namespace) -> int:
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
     from robotwright.generators.tasks import load_robot
     from robotwright.generators.urdf import URDFHumanoidGenerator
+    from robotwright.hrdf.compiles import require_compiles
 
     args.format = output_format(args.output, args.format)
     check_overwrite(args.output, args.overwrite)
     hrdf = load_robot(args.robot)
     out = Path(args.output)
+    # What MuJoCo refuses is not written (validate calls such a robot invalid).
+    require_compiles(hrdf, f"cannot write {out}")
     if args.format == "mjcf":
         MJCFHumanoidGenerator.from_hrdf(hrdf).export(
             out,

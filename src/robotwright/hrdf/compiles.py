@@ -199,8 +199,34 @@ def check_compiles(hrdf: HRDF) -> list[Problem]:
     return out
 
 
+def require_compiles(hrdf: HRDF, doing: str) -> None:
+    """Refuse a model MuJoCo refuses, saying where: ``convert``/``export`` call it before
+    writing (so they never write what ``validate`` calls invalid, and exit 0), ``render``
+    and ``view`` when MuJoCo cannot compile what they were given. ``doing`` starts the
+    message (``"cannot write out.xml"``).
+
+    The whole model is compiled once; only when MuJoCo refuses it are the per-mesh and
+    per-row checks of :func:`check_compiles` run to say where.
+
+    Raises:
+        HRDFError: the problems (naming table and row, mesh file, or the generated MJCF);
+            also the table errors that stop the model from being generated at all.
+    """
+    from robotwright.errors import HRDFError
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # conversion warnings are reported on export
+        message = _compile_xml(_generated_xml(hrdf))  # table errors raise HRDFError here
+    if message is None:
+        return
+    problems = [p for p in check_compiles(hrdf) if p.severity == "error"]
+    if not problems:  # the detailed checks found nothing more precise than MuJoCo's words
+        problems = [Problem(GENERATED, f"MuJoCo refuses the model: {message}")]
+    raise HRDFError(problems, summary=f"{doing}: MuJoCo refuses the model")
+
+
 def _without_extra(hrdf: HRDF) -> HRDF:
     return dataclasses.replace(hrdf, mjcf_extra=None)
 
 
-__all__ = ["GENERATED", "check_compiles", "check_meshes"]
+__all__ = ["GENERATED", "check_compiles", "check_meshes", "require_compiles"]

@@ -511,12 +511,8 @@ class FilePatternCfg(PatternCfg):
 
     def __post_init__(self) -> None:
         path = Path(self.path)
-        if not path.is_file():
-            raise SensorError(f"{path}: pattern file not found")
-        if path.suffix == ".npy":
-            angles = np.load(path, allow_pickle=False)
-        else:
-            angles = _read_angle_table(path)
+        data = _read_pattern_file(path)
+        angles = _load_npy(data, path) if path.suffix == ".npy" else _read_angle_table(data, path)
         angles = np.asarray(angles, dtype=np.float64)
         if angles.ndim != 2 or angles.shape[1] != 2:
             raise SensorError(
@@ -541,10 +537,65 @@ class FilePatternCfg(PatternCfg):
         return spherical_to_directions(self._angles[:, 0], self._angles[:, 1])
 
 
-def _read_angle_table(path: Path) -> np.ndarray:
+def _read_pattern_file(path: Path) -> bytes:
+    """The bytes of pattern file ``path``: a regular file within the table size limit
+    (a pattern file may come with a downloaded robot or scene), else :class:`SensorError`
+    naming it."""
+    from robotwright._inputs import MAX_TABLE_BYTES, read_bytes
+    from robotwright.errors import InputFileError
+
+    try:
+        return read_bytes(path, MAX_TABLE_BYTES)
+    except FileNotFoundError:
+        raise SensorError(f"{path}: pattern file not found") from None
+    except InputFileError as exc:
+        raise SensorError(f"{path}: pattern file {exc.reason}") from None
+    except OSError as exc:
+        raise SensorError(f"{path}: cannot read pattern file: {exc.strerror or exc}") from None
+
+
+def _load_npy(data: bytes, path: Path) -> np.ndarray:
+    """The array of a ``.npy`` file's bytes: real numbers only (no pickled objects, no
+    strings, booleans, complex numbers or records), else :class:`SensorError`."""
+    import io
+    import pickle
+
+    fmt = np.lib.format
+    try:
+        # The header's shape is checked against the bytes present first: np.load
+        # allocates the whole declared array before reading it (a 200-byte file can
+        # declare terabytes).
+        head = io.BytesIO(data)
+        version = fmt.read_magic(head)
+        if version not in ((1, 0), (2, 0)):
+            raise ValueError(f"format version {version}; expected 1.0 or 2.0")
+        read_header = fmt.read_array_header_1_0 if version == (1, 0) else fmt.read_array_header_2_0
+        shape, _, dtype = read_header(head)
+        need = math.prod(shape) * dtype.itemsize
+        if need > len(data) - head.tell():
+            raise ValueError(
+                f"the header declares shape {shape} ({need} bytes), more than the file holds"
+            )
+        array = np.load(io.BytesIO(data), allow_pickle=False)
+    except (ValueError, EOFError, OSError, pickle.UnpicklingError) as exc:
+        why = " ".join(str(exc).split())[:200]
+        raise SensorError(f"{path}: not a readable .npy array ({why})") from None
+    if not isinstance(array, np.ndarray) or array.dtype.kind not in "iuf":
+        got = array.dtype if isinstance(array, np.ndarray) else "an .npz archive"
+        raise SensorError(f"{path}: expected an array of real numbers, got {got}")
+    return array
+
+
+def _read_angle_table(data: bytes, path: Path) -> np.ndarray:
+    from robotwright._inputs import decode
+    from robotwright.errors import InputFileError
+
     rows: list[list[float]] = []
     header_seen = False
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = decode(data, path)
+    except InputFileError as exc:
+        raise SensorError(f"{path}: pattern file {exc.reason}") from None
     for lineno, raw in enumerate(text.splitlines(), start=1):
         line = raw.split("#", 1)[0].strip()
         if not line:

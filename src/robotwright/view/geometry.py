@@ -11,6 +11,7 @@ tessellated with trimesh.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -192,15 +193,28 @@ def _mesh(model: mujoco.MjModel, mesh_id: int) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
+#: Most height-field samples drawn (512 x 512): a larger field is drawn from an evenly
+#: spaced subset of its rows and columns (its first and last included). Drawing every
+#: sample of a 3000 x 3000 field took 18 million triangles and 10 GB of memory.
+MAX_HFIELD_DRAWN = 512 * 512
+
+
 def hfield_surface(model: mujoco.MjModel, hid: int) -> tuple[np.ndarray, np.ndarray]:
     """The top surface of a height field: ``size`` = (x half, y half, top, bottom) [m];
-    MuJoCo's rows run along y from -y to +y, columns along x."""
-    nrow, ncol = int(model.hfield_nrow[hid]), int(model.hfield_ncol[hid])
+    MuJoCo's rows run along y from -y to +y, columns along x. At most
+    :data:`MAX_HFIELD_DRAWN` samples are drawn."""
+    full_rows, full_cols = int(model.hfield_nrow[hid]), int(model.hfield_ncol[hid])
     rx, ry, top = (float(s) for s in model.hfield_size[hid][:3])
     adr = int(model.hfield_adr[hid])
-    z = np.asarray(model.hfield_data[adr : adr + nrow * ncol], np.float32).reshape(nrow, ncol)
-    xs = np.linspace(-rx, rx, ncol, dtype=np.float32)
-    ys = np.linspace(-ry, ry, nrow, dtype=np.float32)
+    data = np.asarray(model.hfield_data[adr : adr + full_rows * full_cols])
+    stride = max(1.0, math.sqrt(full_rows * full_cols / MAX_HFIELD_DRAWN))
+    rows = np.unique(np.linspace(0, full_rows - 1, max(2, round(full_rows / stride))).round())
+    cols = np.unique(np.linspace(0, full_cols - 1, max(2, round(full_cols / stride))).round())
+    rows, cols = rows.astype(np.int64), cols.astype(np.int64)
+    z = data.reshape(full_rows, full_cols)[np.ix_(rows, cols)].astype(np.float32)
+    nrow, ncol = len(rows), len(cols)
+    xs = (cols / max(full_cols - 1, 1) * 2 - 1).astype(np.float32) * rx
+    ys = (rows / max(full_rows - 1, 1) * 2 - 1).astype(np.float32) * ry
     gx, gy = np.meshgrid(xs, ys)
     vertices = np.stack([gx, gy, z * top], axis=-1).reshape(-1, 3)
     r, c = np.meshgrid(np.arange(nrow - 1), np.arange(ncol - 1), indexing="ij")

@@ -159,12 +159,21 @@ def _no_scene(scene: SourceLike | None, what: str) -> None:
 
 def _hrdf_model(hrdf: HRDF) -> tuple[mujoco.MjModel, list[str]]:
     """Compile a robot through the MJCF generator; its conversion notes are kept."""
-    from robotwright.errors import ConversionWarning
+    from robotwright.errors import ConversionWarning, RobotwrightError
     from robotwright.generators import MJCFHumanoidGenerator
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConversionWarning)
-        model = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
+        try:
+            model = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
+        except ValueError as exc:  # MuJoCo refuses the model (a mesh it cannot read, ...)
+            if isinstance(exc, RobotwrightError):
+                raise
+            from robotwright.hrdf.compiles import require_compiles
+
+            require_compiles(hrdf, f"cannot show robot '{hrdf.name}'")  # says where
+            reason = " ".join(str(exc).split())  # MuJoCo's message spans lines
+            raise ViewError(f"robot '{hrdf.name}': MuJoCo refuses the model: {reason}") from None
     notes = []
     for w in caught:
         if issubclass(w.category, ConversionWarning):
