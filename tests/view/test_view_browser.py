@@ -104,6 +104,9 @@ def test_robot_is_drawn_where_it_stands(chromium: str) -> None:
         for node in robot:
             node.visible = True
         again = browser.steady_screenshot(until=lambda s: _changed(s, empty)[inside].any())
+        # the page's own requests and messages all pass the server's Host/Origin and
+        # message checks
+        assert not viewer.refused, list(viewer.refused)
     changed = _changed(full, empty)
     view = _view_mask()
     grown = np.zeros_like(inside)  # a few pixels of anti-aliasing around the outline
