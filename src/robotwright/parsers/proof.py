@@ -269,6 +269,14 @@ def _structure_key(side: _Side, fam: str, i: int, body_map: dict[int, int] | Non
     return (fam,)
 
 
+#: a name the parsers or generators give an unnamed object (``geom_3``, ``body_7``).
+_GIVEN = re.compile(r"(body|joint|geom|site|sensor|actuator|tendon|equality|key)_\d+")
+
+
+def _unnamed(name: str) -> bool:
+    return not name or _GIVEN.fullmatch(name) is not None
+
+
 def _match(src: _Side, res: _Side, fam: str, body_map: dict[int, int]) -> dict[int, int]:
     """Source index -> result index for the objects of ``fam``: by name, then by the
     parsers' name of an unnamed object, then by structure and order."""
@@ -290,8 +298,11 @@ def _match(src: _Side, res: _Side, fam: str, body_map: dict[int, int]) -> dict[i
     if not rest:
         return out
     pool: dict[tuple, list[int]] = {}
+    # By structure: unnamed objects with the other side's unnamed ones, in order (a named
+    # one not found by its name is missing).
+    rest = [i for i in rest if not src.names[fam][i]]
     for j in r_idx:
-        if j not in taken:
+        if j not in taken and _unnamed(res.names[fam][j]):
             pool.setdefault(_structure_key(res, fam, j, None), []).append(j)
     for i in rest:
         cands = pool.get(_structure_key(src, fam, i, body_map))
@@ -314,8 +325,16 @@ def _match_bodies(src: _Side, res: _Side) -> dict[int, int]:
         j = r_names.get(name)
         if j is None or j in taken:
             parent = out.get(int(src.m.body_parentid[i]))
-            free = [k for k in children.get(parent, []) if k not in taken and
-                    not (src.names["body"][i] and res.names["body"][k])]  # fmt: skip
+            # By structure: an unnamed body with its parent's unnamed children, in order.
+            free = (
+                []
+                if src.names["body"][i]
+                else [
+                    k
+                    for k in children.get(parent, [])
+                    if k not in taken and _unnamed(res.names["body"][k])
+                ]
+            )
             j = free[0] if free else None
         if j is not None:
             out[i] = j
@@ -428,6 +447,10 @@ def compare_models(
             if attr in _KEY_COLUMNS:
                 a, b = _key_columns(a, b, cols[_KEY_COLUMNS[attr]])
             a, b = a[si], b[ri]
+            if attr.endswith("quat"):
+                # q and -q are the same rotation.
+                flip = (a.reshape(len(a), -1) * b.reshape(len(b), -1)).sum(axis=1) < 0
+                b = np.where(flip.reshape((-1,) + (1,) * (b.ndim - 1)), -b, b)
             if attr in ("geom_size", "site_size"):
                 a, b = (
                     _used_sizes(a, getattr(source, attr[:-4] + "type")[si]),
@@ -770,9 +793,12 @@ def prove(
     """The proof of converting ``source`` (``kind``: ``"mjcf"`` or ``"urdf"``) into
     ``hrdf`` and writing it as ``out_kind`` (``"hrdf"``, ``"mjcf"``, ``"urdf"``): one
     conversion note per difference that no note in ``notes`` reports (see
-    :func:`as_problems`). Empty when MuJoCo does not compile the source. A URDF output
-    is compared in what URDF holds: bodies, joints and degrees of freedom, geoms
-    (``<collision>``), and the options MuJoCo's URDF import sets from the file."""
+    :func:`as_problems`). Empty when MuJoCo does not compile the source, and for now
+    for a URDF source or output (``roundtrip`` compares those)."""
+    if kind != "mjcf" or out_kind == "urdf":
+        # Not yet: MuJoCo's URDF import writes the same robot in other terms (principal
+        # axes in another order, the root link as the world), which need matching first.
+        return []
     options = dict(options or {})
     src = source_model(source, kind, options)
     if src is None:
