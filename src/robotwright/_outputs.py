@@ -125,10 +125,10 @@ def _encloses_a_protected_folder(path: Path) -> str | None:
     real = path.resolve()
     if real.parent == real:
         return "is the root folder"
-    for what, folder in (("the working folder", Path.cwd()), ("your home folder", Path.home())):
+    for what, where in (("the working folder", Path.cwd), ("your home folder", Path.home)):
         try:
-            inner = folder.resolve()
-        except OSError:
+            inner = where().resolve()
+        except (OSError, RuntimeError, KeyError):  # deleted working folder, no home known
             continue
         if inner == real or real in inner.parents:
             return f"is or holds {what} ({inner})"
