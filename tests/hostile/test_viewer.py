@@ -565,7 +565,7 @@ def test_listening_beyond_loopback_warns() -> None:
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 0
+    assert proc.returncode == 0, stderr
     assert any(
         line.startswith("warning: listening on 0.0.0.0") and "anyone" in line
         for line in stderr.splitlines()

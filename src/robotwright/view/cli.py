@@ -138,8 +138,9 @@ def _run(args: argparse.Namespace) -> int:
         print(f"note: {line}", file=sys.stderr)
     if len(shown) < len(lines):
         print(f"note: ... {len(lines) - len(shown)} more (-v lists each)", file=sys.stderr)
-    print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
     try:
+        # Inside the try: a Ctrl-C right after the address is printed still stops cleanly.
+        print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
