@@ -22,7 +22,7 @@ def _options(args: argparse.Namespace) -> dict:
         opts["root_body"] = args.root_body
     if getattr(args, "massless_frames", None):
         opts["massless_frames"] = args.massless_frames
-    for name in ("bound_mass", "bound_inertia"):
+    for name in ("bound_mass", "bound_inertia", "density"):
         if getattr(args, name, None) is not None:
             opts[name] = getattr(args, name)
     for name in ("balance_inertia", "join_obj_objects"):
@@ -30,6 +30,8 @@ def _options(args: argparse.Namespace) -> dict:
             opts[name] = True
     if getattr(args, "actuators", None):
         opts["actuators"] = args.actuators
+    if getattr(args, "inertia_from_geoms", None):
+        opts["inertia_from_geoms"] = args.inertia_from_geoms
     if getattr(args, "xacro_arg", None):
         opts["xacro_args"] = dict(args.xacro_arg)
     if getattr(args, "actuator_gain", None):
@@ -51,6 +53,16 @@ def _actuator_gain(text: str) -> tuple[str, tuple[float, float]]:
     if not sep or not pattern or len(gains) not in (1, 2) or min(gains) < 0:
         raise argparse.ArgumentTypeError(f"{text!r}: expected PATTERN=KP,KV (numbers >= 0)")
     return pattern, (gains[0], gains[1] if len(gains) == 2 else 0.0)
+
+
+def _density(text: str) -> float:
+    """``--density``: a finite number > 0 (kg/m^3)."""
+    from robotwright.parsers.inertia_from_geoms import check_density
+
+    try:
+        return check_density(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a finite number > 0") from None
 
 
 def _xacro_arg(text: str) -> tuple[str, str]:
@@ -118,6 +130,20 @@ def _repair_args(p: argparse.ArgumentParser) -> None:
         type=float,
         metavar="KG_M2",
         help="URDF: raise principal moments below KG_M2 [kg m^2] to it",
+    )
+    p.add_argument(
+        "--inertia-from-geoms",
+        choices=("auto", "never"),
+        help="URDF: a link without <inertial> gets the mass and inertia of its collision "
+        "geoms, computed by MuJoCo as its URDF import does (auto, the default; one note "
+        "per link), or none (never: such a link is massless, a moving one refused)",
+    )
+    p.add_argument(
+        "--density",
+        type=_density,
+        metavar="KG_M3",
+        help="URDF, --inertia-from-geoms auto: density of the collision geoms of links "
+        "without <inertial> (default 1000, MuJoCo's)",
     )
     p.add_argument(
         "--join-obj-objects",

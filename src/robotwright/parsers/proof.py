@@ -710,7 +710,13 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
             for k in ("balance_inertia", "bound_mass", "bound_inertia")
             if k in options
         }
-        return compile_urdf(urdf_for_mujoco(path, options.get("package_map"), **compiler))
+        text = urdf_for_mujoco(
+            path,
+            options.get("package_map"),
+            inertia_from_geoms=options.get("inertia_from_geoms", "auto"),
+            **compiler,
+        )
+        return compile_urdf(text, options.get("density"))
     except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
         return None
 

@@ -39,6 +39,7 @@ from robotwright.hrdf.model import (
     Site,
 )
 from robotwright.parsers import inertia as inr
+from robotwright.parsers import inertia_from_geoms as geom_inertia
 from robotwright.parsers import urdf_actuators as acts
 from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
 from robotwright.parsers.geom_pairs import BOTH, merge_visual_collision
@@ -101,6 +102,12 @@ class URDFOptions:
             mesh paths may point into (trusted explicitly; see :mod:`robotwright._paths`).
         xacro_args: ``{"name": "value"}`` for the ``$(arg name)`` of a ``.xacro`` source
             (see :mod:`robotwright.parsers.xacro`).
+        inertia_from_geoms: a link without ``<inertial>`` gets the mass and inertia of
+            its collision geoms at ``density``, computed by MuJoCo, as MuJoCo's URDF
+            import does (``"auto"``, default; one note per link with the values), or
+            none (``"never"``: mass 0, so a moving such link is refused). See
+            :mod:`robotwright.parsers.inertia_from_geoms`.
+        density: kg/m^3 of the collision geoms of such links (MuJoCo's default 1000).
     """
 
     fixed_joints: FixedPolicy = "keep"
@@ -116,8 +123,16 @@ class URDFOptions:
     join_obj_objects: bool = False
     asset_roots: tuple[str | os.PathLike, ...] = ()
     xacro_args: Mapping[str, str] | None = None
+    inertia_from_geoms: Literal["auto", "never"] = "auto"
+    density: float = geom_inertia.DEFAULT_DENSITY
 
     def __post_init__(self) -> None:
+        if self.inertia_from_geoms not in geom_inertia.INERTIA_FROM_GEOMS:
+            raise ValueError(
+                f"inertia_from_geoms={self.inertia_from_geoms!r}: expected one of "
+                f"{list(geom_inertia.INERTIA_FROM_GEOMS)}"
+            )
+        object.__setattr__(self, "density", geom_inertia.check_density(self.density))
         if self.fixed_joints not in FIXED_POLICIES:
             raise ValueError(
                 f"fixed_joints={self.fixed_joints!r}: expected one of {list(FIXED_POLICIES)}"
@@ -189,6 +204,9 @@ class _LinkData:
     tensor: np.ndarray  # about the com, link frame
     geoms: list[tuple[str, _Pose, dict]]  # kind ("visual"/"collision"/BOTH), pose, fields
     has_inertial: bool
+    # (moments, iquat) as MuJoCo computed them from the geoms, kept as they are when the
+    # link is a body of its own, so that its principal axes come out in MuJoCo's order.
+    principal: tuple[tuple[float, float, float], tuple[float, float, float, float]] | None = None
 
 
 def _link_inertial(link: ET.Element, rep: Reporter) -> tuple[float, np.ndarray, np.ndarray, bool]:
@@ -347,7 +365,65 @@ class _URDFReader:
                 g = self._geom(elem, kind, name)
                 if g is not None:
                     geoms.append(g)
-        return _LinkData(name, mass, com, tensor, merge_visual_collision(geoms), has)
+        principal = None
+        if not has and self.opt.inertia_from_geoms == "auto":
+            mass, com, tensor, has, principal = self._inertia_from_geoms(name, geoms)
+        return _LinkData(name, mass, com, tensor, merge_visual_collision(geoms), has, principal)
+
+    def _inertia_from_geoms(
+        self, name: str, geoms: list[tuple[str, _Pose, dict]]
+    ) -> tuple[float, np.ndarray, np.ndarray, bool, Any]:
+        """A link without ``<inertial>``: the inertia of its collision geoms, computed by
+        MuJoCo as its URDF import does (visual geoms carry no mass there); reported.
+        Returns mass, centre of mass, tensor, whether it has mass, (moments, iquat)."""
+        where = f'<link name="{name}">'
+        shapes = []
+        for kind, pose, fields in geoms:
+            if kind != "collision":
+                continue
+            if fields.get("mesh"):
+                shape = geom_inertia.GeomShape(
+                    "mesh",
+                    (0.0, 0.0, 0.0),
+                    _t(pose.pos),
+                    pose.quat,
+                    file=self.store.root / fields["file"],
+                    scale=fields["scale"],
+                )
+            else:
+                shape = geom_inertia.GeomShape(
+                    fields["type"], fields["size"], _t(pose.pos), pose.quat
+                )
+            shapes.append(shape)
+        empty = (0.0, np.zeros(3), np.zeros((3, 3)), False, None)
+        if not shapes:
+            if geoms:  # a frame link (no geoms) has nothing to compute: no note
+                self.rep.warn(
+                    "no <inertial> and no collision geoms: mass 0, as MuJoCo's URDF import "
+                    "gives it (it takes mass from collision geoms only)",
+                    where,
+                )
+            return empty
+        density = self.opt.density
+        try:
+            got = geom_inertia.inertia_of_geoms(shapes, density)
+        except geom_inertia.InertiaFromGeomsError as exc:
+            # MuJoCo's own import refuses the file then: so do we, naming the link.
+            problem = (
+                f"no <inertial>, and MuJoCo computes no mass from its {len(shapes)} collision "
+                f"geom(s): {exc} (inertia_from_geoms='never', --inertia-from-geoms never, "
+                "leaves the link massless)"
+            )
+            raise ConversionError([Problem(self.rep.file, problem, element=where)]) from None
+        self.rep.warn(
+            f"no <inertial>: mass {got.mass!r} kg, centre of mass {_t(got.com)} m, principal "
+            f"moments {got.moments} kg m^2 computed by MuJoCo from its {len(shapes)} "
+            f"collision geom(s) at density {density!r} kg/m^3, as MuJoCo's URDF import "
+            "does (inertia_from_geoms='never', --inertia-from-geoms never, leaves it massless)",
+            where,
+        )
+        principal = (got.moments, got.iquat) if got.mass > 0 else None
+        return got.mass, got.com, got.tensor, got.mass > 0, principal
 
 
 def _make_geom(body: str, kind: str, pose: _Pose, fields: dict) -> MeshGeom | SimpleGeom:
@@ -582,7 +658,10 @@ def _body_record(
         mass, com, tensor = inr.combine(b["parts"])
     else:
         mass, com, tensor = 0.0, np.zeros(3), np.zeros((3, 3))
-    diag, iquat = inr.diagonalize(tensor)
+    if len(b["parts"]) == 1 and b.get("principal") is not None:
+        diag, iquat = b["principal"]  # MuJoCo's own, from the link's geoms
+    else:
+        diag, iquat = inr.diagonalize(tensor)
     where = f'<link name="{name}">'
     if mass > 0 and not inr.is_physical(diag):
         if opt.balance_inertia and min(diag) > 0:
@@ -763,6 +842,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
             "pose": pose,
             "parts": [(d.mass, d.com, d.tensor)] if d.mass > 0 or d.tensor.any() else [],
             "geoms": list(d.geoms),
+            "principal": d.principal if d.mass > 0 or d.tensor.any() else None,
         }
         body_order.append(name)
         if j is None and root_joint is not None:
