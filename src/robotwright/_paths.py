@@ -317,4 +317,10 @@ def checked_mjcf_spec(path: PathLike, *, trusted: Sequence[Path] | None = None) 
     check_mjcf_includes(tree, **where, trusted=trusted)
     spec = mujoco.MjSpec.from_file(str(path))
     check_mjcf_spec(spec, **where, trusted=trusted)
+    # Keyframes are allocated when the model compiles: refuse a flood of them first.
+    from robotwright._limits import keyframes_problem
+
+    problem = keyframes_problem(max(len(spec.keys), spec.nkey))
+    if problem is not None:
+        raise InputFileError(path, problem)
     return spec

@@ -16,6 +16,7 @@ from typing import Any
 
 from robotwright import __version__
 from robotwright._atomic import mesh_size_limit
+from robotwright._limits import keyframe_limit
 from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, collect_notes, summary_line
 from robotwright._npz import npz_limit
@@ -160,6 +161,15 @@ def build_parser() -> argparse.ArgumentParser:
             help="largest mesh or asset file copied into the output, in MB (default 512): "
             "a larger one is refused",
         )
+    for name in _ASSET_COMMANDS:
+        sub.choices[name].add_argument(
+            "--max-keyframes",
+            type=_count_arg,
+            default=None,
+            metavar="N",
+            help="most keyframes a model read may hold (default 10,000): MuJoCo allocates "
+            "a full state per keyframe",
+        )
     for name in _SCAN_COMMANDS:
         sub.choices[name].add_argument(
             "--max-scan-mb",
@@ -170,6 +180,16 @@ def build_parser() -> argparse.ArgumentParser:
             "scan .npz declaring more is refused before it is loaded",
         )
     return parser
+
+
+def _count_arg(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
+    return value
 
 
 def _positive_mb(text: str) -> float:
@@ -231,7 +251,8 @@ def _run(args: argparse.Namespace) -> int:
         packages = given_packages(dict(getattr(args, "packages", None) or []))
         limit = mesh_size_limit(getattr(args, "max_mesh_mb", None))
         scans = npz_limit(getattr(args, "max_scan_mb", None))
-        with trusted_asset_roots(roots), packages, limit, scans, collect_notes() as caught:
+        keys = keyframe_limit(getattr(args, "max_keyframes", None))
+        with trusted_asset_roots(roots), packages, limit, scans, keys, collect_notes() as caught:
             code = int(args.func(args) or 0)
         # Commands that only show a model (view, render) write no conversion: the notes
         # of loading it say nothing about the picture, so they are listed with -v only.

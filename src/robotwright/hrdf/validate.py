@@ -21,6 +21,7 @@ from pathlib import Path
 import defusedxml
 import defusedxml.ElementTree as SafeET
 
+from robotwright._limits import keyframes_problem
 from robotwright._names import name_problem
 from robotwright.errors import Problem, UnsafePathError
 from robotwright.hrdf.model import (
@@ -693,7 +694,19 @@ def check_extra(text: str | None) -> list[Problem]:
                 Problem(file, "names a file: not allowed in extra.xml", element=f"<{el.tag}>")
             )
         stack.extend((child, depth + 1) for child in el)
+    keys = sum(1 for section in root.iter("keyframe") for el in section if el.tag == "key")
+    nkey = max((_int_or_zero(el.get("nkey")) for el in root.iter("size")), default=0)
+    problem = keyframes_problem(max(keys, nkey))
+    if problem is not None:
+        out.append(Problem(file, problem, element="<keyframe>"))
     return out
+
+
+def _int_or_zero(text: str | None) -> int:
+    try:
+        return int(text or 0)
+    except ValueError:
+        return 0  # MuJoCo refuses the value itself when it compiles the model
 
 
 def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> list[Problem]:

@@ -22,6 +22,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from robotwright._limits import keyframes_problem
 from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
 from robotwright.errors import ConversionError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
@@ -902,6 +903,10 @@ def parse_mjcf(
         check_mjcf_includes(tree, **where, root=path.resolve().parent, trusted=trusted)
         spec = mujoco.MjSpec.from_file(str(path))
         check_mjcf_spec(spec, **where, root=path.resolve().parent, trusted=trusted)
+        # Keyframes are allocated when the model compiles: refuse a flood of them first.
+        too_many = keyframes_problem(max(len(spec.keys), spec.nkey))
+        if too_many is not None:
+            raise InputFileError(path, too_many)
         model = spec.compile()
     except UnsafePathError as exc:
         problem = Problem(exc.file or str(path), exc.reason, element=exc.element)
