@@ -325,3 +325,70 @@ def test_fifo_mesh_in_urdf_is_refused(shared: Path) -> None:
     os.mkfifo(shared / "robot" / "pipe.stl")
     with pytest.raises(RobotwrightError, match="not a regular file"):
         urdf_to_hrdf(path)
+
+
+def test_roundtrip_reference_api_keeps_the_rule(shared: Path) -> None:
+    """The round trip's reference (MuJoCo's import of the source) is also a reader: an
+    outside mesh is refused, not handed to MuJoCo as written."""
+    from robotwright.errors import UnsafePathError
+    from robotwright.parsers.reference import urdf_for_mujoco
+    from robotwright.parsers.roundtrip import reference_view
+
+    path = _urdf(shared / "robot", "../private/secret.stl")
+    with pytest.raises(UnsafePathError):
+        urdf_for_mujoco(path)
+    with pytest.raises(UnsafePathError):
+        reference_view(path, reference="mujoco")
+    own = _urdf(shared / "robot", "part.stl", "own.urdf")
+    assert str(shared / "robot" / "part.stl") in urdf_for_mujoco(own)
+
+
+MJCF = """<mujoco><asset><mesh name="m" file="{file}"/></asset>
+<worldbody><body name="b"><geom type="mesh" mesh="m"/></body></worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device"])
+def test_mjcf_readers_refuse_fifo_and_device_files(shared: Path, kind: str) -> None:
+    """The MJCF gate (the parser, render/view's loader) refuses a mesh that is not a
+    regular file before MuJoCo opens it. Run in a subprocess: the timeout only guards
+    against a regression that blocks."""
+    import subprocess
+    import sys
+
+    folder = shared / "robot"
+    if kind == "fifo":
+        os.mkfifo(folder / "pipe.stl")
+        file, trust = "pipe.stl", []
+    else:
+        file, trust = "/dev/zero", ["--asset-root", "/dev"]
+    scene = folder / "scene.xml"
+    scene.write_text(MJCF.format(file=file))
+    out = shared / "out.urdf"
+    run = [sys.executable, "-m", "robotwright", "convert", str(scene), "-o", str(out), *trust]
+    done = subprocess.run(run, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert "expected a regular file" in done.stderr and not out.exists()
+    code = (
+        "import sys\nfrom robotwright.render import load_model\n"
+        "from robotwright import trusted_asset_roots\n"
+        "from robotwright.errors import RobotwrightError\n"
+        f"try:\n    with trusted_asset_roots({trust[1:]!r}):\n"
+        f"        load_model({str(scene)!r})\n"
+        "except RobotwrightError as exc:\n    print(exc); sys.exit(2)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert "expected a regular file" in done.stdout
+
+
+def test_given_packages_reach_the_render_view_loader(shared: Path) -> None:
+    """``--package`` on render/view is a ``given_packages`` block around the loader."""
+    from robotwright.parsers.packages import given_packages
+
+    path = _urdf(shared / "robot", "package://private/secret.stl")
+    with pytest.raises(RobotwrightError, match="package 'private' not found"):
+        load_model(path)
+    with given_packages({"private": shared / "private"}):
+        assert load_model(path).model.nmesh == 1
+    with pytest.raises(RobotwrightError):  # the block is closed
+        load_model(path)

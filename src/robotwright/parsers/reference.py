@@ -24,6 +24,7 @@ import mujoco
 import numpy as np
 
 from robotwright._rotations import quat_to_mat, rpy_to_quat
+from robotwright.errors import UnsafePathError
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.xmlsafe import parse_xml
 
@@ -458,28 +459,35 @@ def urdf_for_mujoco(
     bound_mass=None,
     bound_inertia=None,
     root: ET.Element | None = None,
-    inertia_from_geoms: str = "auto",
 ) -> str:
     """The URDF text with mesh URIs made absolute, rotated inertial frames written in the
     link frame where MuJoCo would drop the rotation (see
     :func:`_inertia_into_link_frame`) and a ``<mujoco><compiler>`` block
-    that keeps every link a body (``fusestatic="false"``), gives a link without
-    ``<inertial>`` the inertia of its collision geoms as MuJoCo's import does by default
-    (``inertiafromgeom="auto"``; ``inertia_from_geoms="never"``: ``"false"``, none) and
-    drops visual geoms (which carry no mass in MuJoCo's import).
+    that keeps every link a body (``fusestatic="false"``), takes inertia only from
+    ``<inertial>`` (``inertiafromgeom="false"``) and drops visual geoms.
 
     ``root``: the URDF already parsed (changed in place), for a document that is not a
-    file yet; relative mesh URIs then resolve from ``path``'s folder all the same.
+    file yet (one robotwright wrote: its mesh paths are its own, not checked); relative
+    mesh URIs then resolve from ``path``'s folder all the same. A source file's mesh
+    paths keep the parsers' containment rule: one that exists outside the file's root
+    (and outside trusted folders) raises :class:`~robotwright.errors.UnsafePathError`
+    (a ``ValueError``) instead of reaching MuJoCo.
     """
+    contained = root is None
     if root is None:
         root = parse_xml(path)
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename")
         if uri:
             try:
-                resolved = resolve_uri(uri, path, package_map, Path("/"))
-            except UnresolvedMesh:
-                continue  # left as written: MuJoCo's own error then names the file
+                resolved = resolve_uri(uri, path, package_map, None if contained else Path("/"))
+            except UnresolvedMesh as exc:
+                try:
+                    resolve_uri(uri, path, package_map, Path("/"))
+                except UnresolvedMesh:
+                    continue  # left as written: MuJoCo's own error then names the file
+                # It exists, outside the robot's root: the parsers' containment rule.
+                raise UnsafePathError(str(exc), file=str(path)) from None
             mesh.set("filename", str(resolved))
     if not mujoco_urdf_keeps_inertial_rotation():
         _inertia_into_link_frame(root)
@@ -496,7 +504,7 @@ def urdf_for_mujoco(
     attrs = {
         "fusestatic": "false",
         "discardvisual": "true",
-        "inertiafromgeom": "false" if inertia_from_geoms == "never" else "auto",
+        "inertiafromgeom": "false",
         "strippath": "false",
         "balanceinertia": "true" if balance_inertia else "false",
     }
@@ -508,11 +516,8 @@ def urdf_for_mujoco(
     return ET.tostring(root, encoding="unicode")
 
 
-def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
+def compile_urdf(text: str) -> mujoco.MjModel:
     """MuJoCo's import of a URDF text (as :func:`urdf_for_mujoco` writes it), compiled.
-
-    ``density``: kg/m^3 given to the collision geoms (MuJoCo's import gives them its
-    default, 1000; a URDF cannot say otherwise), for the links without ``<inertial>``.
 
     On MuJoCo 4.x this is ``MjModel.from_xml_string(text)``. Where the installed MuJoCo
     gets a URDF wrong (3.11; each found by a probe), the import is completed so that the
@@ -529,7 +534,6 @@ def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
         mujoco_diagonalises_inertia_exactly()
         and mujoco_urdf_imports_mimic()
         and mujoco_urdf_keeps_mesh_files_apart()
-        and density is None
     ):
         return mujoco.MjModel.from_xml_string(text)
     root = DET.fromstring(text)
@@ -539,10 +543,6 @@ def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
         if assets:
             text = ET.tostring(root, encoding="unicode")
     spec = mujoco.MjSpec.from_string(text, assets=assets or None)
-    if density is not None:
-        for geom in spec.geoms:
-            if geom.density > 0:  # collision geoms; the import gives visual ones 0
-                geom.density = float(density)
     if not mujoco_urdf_imports_mimic():
         # As MuJoCo 4.x's URDF reader does (same fields, defaults for the rest).
         joints = {j.name for j in spec.joints}

@@ -27,6 +27,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright._paths import trusted_asset_roots
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers import inertia as inr
@@ -780,18 +781,15 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
         None if reference == "mujoco" else functools.partial(_yourdfpy_instead, path, compiler)
     )
     try:
-        text = urdf_for_mujoco(
-            path,
-            options.get("package_map"),
-            inertia_from_geoms=options.get("inertia_from_geoms", "auto"),
-            **compiler,
-        )
+        # The source's mesh paths under the parsers' containment rule (trusted folders:
+        # the caller's asset_roots and those of an enclosing --asset-root).
+        with trusted_asset_roots(options.get("asset_roots") or ()):
+            text = urdf_for_mujoco(path, options.get("package_map"), **compiler)
     except ValueError as exc:
         if fallback is None:
             raise
         return ReferenceLoader(functools.partial(fallback, exc))  # yourdfpy's from the start
-    density = options.get("density")  # of links without <inertial>, as the parser's
-    return ReferenceLoader(lambda: view_from_model(compile_urdf(text, density), "mujoco"), fallback)
+    return ReferenceLoader(lambda: view_from_model(compile_urdf(text), "mujoco"), fallback)
 
 
 def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:
