@@ -459,12 +459,15 @@ def urdf_for_mujoco(
     bound_mass=None,
     bound_inertia=None,
     root: ET.Element | None = None,
+    inertia_from_geoms: str = "auto",
 ) -> str:
     """The URDF text with mesh URIs made absolute, rotated inertial frames written in the
     link frame where MuJoCo would drop the rotation (see
     :func:`_inertia_into_link_frame`) and a ``<mujoco><compiler>`` block
-    that keeps every link a body (``fusestatic="false"``), takes inertia only from
-    ``<inertial>`` (``inertiafromgeom="false"``) and drops visual geoms.
+    that keeps every link a body (``fusestatic="false"``), gives a link without
+    ``<inertial>`` the inertia of its collision geoms as MuJoCo's import does by default
+    (``inertiafromgeom="auto"``; ``inertia_from_geoms="never"``: ``"false"``, none) and
+    drops visual geoms (which carry no mass in MuJoCo's import).
 
     ``root``: the URDF already parsed (changed in place), for a document that is not a
     file yet (one robotwright wrote: its mesh paths are its own, not checked); relative
@@ -504,7 +507,7 @@ def urdf_for_mujoco(
     attrs = {
         "fusestatic": "false",
         "discardvisual": "true",
-        "inertiafromgeom": "false",
+        "inertiafromgeom": "false" if inertia_from_geoms == "never" else "auto",
         "strippath": "false",
         "balanceinertia": "true" if balance_inertia else "false",
     }
@@ -516,8 +519,11 @@ def urdf_for_mujoco(
     return ET.tostring(root, encoding="unicode")
 
 
-def compile_urdf(text: str) -> mujoco.MjModel:
+def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
     """MuJoCo's import of a URDF text (as :func:`urdf_for_mujoco` writes it), compiled.
+
+    ``density``: kg/m^3 given to the collision geoms (MuJoCo's import gives them its
+    default, 1000; a URDF cannot say otherwise), for the links without ``<inertial>``.
 
     On MuJoCo 4.x this is ``MjModel.from_xml_string(text)``. Where the installed MuJoCo
     gets a URDF wrong (3.11; each found by a probe), the import is completed so that the
@@ -534,6 +540,7 @@ def compile_urdf(text: str) -> mujoco.MjModel:
         mujoco_diagonalises_inertia_exactly()
         and mujoco_urdf_imports_mimic()
         and mujoco_urdf_keeps_mesh_files_apart()
+        and density is None
     ):
         return mujoco.MjModel.from_xml_string(text)
     root = DET.fromstring(text)
@@ -543,6 +550,10 @@ def compile_urdf(text: str) -> mujoco.MjModel:
         if assets:
             text = ET.tostring(root, encoding="unicode")
     spec = mujoco.MjSpec.from_string(text, assets=assets or None)
+    if density is not None:
+        for geom in spec.geoms:
+            if geom.density > 0:  # collision geoms; the import gives visual ones 0
+                geom.density = float(density)
     if not mujoco_urdf_imports_mimic():
         # As MuJoCo 4.x's URDF reader does (same fields, defaults for the rest).
         joints = {j.name for j in spec.joints}

@@ -784,12 +784,18 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
         # The source's mesh paths under the parsers' containment rule (trusted folders:
         # the caller's asset_roots and those of an enclosing --asset-root).
         with trusted_asset_roots(options.get("asset_roots") or ()):
-            text = urdf_for_mujoco(path, options.get("package_map"), **compiler)
+            text = urdf_for_mujoco(
+                path,
+                options.get("package_map"),
+                inertia_from_geoms=options.get("inertia_from_geoms", "auto"),
+                **compiler,
+            )
     except ValueError as exc:
         if fallback is None:
             raise
         return ReferenceLoader(functools.partial(fallback, exc))  # yourdfpy's from the start
-    return ReferenceLoader(lambda: view_from_model(compile_urdf(text), "mujoco"), fallback)
+    density = options.get("density")  # of links without <inertial>, as the parser's
+    return ReferenceLoader(lambda: view_from_model(compile_urdf(text, density), "mujoco"), fallback)
 
 
 def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:
