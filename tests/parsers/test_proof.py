@@ -350,3 +350,98 @@ def test_corpus_mjcf_proof_has_no_unreported_difference(
         options["root_body"] = source.body(max(top, key=lambda i: (size[i], -i))).name
     messages = convert(path, tmp_path / "out", **options)
     assert not [m for m in messages if "proof:" in m], messages
+
+
+# -- URDF sources: compared with MuJoCo's own import -----------------------------------------
+def test_inertia_compared_as_tensor_not_principal_axes() -> None:
+    # One tensor, written as principal moments in two axis orders (the quat turns them).
+    a = _model(PLAIN.replace('mass="1"/>', 'mass="1"/><inertial pos="0 0 0" mass="1" '
+                             'diaginertia="0.1 0.2 0.3"/>'))  # fmt: skip
+    b = _model(
+        PLAIN.replace(
+            'mass="1"/>',
+            'mass="1"/><inertial pos="0 0 0" mass="1" '
+            'diaginertia="0.2 0.1 0.3" quat="0.7071068 0 0 0.7071068"/>',
+        )
+    )
+    assert not [d for d in proof.compare_models(a, b) if d.field.startswith("body_i")]
+    # Another tensor (same moments, axes turned by 45 degrees) is a difference, named once.
+    c = _model(
+        PLAIN.replace(
+            'mass="1"/>',
+            'mass="1"/><inertial pos="0 0 0" mass="1" '
+            'diaginertia="0.1 0.2 0.3" quat="0.9238795 0 0 0.3826834"/>',
+        )
+    )
+    diffs = [d for d in proof.compare_models(a, c) if d.field.startswith("body_i")]
+    assert [(d.field, d.obj) for d in diffs] == [("body_inertia", "body 'base'")], diffs
+
+
+URDF = """<robot name="u">
+  <link name="base">
+    <inertial><origin xyz="0 0 0.1" rpy="0.3 0.2 0.1"/><mass value="2"/>
+      <inertia ixx="0.3" iyy="0.25" izz="0.2" ixy="0.01" ixz="0.02" iyz="0.03"/></inertial>
+    <visual><geometry><box size="0.2 0.2 0.2"/></geometry></visual>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
+  </link>
+  <link name="arm">
+    <inertial><mass value="0.5"/><inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0"
+      ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.15"/><geometry><cylinder radius="0.03" length="0.3"/>
+      </geometry></collision>
+    <collision><origin xyz="0 0 0.3"/><geometry><sphere radius="0.04"/></geometry></collision>
+  </link>
+  <link name="tip"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 0.2"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="5"
+    velocity="1"/><dynamics damping="0.5" friction="0.1"/></joint>
+  <joint name="fix" type="fixed"><parent link="arm"/><child link="tip"/>
+    <origin xyz="0 0 0.3"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("out", ["hrdf", "r_out.xml"])
+def test_urdf_source_matches_mujocos_import(tmp_path: Path, out: str) -> None:
+    src = _write(tmp_path, URDF, "u.urdf")
+    reference = proof.source_model(src, "urdf", {})
+    assert reference is not None
+    hrdf, _ = __import__("robotwright.parsers.convert", fromlist=["load_any"]).load_any(src)
+    ours, _ = proof.result_model(hrdf, "mjcf", None, discard_visual=True)
+    # MuJoCo's import orders the rotated inertia's principal axes its own way.
+    assert not np.allclose(reference.body("base").inertia, ours.body("base").inertia)
+    assert proof.compare_models(reference, ours, families=("body", "jnt", "dof", "geom"),
+                                options=False) == []  # fmt: skip
+    messages = convert(src, tmp_path / out)
+    assert not [m for m in messages if "proof:" in m], messages
+
+
+def test_urdf_source_silent_loss_becomes_a_note(tmp_path: Path, monkeypatch) -> None:
+    _lose_shoulder_damping(monkeypatch)
+    messages = convert(_write(tmp_path, URDF, "u.urdf"), tmp_path / "out")
+    lost = [m for m in messages if "proof:" in m]
+    assert len(lost) == 1 and "dof_damping" in lost[0] and "'shoulder'" in lost[0], messages
+    # (a joint without effort and velocity limits: nothing else a strict conversion drops)
+    free = URDF.replace('type="revolute"', 'type="continuous"').replace(
+        '<limit lower="-1" upper="1" effort="5"\n    velocity="1"/>', ""
+    )
+    assert free.count("<limit") == 0
+    with pytest.raises(ConversionError, match="dof_damping"):
+        convert(_write(tmp_path, free, "u.urdf"), tmp_path / "out2", strict=True)
+    assert not (tmp_path / "out2").exists()
+
+
+def test_urdf_source_changed_inertia_is_named(tmp_path: Path, monkeypatch) -> None:
+    real = HRDF.save
+
+    def save(self: HRDF, path, **kw):
+        bodies = [
+            dataclasses.replace(b, mass=b.mass * 1.01) if b.name == "arm" else b
+            for b in self.bodies
+        ]
+        return real(dataclasses.replace(self, bodies=bodies), path, **kw)
+
+    monkeypatch.setattr(HRDF, "save", save)
+    messages = convert(_write(tmp_path, URDF, "u.urdf"), tmp_path / "out")
+    lost = [m for m in messages if "proof:" in m]
+    assert any("body_mass" in m and "'arm'" in m for m in lost), messages

@@ -111,7 +111,10 @@ _TRN_FAMILY = {0: "jnt", 1: "jnt", 2: "site", 3: "tendon", 4: "site", 5: "body"}
 _EQ_FAMILY = {0: "body", 1: "body", 2: "jnt", 3: "tendon"}
 #: bookkeeping that follows from the compared fields (see the module docstring).
 _SKIP_SUFFIX = ("adr", "num", "treeid", "plugin", "dataid", "matid", "mocapid")
-_SKIP_FIELDS = {"body_bvhadr", "body_bvhnum", "actuator_actadr", "key_mpos", "key_mquat"}
+_SKIP_FIELDS = {"body_bvhadr", "body_bvhnum", "actuator_actadr", "key_mpos", "key_mquat",
+                # the compiler's shortcuts for a body whose frames coincide: they follow
+                # from the compared frames (and the axis order of its principal moments)
+                "body_sameframe", "body_simple"}  # fmt: skip
 #: drawing only (MuJoCo's physics never reads them): colours, visibility groups, shadows
 #: and the drawn width of a tendon; a material's colour becomes ``geom_rgba`` as written.
 _APPEARANCE = ("_rgba", "_group", "_castshadow", "_width")
@@ -307,8 +310,25 @@ def _match(src: _Side, res: _Side, fam: str, body_map: dict[int, int]) -> dict[i
     for i in rest:
         cands = pool.get(_structure_key(src, fam, i, body_map))
         if cands:
-            out[i] = cands.pop(0)
+            # The one in the same place with the same size, else the next in order (an
+            # import may list a link's unnamed geoms in another order).
+            here = _placement(src, fam, i)
+            same = [k for k, j in enumerate(cands) if _same(here, _placement(res, fam, j))]
+            out[i] = cands.pop(same[0] if same else 0)
     return out
+
+
+def _placement(side: _Side, fam: str, i: int) -> np.ndarray | None:
+    """Where an unnamed geom or site is in its body and its size (None for others)."""
+    if fam not in ("geom", "site"):
+        return None
+    m = side.m
+    size = _used_sizes(getattr(m, f"{fam}_size")[i : i + 1], getattr(m, f"{fam}_type")[i : i + 1])
+    return np.concatenate([getattr(m, f"{fam}_pos")[i], size[0]])
+
+
+def _same(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    return a is not None and b is not None and _bad_rows(a[None, :], b[None, :]).size == 0
 
 
 def _match_bodies(src: _Side, res: _Side) -> dict[int, int]:
@@ -447,7 +467,19 @@ def compare_models(
             if attr in _KEY_COLUMNS:
                 a, b = _key_columns(a, b, cols[_KEY_COLUMNS[attr]])
             a, b = a[si], b[ri]
-            if attr.endswith("quat"):
+            if attr in _INERTIA_PAIRS.values():
+                continue  # compared with its moments, as one tensor
+            if attr in _INERTIA_PAIRS:
+                quat = _INERTIA_PAIRS[attr]
+                a = _tensors(a, getattr(source, quat)[si])
+                b = _tensors(b, getattr(result, quat)[ri])
+            elif attr in ("body_ipos", "body_invweight0"):
+                # A body without mass or inertia has no centre of mass to place (MuJoCo
+                # keeps the position it was given, or its geoms' centre, and computes
+                # the inverse weight there).
+                empty = _massless(source, si) & _massless(result, ri)
+                b = np.where(empty.reshape((-1,) + (1,) * (b.ndim - 1)), a, b)
+            elif attr.endswith("quat"):
                 # q and -q are the same rotation.
                 flip = (a.reshape(len(a), -1) * b.reshape(len(b), -1)).sum(axis=1) < 0
                 b = np.where(flip.reshape((-1,) + (1,) * (b.ndim - 1)), -b, b)
@@ -479,6 +511,30 @@ def compare_models(
     # A derived value (a subtree mass, an inverse weight) differs because an input did:
     # that input is the difference to report; derived ones alone are reported as such.
     return primary if primary else diffs
+
+
+#: principal moments -> the rotation of their axes: compared as the one tensor they make
+#: in the object's frame (MuJoCo orders and signs principal axes as its eigen-solver
+#: returns them; an import and our writer may differ there and hold the same inertia).
+_INERTIA_PAIRS = {"body_inertia": "body_iquat"}
+
+
+def _massless(model: mujoco.MjModel, idx: np.ndarray) -> np.ndarray:
+    """Per body of ``idx``: whether its mass and principal moments are all zero."""
+    return (model.body_mass[idx] == 0) & (model.body_inertia[idx] == 0).all(axis=1)
+
+
+def _tensors(moments: np.ndarray, quats: np.ndarray) -> np.ndarray:
+    """Per object, the inertia tensor ``R diag(moments) R^T`` in the object's frame as
+    its six values ``xx yy zz xy xz yz`` (kg m^2)."""
+    out = np.zeros((len(moments), 6))
+    mat = np.zeros(9)
+    for k, (d, q) in enumerate(zip(moments, quats, strict=True)):
+        mujoco.mju_quat2Mat(mat, np.asarray(q, dtype=float))
+        r = mat.reshape(3, 3)
+        t = r @ np.diag(np.asarray(d, dtype=float)) @ r.T
+        out[k] = (t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2], t[1, 2])
+    return out
 
 
 #: values the compiler derives from the others (and from every body of a subtree).
@@ -732,17 +788,22 @@ def _file_key(path: str | Path) -> tuple[int, str] | None:
     return len(data), hashlib.sha256(data).hexdigest()
 
 
-def _compile_with_same_files(xml: str, originals: Iterable[Path]) -> mujoco.MjModel:
+def _compile_with_same_files(
+    xml: str, originals: Iterable[Path], discard_visual: bool = False
+) -> mujoco.MjModel:
     """Compile ``xml``; a mesh file with the same bytes as one of ``originals`` (a copy or
     a link the writer made) is read through that path, whose compiled mesh MuJoCo has
     cached: the values compared are the same, the second processing of every mesh
-    (most of a compile) is saved."""
+    (most of a compile) is saved. ``discard_visual``: compile as MuJoCo's URDF import
+    does (``discardvisual``: geoms that neither collide nor carry mass left out)."""
     by_key: dict[tuple[int, str], str] = {}
     for p in originals:
         key = _file_key(p)
         if key is not None:
             by_key.setdefault(key, str(p))
     spec = mujoco.MjSpec.from_string(xml)
+    if discard_visual:
+        spec.compiler.discardvisual = True
     for mesh in spec.meshes:
         if mesh.file:
             key = _file_key(mesh.file)
@@ -752,11 +813,13 @@ def _compile_with_same_files(xml: str, originals: Iterable[Path]) -> mujoco.MjMo
 
 
 def result_model(
-    hrdf: HRDF, out_kind: str, work_dir: Path | None
+    hrdf: HRDF, out_kind: str, work_dir: Path | None, *, discard_visual: bool = False
 ) -> tuple[mujoco.MjModel, list[str]]:
     """What the output of ``hrdf`` compiles to, and the notes its writer gives: an HRDF
     folder saved and read back (into ``work_dir``), then generated as MJCF; an MJCF as
-    ``export`` writes it; a URDF as MuJoCo imports it."""
+    ``export`` writes it; a URDF as MuJoCo imports it. ``discard_visual``: the MJCF
+    compiled as MuJoCo compiles a URDF (visual geoms left out), to compare with a URDF
+    source."""
     import tempfile
     import warnings
 
@@ -774,7 +837,7 @@ def result_model(
                 except Exception:  # noqa: BLE001 - an unreadable mesh fails the compile
                     continue
             if out_kind == "mjcf":
-                model = _compile_with_same_files(our_mjcf_text(hrdf), originals)
+                model = _compile_with_same_files(our_mjcf_text(hrdf), originals, discard_visual)
             else:
                 from robotwright.hrdf.model import HRDF as _HRDF
 
@@ -782,7 +845,9 @@ def result_model(
                     folder = Path(tmp) / "robot"
                     hrdf.save(folder)
                     loaded = _HRDF.from_dir(folder, asset_roots=hrdf.asset_roots)
-                    model = _compile_with_same_files(our_mjcf_text(loaded), originals)
+                    model = _compile_with_same_files(
+                        our_mjcf_text(loaded), originals, discard_visual
+                    )
     return model, [str(w.message) for w in caught]
 
 
@@ -799,17 +864,22 @@ def prove(
     """The proof of converting ``source`` (``kind``: ``"mjcf"`` or ``"urdf"``) into
     ``hrdf`` and writing it as ``out_kind`` (``"hrdf"``, ``"mjcf"``, ``"urdf"``): one
     conversion note per difference that no note in ``notes`` reports (see
-    :func:`as_problems`). Empty when MuJoCo does not compile the source, and for now
-    for a URDF source or output (``roundtrip`` compares those)."""
-    if kind != "mjcf" or out_kind == "urdf":
-        # Not yet: MuJoCo's URDF import writes the same robot in other terms (principal
-        # axes in another order, the root link as the world), which need matching first.
+    :func:`as_problems`). Empty when MuJoCo does not compile the source.
+
+    A URDF source is compared with MuJoCo's own import of it (every link a body, visual
+    geoms discarded as that import does; the output compiled the same way)."""
+    if out_kind == "urdf":
+        # A URDF output is compared with the MJCF of the same robot (prove_urdf_output).
         return []
     options = dict(options or {})
+    if kind == "urdf" and options.get("fixed_joints", "keep") != "keep":
+        # MuJoCo's import keeps every link a body here (fusing static bodies would fuse
+        # the fixed base into the world): links merged on request have no counterpart.
+        return []
     src = source_model(source, kind, options)
     if src is None:
         return []
-    res, written = result_model(hrdf, out_kind, work_dir)
+    res, written = result_model(hrdf, out_kind, work_dir, discard_visual=kind == "urdf")
     root = options.get("root_body")
     families = None
     if out_kind == "urdf" or kind == "urdf":
