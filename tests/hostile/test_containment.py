@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 import random
+import tempfile
 from pathlib import Path
 from urllib.parse import quote
 
@@ -28,6 +29,7 @@ import trimesh
 from robotwright.cli import main
 from robotwright.errors import RobotwrightError
 from robotwright.parsers import urdf_to_hrdf
+from robotwright.parsers.packages import robot_root
 from robotwright.parsers.roundtrip import roundtrip
 from robotwright.render import load_model
 
@@ -392,3 +394,33 @@ def test_given_packages_reach_the_render_view_loader(shared: Path) -> None:
         assert load_model(path).model.nmesh == 1
     with pytest.raises(RobotwrightError):  # the block is closed
         load_model(path)
+
+
+@pytest.mark.parametrize("levels", [1, 2, 4])
+def test_planted_package_xml_in_a_shared_folder_widens_nothing(
+    tmp_path: Path, monkeypatch, levels: int
+) -> None:
+    # A package.xml someone planted in a shared folder (here the temporary folder) or
+    # more levels up than ROS keeps robot files must not make that folder the root.
+    shared = tmp_path / "shared"
+    robot_dir = shared.joinpath(*[f"d{i}" for i in range(levels)])
+    robot_dir.mkdir(parents=True)
+    (shared / "package.xml").write_text("<package><name>planted</name></package>")
+    monkeypatch.setattr(tempfile, "tempdir", str(shared))
+    urdf = robot_dir / "robot.urdf"
+    urdf.write_text("<robot name='r'><link name='a'/></robot>")
+    assert robot_root(urdf) == robot_dir.resolve()
+
+
+def test_package_xml_found_within_ros_depth(tmp_path: Path) -> None:
+    pkg = tmp_path / "my_robot_description"
+    urdf_dir = pkg / "robots" / "my_robot" / "urdf"
+    urdf_dir.mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>my_robot_description</name></package>")
+    deep = urdf_dir / "a" / "b" / "c" / "d"
+    deep.mkdir(parents=True)
+    (urdf_dir / "r.urdf").write_text("<robot name='r'/>")
+    (deep / "r.urdf").write_text("<robot name='r'/>")
+    assert robot_root(urdf_dir / "r.urdf") == pkg.resolve()
+    # Seven levels below the package.xml: further than ROS keeps robot files.
+    assert robot_root(deep / "r.urdf") == deep.resolve()

@@ -34,8 +34,10 @@ it lies in a folder trusted explicitly (see :mod:`robotwright._paths`).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
+import tempfile
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -43,8 +45,9 @@ from functools import lru_cache
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+from robotwright._assets import check_asset_file
 from robotwright._paths import resolve_inside
-from robotwright.errors import UnsafePathError
+from robotwright.errors import InputFileError, UnsafePathError
 
 _NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 
@@ -189,12 +192,33 @@ def _package_inside_root(name: str, urdf_path: Path) -> Path | None:
 def robot_root(urdf_path: Path) -> Path:
     """The folder a URDF or xacro file may read from (relative and ``file://`` mesh
     paths, xacro includes and ``load_yaml``): the nearest ancestor of the file holding a
-    ``package.xml`` (the ROS package it belongs to), else the file's own folder."""
+    ``package.xml`` (the ROS package it belongs to), else the file's own folder.
+
+    The search looks at most :data:`PACKAGE_SEARCH_DEPTH` folders up and never takes a
+    shared folder (``/``, the home folder, the system's temporary folder) as a package:
+    a ``package.xml`` planted there by someone else must not widen every robot below it
+    to the whole shared folder."""
     resolved = urdf_path.resolve()
-    for ancestor in resolved.parents:
+    for ancestor in resolved.parents[:PACKAGE_SEARCH_DEPTH]:
+        if ancestor in _shared_folders():
+            break
         if (ancestor / "package.xml").is_file():
             return ancestor
     return resolved.parent
+
+
+#: Folders searched for a URDF's ``package.xml``, its own first (ROS keeps robot files a
+#: few levels deep: ``urdf/``, ``urdf/xacro/``, ``robots/NAME/urdf/``; xacro's own test
+#: robots sit four below theirs).
+PACKAGE_SEARCH_DEPTH = 6
+
+
+def _shared_folders() -> frozenset[Path]:
+    """Folders many users or programs write into, never a robot's package."""
+    folders = {Path("/"), Path(tempfile.gettempdir()).resolve()}
+    with contextlib.suppress(RuntimeError, KeyError, OSError):
+        folders.add(Path.home().resolve())
+    return frozenset(folders)
 
 
 def resolve_uri(
@@ -207,6 +231,8 @@ def resolve_uri(
 
     Raises:
         UnresolvedMesh: unknown package, missing file, or a path escaping its folder.
+        robotwright.errors.InputFileError: the file is larger than the mesh size limit
+            (``--max-mesh-mb``; see :mod:`robotwright._assets`).
     """
     if uri.startswith("package://"):
         rest = uri[len("package://") :].lstrip("/")
@@ -232,7 +258,11 @@ def resolve_uri(
         if path.exists():
             raise UnresolvedMesh(f"'{uri}' resolves to {path}, which is not a regular file")
         raise UnresolvedMesh(f"'{uri}' resolves to {path}, which does not exist")
-    return path
+    try:
+        # Not an unresolved mesh (a caller may leave those to MuJoCo): a refusal.
+        return check_asset_file(path)
+    except InputFileError as exc:
+        raise InputFileError(f"{urdf_path}: mesh '{uri}': {exc.path}", exc.reason) from None
 
 
 def package_not_found(name: str, urdf_path: Path) -> str:
