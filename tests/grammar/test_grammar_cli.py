@@ -102,8 +102,8 @@ def test_search_and_export(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "12 designs evaluated" in text and "best reach" in text
     again = tmp_path / "again"
-    assert main(["grammar", "export", str(out / "design.json"), "-o", str(again)]) == 0
-    assert (again / "srl.xml").read_text() == (out / "srl.xml").read_text()
+    assert main(["grammar", "export", str(out / "best_1" / "design.json"), "-o", str(again)]) == 0
+    assert (again / "srl.xml").read_text() == (out / "best_1" / "srl.xml").read_text()
     assert main(["grammar", "search", "--constraint", "shiny", "--budget", "2"]) == 2
 
 

@@ -63,6 +63,22 @@ def _vec(v: np.ndarray) -> tuple[float, float, float]:
     return tuple(float(x) for x in _clean(np.asarray(v, dtype=float)))  # type: ignore[return-value]
 
 
+_GEOM_TYPES = {
+    "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+    "box": mujoco.mjtGeom.mjGEOM_BOX,
+    "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+    "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
+}
+
+
+def _quat_mat(quat: tuple[float, float, float, float]) -> np.ndarray:
+    """Rotation matrix of a quaternion (w, x, y, z), normalised first."""
+    q = np.asarray(quat, dtype=float)
+    out = np.zeros(9)
+    mujoco.mju_quat2Mat(out, q / np.linalg.norm(q))
+    return out.reshape(3, 3)
+
+
 # Quaternion turning a geom's z axis onto body x (cylinders along a link).
 _Z_TO_X = mat2quat(np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]))
 
@@ -150,35 +166,78 @@ class Limb:
         spec = mujoco.MjSpec()
         spec.compiler.degree = False
         spec.modelname = self.name
-        made = []
+        self.add_to(spec, spec.worldbody)
+        return spec
+
+    def add_to(
+        self,
+        spec: mujoco.MjSpec,
+        parent: mujoco.MjsBody,
+        pos: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0),
+        prefix: str = "",
+        motors: bool = False,
+    ) -> list[str]:
+        """Add the limb's bodies, geoms and joints under ``parent`` of ``spec`` (angles
+        in radians), its base placed at ``pos``/``quat`` (m; w, x, y, z) in the
+        parent's frame, every name prefixed with ``prefix``. With ``motors``, one motor
+        per joint with ``ctrlrange`` and joint ``actuatorfrcrange`` +-peak torque (N m,
+        or N for a slide), so MuJoCo clips commands to the component's limit.
+
+        Returns:
+            The names of the bodies added, in the limb's order.
+        """
+        made: list = []
+        by_body: dict[str, list[LimbJoint]] = {}
+        for j in self.joints:
+            by_body.setdefault(j.body, []).append(j)
+        hinge, slide = mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE
+        limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        added_joints: list[tuple[str, float]] = []
         for b in self.bodies:
-            parent = spec.worldbody if b.parent < 0 else made[b.parent]
-            rel = b.frame if b.parent < 0 else np.linalg.inv(self.bodies[b.parent].frame) @ b.frame
-            body = parent.add_body(name=b.name, pos=rel[:3, 3], quat=mat2quat(rel[:3, :3]))
+            if b.parent < 0:
+                root = b.frame
+                base = np.eye(4)
+                base[:3, :3] = _quat_mat(quat)
+                base[:3, 3] = pos
+                rel = base @ root
+                into = parent
+            else:
+                rel = np.linalg.inv(self.bodies[b.parent].frame) @ b.frame
+                into = made[b.parent]
+            body = into.add_body(name=prefix + b.name, pos=rel[:3, 3], quat=mat2quat(rel[:3, :3]))
             for g in b.geoms:
                 body.add_geom(
-                    name=g.name,
-                    type=getattr(mujoco.mjtGeom, f"mjGEOM_{g.type.upper()}"),
+                    name=prefix + g.name,
+                    type=_GEOM_TYPES.get(g.type)
+                    or getattr(mujoco.mjtGeom, f"mjGEOM_{g.type.upper()}"),
                     size=g.size,
                     pos=g.pos,
                     quat=g.quat,
                     rgba=g.rgba,
                     density=g.density,
                 )
-            for j in self.joints:
-                if j.body == b.name:
-                    body.add_joint(
-                        name=j.name,
-                        type=mujoco.mjtJoint.mjJNT_HINGE
-                        if j.type == "hinge"
-                        else mujoco.mjtJoint.mjJNT_SLIDE,
-                        pos=j.pos,
-                        axis=j.axis,
-                        range=j.range,
-                        limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-                    )
+            for j in by_body.get(b.name, ()):
+                joint = body.add_joint(
+                    name=prefix + j.name,
+                    type=hinge if j.type == "hinge" else slide,
+                    pos=j.pos,
+                    axis=j.axis,
+                    range=j.range,
+                    limited=limited,
+                )
+                if motors:
+                    joint.actfrclimited = limited
+                    joint.actfrcrange = (-j.peak_torque, j.peak_torque)
+                added_joints.append((prefix + j.name, j.peak_torque))
             made.append(body)
-        return spec
+        if motors:
+            for name, peak in added_joints:
+                act = spec.add_actuator(name=f"{name}_motor", target=name)
+                act.trntype = mujoco.mjtTrn.mjTRN_JOINT
+                act.ctrllimited = limited
+                act.ctrlrange = (-peak, peak)
+        return [prefix + b.name for b in self.bodies]
 
     def mass_properties(self) -> list[dict[str, tuple[float, ...] | float]]:
         """Mass (kg), centre of mass, principal inertia (kg m^2) and its frame per body,

@@ -198,16 +198,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument(
         "--objective",
         default="reach",
-        choices=["reach", "workspace", "mass", "dof"],
+        choices=["reach", "workspace", "mass", "dof", "payload", "track", "energy"],
         help="reach: farthest end point [m] (default); workspace: reachable volume "
-        "estimate [m^3]; mass: lightest [kg]; dof: most joints",
+        "estimate [m^3]; mass: lightest [kg]; dof: most joints; worn by the carrier "
+        "(mini_humanoid's back): payload: heaviest load held at every sampled pose [kg]; "
+        "track: smallest RMS error following a circle and a line [m]; energy: least mean "
+        "mechanical power on that path [W]",
     )
     q.add_argument(
         "--constraint",
         action="append",
         default=None,
-        help="no-self-collision (default), joint-limits, max-mass=KG, max-dof=N, min-dof=N; "
-        "repeatable",
+        help="no-self-collision (default), no-carrier-collision, joint-limits, max-mass=KG, "
+        "max-dof=N, min-dof=N; repeatable",
     )
     q.add_argument(
         "--budget",
@@ -242,8 +245,20 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="allow --workers above the CPU count (each worker is a process started at once)",
     )
     q.add_argument(
-        "-o", "--out", type=Path, default=None, help="write the best design's files here"
+        "-o",
+        "--out",
+        type=Path,
+        default=None,
+        help="write the best designs here: OUT/best_1 ... (design folders with their values, "
+        "a picture on the carrier, and for track/energy the tool path against the reference)",
     )
+    q.add_argument(
+        "--top",
+        type=_int_at_least(1),
+        default=3,
+        help="how many of the best designs -o writes (default 3)",
+    )
+    q.add_argument("--no-picture", action="store_true", help="with -o: skip the PNG pictures")
     add_overwrite_flag(q)
     q.set_defaults(func=_search)
 
@@ -379,13 +394,12 @@ def _search_progress(budget: int, name: str):
 
 
 def _search(args: argparse.Namespace) -> int:
-    from robotwright.grammar.export import export_design
     from robotwright.grammar.objectives import OBJECTIVES, make_constraint
     from robotwright.grammar.search import beam_search, check_workers, mcts_search, random_search
 
     g = _grammar(args)
     if args.out:
-        _check_design_dir(args.out, args.overwrite)
+        _check_design_dir(args.out, args.overwrite, kind="designs")
     try:
         constraints = [make_constraint(c) for c in (args.constraint or ["no-self-collision"])]
     except ValueError as exc:
@@ -422,8 +436,12 @@ def _search(args: argparse.Namespace) -> int:
     )
     print(res.best.design.to_text(), end="")
     if args.out:
-        export_design(g, res.best.design, args.out, overwrite=True)
-        print(f"written to {args.out}")
+        from robotwright.grammar.winners import write_winners
+
+        folders = write_winners(
+            g, res.evaluations, [objective], args.out, k=args.top, pictures=not args.no_picture
+        )
+        print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
     return 0
 
 

@@ -3,7 +3,9 @@
 An objective maps an :class:`EvalContext` to a number and says whether larger is
 better; a constraint returns ``None`` when satisfied or a message naming the
 violation. Both are small frozen dataclasses, so they pickle into worker processes.
-Units: metres, cubic metres, kilograms, radians.
+Units: metres, cubic metres, kilograms, radians, watts. The physics objectives
+(``payload``, ``track``, ``energy``) and ``no-carrier-collision`` evaluate the limb
+worn by its carrier (:mod:`robotwright.grammar.physics`).
 """
 
 from __future__ import annotations
@@ -17,6 +19,16 @@ import numpy as np
 
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.design import Design
+from robotwright.grammar.physics import (
+    Carrier,
+    Mounted,
+    TrackResult,
+    carrier_collisions,
+    mount,
+    payload,
+    sample_poses,
+    track,
+)
 from robotwright.grammar.rules import Grammar
 
 
@@ -34,6 +46,23 @@ class EvalContext:
     @cached_property
     def model(self) -> mujoco.MjModel:
         return self.limb.to_spec().compile()
+
+    def mounted(self, carrier: Carrier) -> Mounted:
+        """The limb compiled on ``carrier`` (joints locked), built once per carrier."""
+        cache = self.__dict__.setdefault("_mounted", {})
+        if carrier not in cache:
+            cache[carrier] = mount(self.limb, carrier)
+        return cache[carrier]
+
+    def tracking(self, carrier: Carrier, duration: float, scale: float) -> TrackResult:
+        """One tracking run (shared by ``track`` and ``energy``)."""
+        key = (carrier, duration, scale)
+        cache = self.__dict__.setdefault("_tracks", {})
+        if key not in cache:
+            cache[key] = track(
+                self.limb, carrier, duration=duration, scale=scale, mounted=self.mounted(carrier)
+            )
+        return cache[key]
 
     def tool_points(self, samples: int, seed: int) -> np.ndarray:
         """Tool-point positions (m, mount frame) of every branch for ``samples`` joint
@@ -223,20 +252,94 @@ class NoSelfCollision:
         return f"self-collision at zero pose: {pairs}"
 
 
+@dataclass(frozen=True)
+class Payload:
+    """Largest mass (kg) at every tool point that the limb, worn by ``carrier``, holds
+    still at the zero pose and ``samples`` seeded random poses with every joint torque
+    within its peak (:func:`robotwright.grammar.physics.payload`); larger is better."""
+
+    samples: int = 32
+    seed: int = 0
+    carrier: Carrier = Carrier()
+    name: str = "payload"
+    maximize: bool = True
+
+    def __call__(self, ctx: EvalContext) -> float:
+        m = ctx.mounted(self.carrier)
+        return payload(ctx.limb, self.carrier, samples=self.samples, seed=self.seed, mounted=m).mass
+
+
+@dataclass(frozen=True)
+class Track:
+    """RMS distance (m) between the first tool point and a circle-then-line reference
+    in front of the limb over ``duration`` s, under PD + gravity compensation within
+    the peak torques (:func:`robotwright.grammar.physics.track`); smaller is better."""
+
+    duration: float = 2.0
+    scale: float = 0.15
+    carrier: Carrier = Carrier()
+    name: str = "track"
+    maximize: bool = False
+
+    def __call__(self, ctx: EvalContext) -> float:
+        return ctx.tracking(self.carrier, self.duration, self.scale).error
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Mean mechanical power (W), ``sum |tau_i dq_i|`` averaged over the steps of the
+    same run as :class:`Track`; smaller is better."""
+
+    duration: float = 2.0
+    scale: float = 0.15
+    carrier: Carrier = Carrier()
+    name: str = "energy"
+    maximize: bool = False
+
+    def __call__(self, ctx: EvalContext) -> float:
+        return ctx.tracking(self.carrier, self.duration, self.scale).power
+
+
+@dataclass(frozen=True)
+class NoCarrierCollision:
+    """The limb touches no geom of its carrier at the zero pose and ``samples`` seeded
+    random poses (MuJoCo collision detection on the mounted model)."""
+
+    samples: int = 32
+    seed: int = 0
+    carrier: Carrier = Carrier()
+    name: str = "no-carrier-collision"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        m = ctx.mounted(self.carrier)
+        hits = carrier_collisions(m, sample_poses(m, self.samples, self.seed))
+        if not hits:
+            return None
+        k, a, b = hits[0]
+        poses = len({h[0] for h in hits})
+        return f"touches the carrier at {poses} of {self.samples + 1} poses (first: pose {k}, {a} and {b})"
+
+
 OBJECTIVES: dict[str, type] = {
     "reach": Reach,
     "workspace": WorkspaceVolume,
     "mass": Mass,
     "dof": DoFCount,
+    "payload": Payload,
+    "track": Track,
+    "energy": Energy,
 }
 
 
 def make_constraint(text: str) -> Constraint:
-    """Parse ``no-self-collision``, ``joint-limits``, ``max-mass=KG``, ``max-dof=N``, ``min-dof=N``."""
+    """Parse ``no-self-collision``, ``no-carrier-collision``, ``joint-limits``,
+    ``max-mass=KG``, ``max-dof=N``, ``min-dof=N``."""
     name, _, value = text.partition("=")
     try:
         if name == "no-self-collision":
             return NoSelfCollision()
+        if name == "no-carrier-collision":
+            return NoCarrierCollision()
         if name == "joint-limits":
             return JointLimitsFeasible()
         if name == "max-mass":
@@ -248,7 +351,7 @@ def make_constraint(text: str) -> Constraint:
     except ValueError:
         raise ValueError(f"constraint {text!r}: {name} needs a number, e.g. {name}=2") from None
     raise ValueError(
-        f"unknown constraint {text!r}: expected no-self-collision, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
+        f"unknown constraint {text!r}: expected no-self-collision, no-carrier-collision, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
     )
 
 

@@ -1,0 +1,413 @@
+"""Physics of a limb mounted on its carrier: payload, trajectory tracking, energy.
+
+Every function here is a deterministic function of a built limb, a :class:`Carrier` and
+its parameters (seeded sampling, fixed time step, no wall-clock or thread dependence),
+evaluated in MuJoCo with the actuator limits of the component library (the connector's
+``peak_torque``: N m for a revolute DoF, N for a prismatic one).
+
+The carrier (default: the bundled ``mini_humanoid``, limb on its ``back_mount`` site
+pointing backwards, as ``robotwright demo`` mounts it) is held still in its reference
+pose: its joints are locked, so only the limb moves. Positions are in metres in the
+world frame, which is the carrier's frame (its root body stays where its model puts
+it); gravity is the carrier model's (-9.81 m/s^2 along z).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+import xml.etree.ElementTree as ET  # noqa: N817 (serialising our own tree, not parsing)
+from dataclasses import dataclass
+from functools import lru_cache
+
+import mujoco
+import numpy as np
+
+from robotwright.grammar.build import Limb
+
+#: The limb's z axis (its base normal) along the site's -x: worn on the back, pointing
+#: backwards. Rotation of -90 deg about y, as (w, x, y, z).
+BACKWARDS = (math.sqrt(0.5), 0.0, -math.sqrt(0.5), 0.0)
+
+
+@dataclass(frozen=True)
+class Carrier:
+    """Where a limb is worn: a bundled robot (``robot``, by name), the body or site
+    ``at`` that carries the limb's base, and the limb's pose there (m; w, x, y, z)."""
+
+    robot: str = "mini_humanoid"
+    at: str = "back_mount"
+    pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    quat: tuple[float, float, float, float] = BACKWARDS
+    prefix: str = "srl_"
+
+
+#: The default carrier: the bundled humanoid, the limb on its back.
+DEFAULT_CARRIER = Carrier()
+
+
+@lru_cache(maxsize=8)
+def _carrier_xml(carrier: Carrier) -> tuple[str, str, tuple[float, ...], tuple[float, ...]]:
+    """MJCF text of the carrier with every joint, actuator and sensor removed (held in
+    its reference pose), and the body and pose (in that body) where the limb goes."""
+    from robotwright.errors import ConversionWarning
+    from robotwright.generators import MJCFHumanoidGenerator
+    from robotwright.grammar.mount import _compose
+    from robotwright.hrdf.model import HRDF
+
+    robot = HRDF.from_robot_name(carrier.robot)
+    site = next((s for s in robot.sites if s.name == carrier.at), None)
+    if site is not None:
+        body, fpos, fquat = site.body, site.pos, site.quat
+    elif carrier.at in {b.name for b in robot.bodies}:
+        body, fpos, fquat = carrier.at, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
+    else:
+        raise ValueError(f"carrier {carrier.robot!r} has no body or site named {carrier.at!r}")
+    pos, quat = _compose(fpos, fquat, carrier.pos, carrier.quat)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConversionWarning)  # peak velocity has no MJCF field
+        root = MJCFHumanoidGenerator.from_hrdf(robot).generate(add_scene=False)
+    xml = ET.tostring(root, encoding="unicode")
+    spec = mujoco.MjSpec.from_string(xml)
+    for kind in ("sensors", "actuators", "joints"):
+        for item in list(getattr(spec, kind)):
+            spec.delete(item)
+    return spec.to_xml(), body, pos, quat
+
+
+@dataclass
+class Mounted:
+    """A limb on its carrier, compiled: ids of the limb's joints, tool sites and bodies."""
+
+    model: mujoco.MjModel
+    peak: np.ndarray  # (nv,) peak torque per limb DoF, N m or N
+    lo: np.ndarray  # (nv,) joint range lower bounds (rad or m)
+    hi: np.ndarray
+    sites: list[int]  # tool-point site ids, branch order
+    limb_bodies: frozenset[int]
+
+    def is_limb_geom(self, geom: int) -> bool:
+        return int(self.model.geom_bodyid[geom]) in self.limb_bodies
+
+
+def mount(limb: Limb, carrier: Carrier = Carrier()) -> Mounted:
+    """Compile ``limb`` on ``carrier`` (the carrier's joints locked), with one motor per
+    limb joint limited to its peak torque."""
+    xml, body, pos, quat = _carrier_xml(carrier)
+    spec = mujoco.MjSpec.from_string(xml)
+    spec.compiler.degree = False
+    names = limb.add_to(spec, spec.body(body), pos, quat, carrier.prefix, motors=True)
+    for s in limb.sites:
+        b = spec.body(carrier.prefix + s.body)
+        b.add_site(name=carrier.prefix + s.name, pos=s.pos, quat=s.quat, size=(0.008, 0, 0))
+    model = spec.compile()
+    peak = np.array([j.peak_torque for j in limb.joints], dtype=float)
+    rng = limb.joint_ranges()
+    return Mounted(
+        model,
+        peak,
+        rng[:, 0].copy(),
+        rng[:, 1].copy(),
+        [model.site(carrier.prefix + br.site).id for br in limb.branches],
+        frozenset(model.body(n).id for n in names),
+    )
+
+
+def sample_poses(m: Mounted, samples: int, seed: int) -> np.ndarray:
+    """The zero pose (clipped into the ranges) and ``samples`` joint vectors drawn
+    uniformly inside the joint ranges with ``numpy.random.default_rng(seed)``."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(m.lo, m.hi, size=(samples, len(m.lo)))
+    return np.vstack([np.clip(np.zeros(len(m.lo)), m.lo, m.hi), q])
+
+
+def contacts(m: Mounted, data: mujoco.MjData) -> list[tuple[str, str, bool]]:
+    """Contacts involving the limb at the current state: (geom, geom, with carrier)."""
+    out = []
+    for c in data.contact[: data.ncon]:
+        a, b = int(c.geom1), int(c.geom2)
+        la, lb = m.is_limb_geom(a), m.is_limb_geom(b)
+        if la or lb:
+            out.append((m.model.geom(a).name, m.model.geom(b).name, not (la and lb)))
+    return out
+
+
+def carrier_collisions(m: Mounted, q: np.ndarray) -> list[tuple[int, str, str]]:
+    """(pose index, limb geom, carrier geom) for every pose of ``q`` where the limb
+    touches a geom of the carrier (MuJoCo collision detection, zero margin)."""
+    data = mujoco.MjData(m.model)
+    out = []
+    for k, qk in enumerate(q):
+        data.qpos[:] = qk
+        mujoco.mj_kinematics(m.model, data)
+        mujoco.mj_collision(m.model, data)
+        for a, b, with_carrier in contacts(m, data):
+            if with_carrier:
+                out.append((k, a, b))
+    return out
+
+
+@dataclass(frozen=True)
+class PayloadResult:
+    """Payload (kg), the worst pose, and per-pose limits (kg; ``inf`` where no joint
+    limits it)."""
+
+    mass: float
+    worst: int
+    poses: np.ndarray
+    per_pose: np.ndarray
+
+
+def holding_torques(m: Mounted, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Joint torques (N m / N) that hold pose ``q`` still: ``tau0`` for the limb alone
+    (``mj_inverse`` at zero velocity and acceleration, contacts and other constraints
+    off) and ``per_kg``, the extra torque per kilogram hung at each tool point
+    (``J^T (-g)`` summed over the tool sites). Holding ``M`` kg needs
+    ``tau0 + M * per_kg``: torque is linear in the payload mass at a fixed pose."""
+    model, data = m.model, mujoco.MjData(m.model)
+    flags = model.opt.disableflags
+    model.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    try:
+        data.qpos[:] = q
+        mujoco.mj_inverse(model, data)
+        tau0 = data.qfrc_inverse.copy()
+    finally:
+        model.opt.disableflags = flags
+    jac = np.zeros((3, model.nv))
+    per_kg = np.zeros(model.nv)
+    for s in m.sites:
+        mujoco.mj_jacSite(model, data, jac, None, s)
+        per_kg += jac.T @ (-model.opt.gravity)
+    return tau0, per_kg
+
+
+def payload(
+    limb: Limb,
+    carrier: Carrier = Carrier(),
+    *,
+    samples: int = 32,
+    seed: int = 0,
+    limit: float = 100.0,
+    mounted: Mounted | None = None,
+) -> PayloadResult:
+    """Largest mass (kg) hung at every tool point that the limb holds at each of the
+    zero pose and ``samples`` seeded random poses, every joint within its peak torque.
+
+    Per pose the holding torque is ``tau0 + M * per_kg`` (:func:`holding_torques`), so
+    the largest ``M`` with ``|tau_i| <= peak_i`` for all joints is found in closed form;
+    the payload is the smallest over the poses, 0 when the limb cannot hold itself at
+    some pose, and at most ``limit`` kg (a limb without joints holds anything: the
+    carrier carries it). Poses where the limb touches itself or the carrier are not
+    reachable and are skipped; when every pose is, the payload is 0.
+    """
+    m = mounted or mount(limb, carrier)
+    poses = sample_poses(m, samples, seed)
+    data = mujoco.MjData(m.model)
+    keep = []
+    for k, qk in enumerate(poses):
+        data.qpos[:] = qk
+        mujoco.mj_kinematics(m.model, data)
+        mujoco.mj_collision(m.model, data)
+        if not contacts(m, data):
+            keep.append(k)
+    poses = poses[keep]
+    if len(poses) == 0:
+        return PayloadResult(0.0, -1, poses, np.zeros(0))
+    per_pose = np.empty(len(poses))
+    for k, qk in enumerate(poses):
+        tau0, a = holding_torques(m, qk)
+        per_pose[k] = _max_mass(tau0, a, m.peak)
+    worst = int(np.argmin(per_pose))
+    return PayloadResult(float(min(per_pose[worst], limit)), worst, poses, per_pose)
+
+
+def _max_mass(tau0: np.ndarray, a: np.ndarray, peak: np.ndarray) -> float:
+    """Largest ``M >= 0`` with ``|tau0 + M a| <= peak`` for every entry (0 when
+    ``|tau0| > peak`` somewhere; ``inf`` when nothing bounds it)."""
+    if np.any(np.abs(tau0) > peak):
+        return 0.0
+    best = math.inf
+    for t, s, p in zip(tau0, a, peak):
+        if s > 1e-12:
+            best = min(best, (p - t) / s)
+        elif s < -1e-12:
+            best = min(best, (-p - t) / s)
+    return max(best, 0.0)
+
+
+def _smooth(s: np.ndarray) -> np.ndarray:
+    """Minimum-jerk time scaling 0 -> 1 (zero velocity and acceleration at both ends)."""
+    return s**3 * (10 - 15 * s + 6 * s**2)
+
+
+def reference_path(center: np.ndarray, radius: float, duration: float, n: int) -> np.ndarray:
+    """``n`` points (m) of the reference over ``duration`` s: a full circle of ``radius``
+    about ``center`` in the carrier's y-z plane (a vertical plane facing along x) in the
+    first half, then a straight line along y through the centre, from ``+radius`` to
+    ``-radius``, in the second; both start and stop at rest (minimum-jerk timing)."""
+    t = np.linspace(0.0, duration, n)
+    half = duration / 2
+    out = np.empty((n, 3))
+    first = t <= half
+    ang = 2 * np.pi * _smooth(np.clip(t / half, 0, 1))
+    out[first] = (
+        center + radius * np.stack([np.zeros_like(ang), np.cos(ang), np.sin(ang)], axis=1)[first]
+    )
+    s = _smooth(np.clip((t - half) / half, 0, 1))
+    line = center + radius * np.stack([np.zeros_like(s), 1 - 2 * s, np.zeros_like(s)], axis=1)
+    out[~first] = line[~first]
+    return out
+
+
+def ik_path(
+    m: Mounted,
+    targets: np.ndarray,
+    q0: np.ndarray,
+    iters: int = 10,
+    damping: float = 0.01,
+    max_step: float = 0.02,
+) -> np.ndarray:
+    """Joint vectors following ``targets`` (m) with the first tool point, by damped least
+    squares (``dq = J^T (J J^T + damping^2 I)^-1 e``, ``damping`` in m, the error ``e``
+    shortened to at most ``max_step`` m per iteration so the solution moves
+    continuously), warm-started from the previous point (``q0`` first; the first point
+    gets ten times the iterations) and clipped to the joint ranges."""
+    model, data = m.model, mujoco.MjData(m.model)
+    site = m.sites[0]
+    jac = np.zeros((3, model.nv))
+    q = np.clip(np.asarray(q0, dtype=float), m.lo, m.hi)
+    out = np.empty((len(targets), model.nv))
+    eye = damping**2 * np.eye(3)
+    for k, target in enumerate(targets):
+        for _ in range(iters * (10 if k == 0 else 1)):
+            data.qpos[:] = q
+            mujoco.mj_kinematics(model, data)
+            err = target - data.site_xpos[site]
+            norm = float(np.sqrt(err @ err))
+            if norm < 1e-7:
+                break
+            if norm > max_step:
+                err *= max_step / norm
+            mujoco.mj_comPos(model, data)
+            mujoco.mj_jacSite(model, data, jac, None, site)
+            q = np.clip(q + jac.T @ np.linalg.solve(jac @ jac.T + eye, err), m.lo, m.hi)
+        out[k] = q
+    return out
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """A tracking run: RMS tool-point error (m), mean mechanical power (W), and the
+    reference and actual tool paths (m, world = carrier frame) sampled every step."""
+
+    error: float
+    power: float
+    reference: np.ndarray
+    path: np.ndarray
+    dt: float
+
+
+def track(
+    limb: Limb,
+    carrier: Carrier = Carrier(),
+    *,
+    duration: float = 2.0,
+    scale: float = 0.15,
+    omega: float = 30.0,
+    reach: float | None = None,
+    mounted: Mounted | None = None,
+) -> TrackResult:
+    """Follow the reference of :func:`reference_path` with the first tool point.
+
+    Reference: centred on the tool point at the limb's display pose (revolute joints at
+    +-0.5 rad, prismatic at mid-stroke), radius ``scale`` times the limb's reach (the
+    largest tool-point distance from the base over 256 seeded poses, or ``reach`` m).
+    Joint reference: damped-least-squares IK at 100 Hz, interpolated to each step.
+    Controller (every 0.002 s step of the carrier model): ``tau = M(q) (qdd_ref + kp e +
+    kd de) + bias(q, dq)`` with ``kp = omega^2``, ``kd = 2 omega`` (a PD law scaled by
+    the inertia, plus gravity and velocity-bias compensation), clipped by MuJoCo to
+    +-peak torque. Contacts are off (collisions are the constraints' job); joint limits
+    stay on. The limb starts at rest on the reference.
+
+    Returns:
+        RMS distance (m) between tool point and reference over the run, and the mean
+        over steps of ``sum |tau_i * dq_i|`` (W; N m rad/s or N m/s).
+    """
+    m = mounted or mount(limb, carrier)
+    model = m.model
+    dt = float(model.opt.timestep)
+    steps = max(1, int(round(duration / dt)))
+    data = mujoco.MjData(model)
+    qn = display_pose(limb) if limb.joints else np.zeros(0)
+    data.qpos[:] = qn
+    mujoco.mj_kinematics(model, data)
+    center = data.site_xpos[m.sites[0]].copy()
+    if reach is None:
+        reach = _reach(limb)
+    ref = reference_path(center, scale * reach, duration, steps + 1)
+    nv = model.nv
+    if nv == 0:
+        path = np.repeat(center[None], steps + 1, axis=0)
+        err = np.linalg.norm(path - ref, axis=1)
+        return TrackResult(float(np.sqrt(np.mean(err**2))), 0.0, ref, path, dt)
+    coarse = max(2, int(round(duration * 100)) + 1)
+    tc = np.linspace(0.0, duration, coarse)
+    qc = ik_path(m, reference_path(center, scale * reach, duration, coarse), qn)
+    t = np.linspace(0.0, duration, steps + 1)
+    qr = np.stack([np.interp(t, tc, qc[:, i]) for i in range(nv)], axis=1)
+    vr = np.gradient(qr, dt, axis=0)
+    ar = np.gradient(vr, dt, axis=0)
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    try:
+        data = mujoco.MjData(model)
+        data.qpos[:] = qr[0]
+        mujoco.mj_forward(model, data)
+        path = np.empty((steps + 1, 3))
+        path[0] = data.site_xpos[m.sites[0]]
+        mv = np.zeros(nv)
+        power = 0.0
+        kp, kd = omega**2, 2 * omega
+        for k in range(steps):
+            mujoco.mj_step1(model, data)
+            e = qr[k] - data.qpos
+            de = vr[k] - data.qvel
+            mujoco.mj_mulM(model, data, mv, ar[k] + kp * e + kd * de)
+            data.ctrl[:] = mv + data.qfrc_bias
+            mujoco.mj_step2(model, data)
+            # the force MuJoCo applied (after clipping) times the velocity it produced
+            power += float(np.abs(data.qfrc_actuator * data.qvel).sum())
+            path[k + 1] = data.site_xpos[m.sites[0]]
+    finally:
+        model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    mujoco.mj_kinematics(model, data)
+    path[-1] = data.site_xpos[m.sites[0]]
+    err = np.linalg.norm(path - ref, axis=1)
+    return TrackResult(float(np.sqrt(np.mean(err**2))), power / steps, ref, path, dt)
+
+
+def display_pose(limb: Limb, angle: float = 0.5) -> np.ndarray:
+    """The pose the pictures show: hinges at +-``angle`` rad (alternating, within
+    limits), slides at mid-stroke (the same rule as :func:`grammar.draw.display_pose`,
+    without importing matplotlib)."""
+    q = []
+    for i, j in enumerate(limb.joints):
+        lo, hi = j.range
+        v = angle * (-1) ** i if j.type == "hinge" else (lo + hi) / 2
+        q.append(min(max(v, lo), hi))
+    return np.array(q, dtype=float)
+
+
+def _reach(limb: Limb, samples: int = 256, seed: int = 0) -> float:
+    """Largest tool-point distance (m) from the limb's base over seeded poses."""
+    rng = np.random.default_rng(seed)
+    names = [j.name for j in limb.joints]
+    lo, hi = limb.joint_ranges().T if limb.joints else (np.zeros(0), np.zeros(0))
+    q = np.vstack(
+        [np.clip(np.zeros(len(names)), lo, hi), rng.uniform(lo, hi, (samples, len(names)))]
+    )
+    best = 0.0
+    for br in limb.branches:
+        cols = [names.index(n) for n in br.joints]
+        pts = br.tool_pose(q[:, cols])[..., :3, 3]
+        best = max(best, float(np.linalg.norm(pts, axis=1).max()))
+    return best
