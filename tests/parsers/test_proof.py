@@ -302,6 +302,23 @@ def test_range_of_an_unlimited_tendon_is_noted(tmp_path: Path) -> None:
     assert not [m for m in messages if "proof:" in m], messages
 
 
+def test_range_of_an_unlimited_joint_is_noted(tmp_path: Path) -> None:
+    xml = PLAIN.replace(
+        'range="-1 1" damping="0.5"', 'limited="false" range="-1.5 1.5" damping="0.5"'
+    )
+    messages = convert(_write(tmp_path, xml), tmp_path / "out")
+    noted = [m for m in messages if "unlimited joint" in m]
+    assert len(noted) == 1 and '"shoulder"' in noted[0] and "-1.5" in noted[0], messages
+    assert not [m for m in messages if "proof:" in m], messages
+    # What MuJoCo simulates is the same: the joint is unlimited on both sides.
+    from robotwright.parsers.roundtrip import our_mjcf_model
+
+    out = our_mjcf_model(HRDF.from_dir(tmp_path / "out"))
+    assert not out.jnt_limited[out.joint("shoulder").id]
+    # A limited joint's range is kept, without that note.
+    assert not [m for m in convert(_write(tmp_path, PLAIN), tmp_path / "o2") if "unlimited" in m]
+
+
 # -- real robots ------------------------------------------------------------------------------
 TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"
 CORPORA = {
@@ -311,10 +328,7 @@ CORPORA = {
     "pybullet": TESTDATA / "pybullet" / "pybullet_data",
 }
 #: "corpus/path" -> why the proof finds a difference no note reports (a fault to fix).
-KNOWN = {
-    "pybullet/mjcf/inverted_pendulum.xml": "the range of an unlimited joint is dropped "
-    "without a note (MuJoCo ignores it)",
-}
+KNOWN: dict[str, str] = {}
 
 
 def _corpus_params() -> list:
@@ -406,7 +420,9 @@ def test_urdf_source_matches_mujocos_import(tmp_path: Path, out: str) -> None:
     src = _write(tmp_path, URDF, "u.urdf")
     reference = proof.source_model(src, "urdf", {})
     assert reference is not None
-    hrdf, _ = __import__("robotwright.parsers.convert", fromlist=["load_any"]).load_any(src)
+    from robotwright.parsers.convert import load_any
+
+    hrdf, _ = load_any(src)
     ours, _ = proof.result_model(hrdf, "mjcf", None, discard_visual=True)
     # MuJoCo's import orders the rotated inertia's principal axes its own way.
     assert not np.allclose(reference.body("base").inertia, ours.body("base").inertia)

@@ -497,6 +497,13 @@ def _joints(
             # The free joint too: our MJCF and URDF then name it alike (URDF needs a name).
             name = joint_name(model, j)
             rep.warn(f"unnamed joint named '{name}'", where)
+        if jt != "free" and not model.jnt_limited[j] and np.any(model.jnt_range[j]):
+            # MuJoCo ignores the range of an unlimited joint: harmless, but said.
+            rep.warn(
+                f"range {model.jnt_range[j].tolist()} of an unlimited joint dropped "
+                "(MuJoCo ignores it)",
+                where,
+            )
         dof = int(model.jnt_dofadr[j])
         qadr = int(model.jnt_qposadr[j])
         for attr, field_name, per_dof in _JOINT_UNHELD:
