@@ -12,6 +12,7 @@ import importlib
 import platform
 import sys
 from collections.abc import Iterator, Sequence
+from contextlib import nullcontext
 from typing import Any
 
 from robotwright import __version__
@@ -20,10 +21,12 @@ from robotwright._limits import keyframe_limit
 from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, collect_notes, summary_line
 from robotwright._npz import npz_limit
+from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
 from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
 from robotwright.parsers.packages import given_packages
+from robotwright.sources import given_source_options, source_options
 
 # Modules that expose ``register(subparsers: argparse._SubParsersAction) -> None``.
 _COMMAND_MODULES: tuple[str, ...] = (
@@ -36,6 +39,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.things.cli",
     "robotwright.view.cli",
     "robotwright.render.cli",
+    "robotwright.catalog_cli",
 )
 
 #: Commands that read robots from files: they take ``--asset-root DIR`` (see
@@ -53,13 +57,15 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "lidar",
 )
 
-#: Commands that read URDF/xacro files: they take ``--package NAME=DIR`` (see
-#: :mod:`robotwright.parsers.packages`).
-_PACKAGE_COMMANDS: tuple[str, ...] = ("convert", "roundtrip", "view", "render")
+#: Commands that read URDF/xacro files (every command that reads a robot: any takes a
+#: URDF): they take ``--package NAME=DIR`` (see :mod:`robotwright.parsers.packages`)
+#: and the robot-source options (see :mod:`robotwright.sources`).
+_PACKAGE_COMMANDS: tuple[str, ...] = _ASSET_COMMANDS
 
-#: Commands that copy mesh (and asset) files into their output: they take
-#: ``--max-mesh-mb MB`` (see :func:`robotwright._atomic.mesh_size_limit`).
-_MESH_COPY_COMMANDS: tuple[str, ...] = ("export", "compose", "convert", "things")
+#: Every command that reads a robot takes ``--max-mesh-mb MB``: the largest mesh, height
+#: field or texture file a model may make MuJoCo read, or copy into an output (see
+#: :func:`robotwright._atomic.mesh_size_limit` and :mod:`robotwright._assets`).
+_MESH_COMMANDS: tuple[str, ...] = _ASSET_COMMANDS
 
 #: Commands that read scan ``.npz`` files: they take ``--max-scan-mb MB`` (see
 #: :func:`robotwright._npz.npz_limit`).
@@ -141,7 +147,10 @@ def build_parser() -> argparse.ArgumentParser:
             help="trust folder DIR: mesh/asset paths of the input may point into it "
             "(by default they must stay inside the robot's own folder); repeatable",
         )
+    from robotwright.sources import add_source_options
+
     for name in _PACKAGE_COMMANDS:
+        add_source_options(sub.choices[name])
         sub.choices[name].add_argument(
             "--package",
             action="append",
@@ -152,14 +161,15 @@ def build_parser() -> argparse.ArgumentParser:
             help="URDF/xacro: package://NAME/... and $(find NAME) name folder DIR (by default "
             "only packages inside the robot's own folder or ROS package are found); repeatable",
         )
-    for name in _MESH_COPY_COMMANDS:
+    for name in _MESH_COMMANDS:
         sub.choices[name].add_argument(
             "--max-mesh-mb",
             type=_positive_mb,
             default=None,
             metavar="MB",
-            help="largest mesh or asset file copied into the output, in MB (default 512): "
-            "a larger one is refused",
+            help="largest mesh, height field or texture a model may read or copy into an "
+            "output, in MB (default 512; counted as the file's size, or the data a height "
+            "field or image declares): a larger one is refused before it is read",
         )
     for name in _ASSET_COMMANDS:
         sub.choices[name].add_argument(
@@ -251,8 +261,20 @@ def _run(args: argparse.Namespace) -> int:
         packages = given_packages(dict(getattr(args, "packages", None) or []))
         limit = mesh_size_limit(getattr(args, "max_mesh_mb", None))
         scans = npz_limit(getattr(args, "max_scan_mb", None))
+        # Files copied next to a file output replace others only with --overwrite.
+        copies = copies_replace(args.overwrite) if "overwrite" in args else nullcontext()
         keys = keyframe_limit(getattr(args, "max_keyframes", None))
-        with trusted_asset_roots(roots), packages, limit, scans, keys, collect_notes() as caught:
+        sources = given_source_options(source_options(args))
+        with (
+            trusted_asset_roots(roots),
+            packages,
+            limit,
+            scans,
+            keys,
+            sources,
+            copies,
+            collect_notes() as caught,
+        ):
             code = int(args.func(args) or 0)
         # Commands that only show a model (view, render) write no conversion: the notes
         # of loading it say nothing about the picture, so they are listed with -v only.

@@ -11,17 +11,17 @@ from robotwright.generators.composite_urdf import URDFGeneratorComposite
 from robotwright.generators.mjcf import MJCFHumanoidGenerator
 from robotwright.generators.placement import Placement
 from robotwright.generators.urdf import URDFHumanoidGenerator
-from robotwright.hrdf.assets import resolve_robot
 from robotwright.hrdf.model import HRDF
 
 RobotRef = str | Path | HRDF
 
 
 def load_robot(robot: RobotRef) -> HRDF:
-    """An HRDF from a robot name, an HRDF folder path, or an HRDF object (returned as is)."""
-    if isinstance(robot, HRDF):
-        return robot
-    return HRDF.from_dir(resolve_robot(robot))
+    """An HRDF from a robot name, an HRDF folder, a URDF, xacro or MJCF file (see
+    :func:`robotwright.sources.load_robot`), or an HRDF object (returned as is)."""
+    from robotwright.sources import load_robot as load_source
+
+    return load_source(robot)
 
 
 def export_robot(

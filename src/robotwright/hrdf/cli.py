@@ -13,28 +13,31 @@ if TYPE_CHECKING:  # the readers load when a command runs, not with `robotwright
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "validate",
-        help="check an HRDF folder and report every problem",
-        description="Check an HRDF folder; print every problem (file, row, column, what "
-        "was expected); exit 1 when any is an error.",
+        help="check a robot and report every problem",
+        description="Check a robot (HRDF folder, URDF, xacro or MJCF file, or a robot name); "
+        "print every problem (file, row or element, column, what was expected); exit 1 "
+        "when any is an error. A URDF or MJCF is checked as read into HRDF, with the same "
+        "checks and MuJoCo compile as a folder.",
     )
-    p.add_argument("path", help="HRDF folder or robot name")
+    p.add_argument("path", help="robot name, HRDF folder, or URDF, xacro or MJCF file")
     p.set_defaults(func=_validate)
 
     p = sub.add_parser(
         "info",
         help="summarise a robot (bodies, joints, actuators, mass, DoF)",
-        description="Print a readable summary of a robot given by HRDF folder or name.",
+        description="Print a readable summary of a robot given by name, HRDF folder, or "
+        "URDF, xacro or MJCF file.",
     )
-    p.add_argument("robot", help="HRDF folder or robot name")
+    p.add_argument("robot", help="robot name, HRDF folder, or URDF, xacro or MJCF file")
     p.set_defaults(func=_info)
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from robotwright.hrdf.assets import resolve_robot
-    from robotwright.hrdf.validate import validate_dir
+    from robotwright.sources import resolve_source
 
-    path = resolve_robot(args.path)
-    problems = validate_dir(path)
+    resolved = resolve_source(args.path)
+    path = resolved.path
+    problems = _problems(str(path) if resolved.entry is None else args.path, resolved.kind)
     errors = [p for p in problems if p.severity == "error"]
     for p in problems:
         print(f"{p.severity}: {p}")
@@ -43,6 +46,27 @@ def _validate(args: argparse.Namespace) -> int:
         return 1
     print(f"{path}: valid ({len(problems)} warning(s))")
     return 0
+
+
+def _problems(source: str, kind: str) -> list:
+    """Every problem of a robot: an HRDF folder as read and compiled; a URDF or MJCF as
+    read into HRDF (a refusal of the reader is its problems), then the same checks."""
+    from robotwright.errors import ProblemsError
+    from robotwright.hrdf.validate import check_model, validate_dir
+    from robotwright.sources import load_robot, resolve_source
+
+    if kind == "hrdf":
+        return validate_dir(resolve_source(source).path)
+    from robotwright.hrdf.compiles import check_compiles
+
+    try:
+        hrdf = load_robot(source)
+    except ProblemsError as exc:
+        return list(exc.problems)
+    problems = check_model(hrdf, check_files=True)
+    if not any(p.severity == "error" for p in problems):
+        problems += check_compiles(hrdf)
+    return problems
 
 
 def _table(headers: list[str], rows: list[list[str]]) -> str:
@@ -123,12 +147,11 @@ def format_info(hrdf: HRDF) -> str:
 
 
 def _info(args: argparse.Namespace) -> int:
-    from robotwright.hrdf.assets import resolve_robot
     from robotwright.hrdf.io import HRDFWarning
-    from robotwright.hrdf.model import HRDF
+    from robotwright.sources import load_robot_with_notes
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HRDFWarning)
-        hrdf = HRDF.from_dir(resolve_robot(args.robot))
+        hrdf, _ = load_robot_with_notes(args.robot)  # a summary: what was not kept is not
     print(format_info(hrdf))
     return 0

@@ -266,10 +266,10 @@ def _convert(args: argparse.Namespace) -> int:
     check_overwrite(args.output, args.overwrite, kind="hrdf" if folder else None)
     source = Path(args.src)
     if not source.exists() and source.suffix.lower() not in (".urdf", ".xml", ".xacro"):
-        # Not a file: a robot name (bundled or under $HURODES_ASSETS_PATH), as export takes.
-        from robotwright.hrdf.assets import resolve_robot
+        # Not a file: a robot name (see robotwright.sources), as every command takes.
+        from robotwright.sources import resolve_source
 
-        source = resolve_robot(args.src)
+        source = resolve_source(args.src).path
     # An existing empty folder holds nothing to lose: the rule lets it be written into.
     overwrite = args.overwrite or Path(args.output).is_dir()
     messages = convert(
@@ -285,10 +285,12 @@ def _convert(args: argparse.Namespace) -> int:
 @_quiet_parser_log
 def _roundtrip(args: argparse.Namespace) -> int:
     from robotwright.parsers.roundtrip import roundtrip
+    from robotwright.sources import resolve_source
 
-    report = roundtrip(
-        args.source, configs=args.configs, reference=args.reference, **_options(args)
-    )
+    source = Path(args.source)
+    if not source.exists() and source.suffix.lower() not in (".urdf", ".xml", ".xacro"):
+        source = resolve_source(args.source).path  # a robot name
+    report = roundtrip(source, configs=args.configs, reference=args.reference, **_options(args))
     if report.input_error is not None:
         raise report.input_error  # bad input: exit 2 on stderr, no table
     print(report.table())

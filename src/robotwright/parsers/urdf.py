@@ -728,8 +728,11 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     order, roots = tree.order, tree.roots
     data = {n: reader.link_data(links[n]) for n in order}
     if reader.unresolved:
+        from robotwright.parsers.unresolved import group_unresolved
+
         raise ConversionError(
-            reader.unresolved, summary=f"{len(reader.unresolved)} mesh(es) of {path} not resolved"
+            group_unresolved(reader.unresolved),
+            summary=f"{len(reader.unresolved)} mesh(es) of {path} not resolved",
         )
 
     # A massless, geometry-free root link (usually "world") only anchors the robot: its

@@ -53,6 +53,8 @@ def render(
             title=title,
         )
     picture = render_model(loaded.model, data, options)
+    # How the drawing differs from the robot (physics replaced to show it) comes first.
+    picture.notes[:0] = loaded.warnings
     if output is not None:
         save_png(picture, Path(output), title=title)
     return picture

@@ -40,6 +40,8 @@ class LoadedModel:
             pose, and the pose ``robotwright lidar`` scans in), else ``qpos0``.
         scan: the scan's hit points, for a scan source.
         notes: what the readers reported (conversion notes), one message each.
+        warnings: how the model drawn differs from the robot (physics replaced to
+            show a robot whose masses or inertias are refused), one line each.
     """
 
     model: mujoco.MjModel
@@ -48,6 +50,7 @@ class LoadedModel:
     qpos: np.ndarray
     scan: ScanCloud | None = None
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
     def initial_data(self) -> mujoco.MjData:
         """A state in :attr:`qpos` with forward kinematics done."""
@@ -81,4 +84,5 @@ def load_model(
         loaded.initial_qpos(),
         loaded.scan,
         list(loaded.notes),
+        list(loaded.warnings),
     )

@@ -27,7 +27,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "distances [m], world-frame points [m], semantic labels and hit geom ids."
         ),
     )
-    p.add_argument("scene", type=Path, help="MJCF file of the scene")
+    p.add_argument(
+        "scene",
+        type=Path,
+        help="MJCF file of the scene, or any robot: name, HRDF folder, URDF or xacro file",
+    )
     p.add_argument("--sensor", required=True, help="name of the body or site carrying the sensor")
     p.add_argument(
         "--pattern", default="mid360", choices=PATTERN_NAMES, help="scan pattern (default mid360)"
@@ -120,8 +124,8 @@ def load_scene(path: Path) -> mujoco.MjModel:
         return checked_mjcf_spec(path).compile()
     except ConversionError as exc:
         raise SensorError(f"{path}: {exc.problems[0].message}") from None
-    except UnsafePathError:
-        raise
+    except (UnsafePathError, InputFileError):
+        raise  # refused before MuJoCo read a file: not MuJoCo's words
     except ValueError as exc:  # MuJoCo reports parse and compile errors as ValueError
         raise SensorError(f"{path}: MuJoCo cannot load the scene: {exc}") from None
 
@@ -133,7 +137,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.output is None and args.png is None:
         raise SensorError("nothing to write: give -o SCAN.npz and/or --png SCAN.png")
-    if not args.scene.exists():
+    scene_file = args.scene.suffix.lower() in (".xml", ".mjcf")
+    if scene_file and not args.scene.exists():
         raise SensorError(f"{args.scene}: scene file not found")
     if args.view_radius is not None and not args.view_radius > 0:
         raise SensorError(
@@ -149,7 +154,14 @@ def run(args: argparse.Namespace) -> int:
                 raise SensorError(f"{out}: folder {out.parent} does not exist")
     check_overwrite([args.output, args.png], args.overwrite)
     mapping = None if args.mapping is None else read_mapping(args.mapping)
-    model = load_scene(args.scene)
+    from robotwright.sources import wants_parse
+
+    if scene_file and not wants_parse():
+        model = load_scene(args.scene)
+    else:  # a robot by name, HRDF folder, URDF or xacro: as view and render show it
+        from robotwright.view.scene import load_source
+
+        model = load_source(str(args.scene)).model
     data = mujoco.MjData(model)
     if model.nkey:
         mujoco.mj_resetDataKeyframe(model, data, 0)

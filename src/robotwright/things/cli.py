@@ -11,14 +11,15 @@ from robotwright._outputs import add_overwrite_flag, check_overwrite
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "things",
-        help="read an MJCF or HRDF robot into Things and write MJCF or HRDF",
-        description="Read a robot (MJCF file or HRDF folder) into the Things object model "
+        help="read a robot into Things and write MJCF or HRDF",
+        description="Read a robot (robot name, HRDF folder, URDF, xacro or MJCF file) into "
+        "the Things object model "
         "and write it as a self-contained MJCF (defaults resolved, radians, meshes copied "
         "next to it) or as an HRDF folder. Anything that cannot be represented is named in "
         "a warning (an error with --strict).",
     )
     p.add_argument(
-        "source", help="MJCF file (.xml), HRDF folder or bundled robot name (arm6, mini_humanoid)"
+        "source", help="robot name, HRDF folder, or URDF (.urdf), xacro or MJCF (.xml) file"
     )
     p.add_argument("output", help="output .xml file (MJCF) or folder (HRDF)")
     p.add_argument(
@@ -31,8 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     from robotwright._atomic import check_output_path
     from robotwright.errors import OutputPathError
-    from robotwright.hrdf import HRDF
-    from robotwright.hrdf.assets import resolve_robot
+    from robotwright.sources import load_robot, resolve_source, wants_parse
     from robotwright.things import World, hrdf_to_world, things_to_hrdf
 
     source, output = Path(args.source), Path(args.output)
@@ -43,10 +43,12 @@ def _run(args: argparse.Namespace) -> int:
         )
     check_output_path(output, folder=not to_xml)
     check_overwrite(output, args.overwrite, kind=None if to_xml else "hrdf")
-    if source.is_file() or source.suffix.lower() == ".xml":
-        world = World.from_xml_path(source, strict=args.strict)
-    else:  # an HRDF folder, or a robot name (bundled or under $HURODES_ASSETS_PATH)
-        world = hrdf_to_world(HRDF.from_dir(resolve_robot(args.source)), strict=args.strict)
+    resolved = resolve_source(args.source)
+    if resolved.kind == "mjcf" and not wants_parse():
+        # Things read MJCF themselves: every element they model is kept.
+        world = World.from_xml_path(resolved.path, strict=args.strict)
+    else:  # a robot name, an HRDF folder, a URDF or xacro: through HRDF
+        world = hrdf_to_world(load_robot(args.source, strict=args.strict), strict=args.strict)
     if to_xml:
         written = world.export(output)
     else:

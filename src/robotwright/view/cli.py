@@ -107,6 +107,8 @@ def _run(args: argparse.Namespace) -> int:
     scene = load_source(args.source, scene=args.scene)
     # The page runs until Ctrl-C, so what the loaders could not carry is told now, in
     # the command line's usual form, rather than when the command ends.
+    for line in scene.warnings:  # the model shown differs from the robot: always said
+        print(f"warning: {line}", file=sys.stderr)
     notes = [n for message in scene.notes for n in notes_of(message)]
     if notes and getattr(args, "verbose", False):
         for n in notes:

@@ -27,7 +27,7 @@ import os
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -86,6 +86,8 @@ class ViewScene:
         source: the source as given, for messages.
         scan: the scan's points, for a scan source.
         notes: what the loaders reported (conversion warnings), one line each.
+        warnings: how the model shown differs from the robot (physics MuJoCo or the
+            generators refuse, replaced to show its geometry), one line each.
     """
 
     model: mujoco.MjModel
@@ -94,6 +96,7 @@ class ViewScene:
     source: str
     scan: ScanCloud | None = None
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
     def initial_qpos(self) -> np.ndarray:
         """The pose shown first: keyframe 0 when the model has one (the pose
@@ -127,8 +130,8 @@ def load_source(
         return ViewScene(source, "model", "model", "<MjModel>")
     if isinstance(source, HRDF):
         _no_scene(scene, "a robot")
-        model, notes = _hrdf_model(source)
-        return ViewScene(model, source.name, "robot", source.name, notes=notes)
+        model, notes, shown = _hrdf_model(source)
+        return ViewScene(model, source.name, "robot", source.name, notes=notes, warnings=shown)
     text = os.fspath(source)
     path = Path(text)
     suffix = path.suffix.lower()
@@ -137,11 +140,7 @@ def load_source(
     _no_scene(scene, f"'{text}'")
     if path.is_dir() and (path / "design.txt").is_file():
         return _design_scene(path, asset_roots)
-    if path.is_file() and suffix in (".xml", ".mjcf"):
-        return ViewScene(_compile_mjcf(path, asset_roots), path.stem, "mjcf", text)
-    if path.is_file() and suffix in (".urdf", ".xacro"):
-        return _urdf_scene(path, asset_roots)
-    if path.is_file():
+    if path.is_file() and suffix not in (".xml", ".mjcf", ".urdf", ".xacro"):
         raise ViewError(
             f"{path}: cannot show a '{suffix or 'extensionless'}' file; expected an MJCF "
             "(.xml), a URDF (.urdf) or xacro (.xacro) file, a scan (.npz), an HRDF or design "
@@ -157,15 +156,26 @@ def _no_scene(scene: SourceLike | None, what: str) -> None:
         raise ViewError(f"scene={os.fspath(scene)!r} applies to a scan (.npz), not to {what}")
 
 
-def _hrdf_model(hrdf: HRDF) -> tuple[mujoco.MjModel, list[str]]:
-    """Compile a robot through the MJCF generator; its conversion notes are kept."""
-    from robotwright.errors import ConversionWarning, RobotwrightError
+def _hrdf_model(hrdf: HRDF) -> tuple[mujoco.MjModel, list[str], list[str]]:
+    """Compile a robot through the MJCF generator; returns the model, its conversion
+    notes, and how the model differs from the robot: a robot whose masses or inertias
+    the generators refuse is shown with those replaced (see
+    :func:`robotwright.view.physics.for_display`), since a picture needs its geometry
+    only."""
+    from robotwright.errors import ConversionWarning, HRDFError, RobotwrightError
     from robotwright.generators import MJCFHumanoidGenerator
+    from robotwright.view.physics import for_display
 
+    shown: list[str] = []
+    try:
+        generator = MJCFHumanoidGenerator.from_hrdf(hrdf)
+    except HRDFError as exc:
+        hrdf, shown = for_display(hrdf, exc)  # raises exc unless physics alone is refused
+        generator = MJCFHumanoidGenerator.from_hrdf(hrdf)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConversionWarning)
         try:
-            model = MJCFHumanoidGenerator.from_hrdf(hrdf).to_model()
+            model = generator.to_model()
         except ValueError as exc:  # MuJoCo refuses the model (a mesh it cannot read, ...)
             if isinstance(exc, RobotwrightError):
                 raise
@@ -180,32 +190,25 @@ def _hrdf_model(hrdf: HRDF) -> tuple[mujoco.MjModel, list[str]]:
             notes.append(str(w.message))
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return model, notes
+    return model, notes, shown
 
 
-def _robot_scene(name_or_dir: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
-    from robotwright.hrdf.assets import resolve_robot
-    from robotwright.hrdf.io import HRDFWarning
-    from robotwright.hrdf.model import HRDF
+def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
+    """A robot by name, HRDF folder, URDF, xacro or MJCF file (see
+    :mod:`robotwright.sources`; the command line's source options apply). An MJCF file
+    is compiled by MuJoCo as it stands unless a source option (``--root-body``) asks
+    for the robot read from it."""
+    from robotwright.sources import load_robot_with_notes, resolve_source, wants_parse
 
-    folder = resolve_robot(name_or_dir)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", HRDFWarning)
-        hrdf = HRDF.from_dir(folder, asset_roots=list(asset_roots) or None)
-    model, notes = _hrdf_model(hrdf)
-    notes = [str(w.message) for w in caught if issubclass(w.category, HRDFWarning)] + notes
-    return ViewScene(model, hrdf.name, "robot", name_or_dir, notes=notes)
-
-
-def _urdf_scene(path: Path, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
-    from robotwright.parsers.api import urdf_to_hrdf_with_warnings
-
-    kwargs: dict[str, Any] = {"asset_roots": tuple(asset_roots)} if asset_roots else {}
-    result = urdf_to_hrdf_with_warnings(path, **kwargs)
-    model, notes = _hrdf_model(result.hrdf)
-    return ViewScene(
-        model, path.stem, "urdf", str(path), notes=[str(w) for w in result.warnings] + notes
-    )
+    resolved = resolve_source(text)
+    if resolved.kind == "mjcf" and not wants_parse():
+        model = _compile_mjcf(resolved.path, asset_roots)
+        return ViewScene(model, resolved.title, "mjcf", text)
+    hrdf, notes = load_robot_with_notes(text, asset_roots=tuple(asset_roots))
+    model, more, shown = _hrdf_model(hrdf)
+    kind = "robot" if resolved.kind == "hrdf" else resolved.kind.replace("xacro", "urdf")
+    title = hrdf.name if resolved.kind == "hrdf" else resolved.title
+    return ViewScene(model, title, kind, text, notes=notes + more, warnings=shown)
 
 
 def _compile_mjcf(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjModel:
@@ -233,8 +236,8 @@ def _compile_mjcf(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjM
         spec = mujoco.MjSpec.from_file(str(path))
         check_mjcf_spec(spec, **where, trusted=trusted)
         return spec.compile()
-    except UnsafePathError:
-        raise
+    except (UnsafePathError, InputFileError):
+        raise  # refused before MuJoCo read a file: not MuJoCo's words
     except ValueError as exc:  # MuJoCo reports parse and compile errors as ValueError
         raise ViewError(f"{path}: MuJoCo cannot load it: {exc}") from None
 
@@ -260,8 +263,10 @@ def _design_scene(folder: Path, asset_roots: tuple[SourceLike, ...]) -> ViewScen
     from robotwright._inputs import MAX_YAML_BYTES, read_text
 
     design = Design.from_text(read_text(design_file, MAX_YAML_BYTES), str(design_file))
-    model, notes = _hrdf_model(build_hrdf(default_grammar(), design))
-    return ViewScene(model, f"{folder.name} (design)", "design", str(folder), notes=notes)
+    model, notes, shown = _hrdf_model(build_hrdf(default_grammar(), design))
+    return ViewScene(
+        model, f"{folder.name} (design)", "design", str(folder), notes=notes, warnings=shown
+    )
 
 
 _SCAN_FIELDS = ("points", "labels", "class_names")

@@ -1,0 +1,362 @@
+"""One robot source for every command: a name, an HRDF folder, a URDF, xacro or MJCF file.
+
+:func:`resolve_source` says what a text names: an existing path is read by its kind
+(a folder with ``meta.yaml`` is HRDF; ``.urdf``, ``.xacro`` / ``.urdf.xacro``, ``.xml`` /
+``.mjcf`` files); anything else is a robot name, looked up in
+:mod:`robotwright.catalog` (``$HURODES_ASSETS_PATH``, bundled robots, installed
+description packages; ``SOURCE:NAME`` picks one source). :func:`load_robot` reads it
+into an :class:`~robotwright.hrdf.model.HRDF` with the project's readers.
+
+The command line adds one option group to every command that reads a robot
+(:func:`add_source_options`: ``--root-body``, ``--fixed-joints``, ``--bound-mass``,
+``--bound-inertia``, ``--inertia-from-geoms``, ``--density``, ``--xacro-arg``; with
+``--asset-root`` and ``--package``, which ``robotwright.cli`` adds) and hands the
+options to the readers for the command's run with :func:`given_source_options`, as
+``--package`` is handed with :func:`robotwright.parsers.packages.given_packages`. An
+option that does not apply to the source's kind (``--bound-mass`` for an MJCF) is an
+error naming it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import warnings
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from robotwright.errors import ConversionWarning, RobotwrightError
+
+if TYPE_CHECKING:
+    from robotwright.catalog import RobotEntry
+    from robotwright.hrdf.model import HRDF
+
+__all__ = [
+    "ResolvedSource",
+    "SourceNotFoundError",
+    "add_source_options",
+    "given_source_options",
+    "load_robot",
+    "load_robot_with_notes",
+    "resolve_source",
+    "source_options",
+]
+
+#: Robot file kinds by extension (``.urdf.xacro`` ends in ``.xacro``).
+FILE_KINDS = {".urdf": "urdf", ".xacro": "xacro", ".xml": "mjcf", ".mjcf": "mjcf"}
+
+#: Options of the shared group, by the source kinds they apply to.
+URDF_OPTIONS = ("fixed_joints", "bound_mass", "bound_inertia", "inertia_from_geoms", "density")
+MJCF_OPTIONS = ("root_body",)
+XACRO_OPTIONS = ("xacro_args",)
+
+_GIVEN: ContextVar[dict[str, Any]] = ContextVar("robotwright_source_options", default={})  # noqa: B039
+
+
+class SourceNotFoundError(RobotwrightError):
+    """A robot source names no file, folder or known robot."""
+
+
+@dataclass(frozen=True)
+class ResolvedSource:
+    """What a source text names.
+
+    Attributes:
+        kind: ``hrdf``, ``urdf``, ``xacro`` or ``mjcf``.
+        path: the HRDF folder or robot file.
+        title: a short name (robot name, folder or file name without extension).
+        entry: the catalog entry when the text was a robot name.
+    """
+
+    kind: str
+    path: Path
+    title: str
+    entry: RobotEntry | None = None
+
+
+def _float_arg(what: str, *, positive: bool) -> Any:
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        ok = value > 0 if positive else value >= 0
+        if not ok or value == float("inf"):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected a finite {what}")
+        return value
+
+    return parse
+
+
+def _xacro_arg(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition(":=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected NAME:=VALUE")
+    return name.strip(), value
+
+
+def add_source_options(p: argparse.ArgumentParser) -> None:
+    """The robot-source options (see the module docstring) on command parser ``p``; an
+    option the command already has (``convert`` and ``roundtrip`` define their own,
+    with the same meaning) is left as it is."""
+    have = set(p._option_string_actions)
+    group = p.add_argument_group("robot source (a name, HRDF folder, URDF, xacro or MJCF file)")
+
+    def add(flag: str, **kw: Any) -> None:
+        if flag not in have:
+            group.add_argument(flag, **kw)
+
+    add(
+        "--root-body",
+        metavar="NAME",
+        help="MJCF: the top-level body that is the robot (when the world holds several)",
+    )
+    add(
+        "--fixed-joints",
+        choices=("keep", "merge", "site"),
+        help="URDF: a link on a fixed joint stays a body (keep, the default), is merged "
+        "into its parent (merge), or becomes a site when massless (site)",
+    )
+    add(
+        "--bound-mass",
+        type=_float_arg("mass >= 0 [kg]", positive=False),
+        metavar="KG",
+        help="URDF: raise masses below KG to KG",
+    )
+    add(
+        "--bound-inertia",
+        type=_float_arg("inertia >= 0 [kg m^2]", positive=False),
+        metavar="KG_M2",
+        help="URDF: raise principal moments below KG_M2 [kg m^2] to it",
+    )
+    add(
+        "--inertia-from-geoms",
+        choices=("auto", "never"),
+        help="URDF: a link without <inertial> gets the mass and inertia of its collision "
+        "geoms (auto, the default) or none (never)",
+    )
+    add(
+        "--density",
+        type=_float_arg("density > 0 [kg/m^3]", positive=True),
+        metavar="KG_M3",
+        help="URDF, --inertia-from-geoms auto: density of those collision geoms (default 1000)",
+    )
+    add(
+        "--xacro-arg",
+        action="append",
+        type=_xacro_arg,
+        metavar="NAME:=VALUE",
+        help=".xacro: value of $(arg NAME) (repeatable)",
+    )
+
+
+def source_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The readers' options given on the command line (only those given)."""
+    opts: dict[str, Any] = {}
+    for name in (*URDF_OPTIONS, *MJCF_OPTIONS):
+        value = getattr(args, name, None)
+        if value is not None:
+            opts[name] = value
+    if getattr(args, "xacro_arg", None):
+        opts["xacro_args"] = dict(args.xacro_arg)
+    return opts
+
+
+@contextmanager
+def given_source_options(options: Mapping[str, Any]) -> Iterator[None]:
+    """Within the block, :func:`load_robot` reads every source with ``options`` (after
+    its own keyword arguments): the options of a command line."""
+    token = _GIVEN.set(dict(options))
+    try:
+        yield
+    finally:
+        _GIVEN.reset(token)
+
+
+def resolve_source(text: str | os.PathLike[str]) -> ResolvedSource:
+    """What ``text`` names (see the module docstring).
+
+    Raises:
+        SourceNotFoundError: no such file, a file of no robot kind, or no such robot.
+    """
+    raw = os.fspath(text)
+    path = Path(raw)
+    suffix = path.suffix.lower()
+    if path.is_dir():
+        if (path / "meta.yaml").is_file():
+            return ResolvedSource("hrdf", path, path.resolve().name)
+        entry = _catalog_entry(raw) if not _looks_like_path(raw) else None
+        if entry is not None:
+            return _from_entry(entry)
+        raise SourceNotFoundError(
+            f"{path}: a folder without meta.yaml: expected an HRDF folder, a URDF, xacro or "
+            "MJCF file, or a robot name ('robotwright robots' lists them)"
+        )
+    if path.exists():
+        kind = FILE_KINDS.get(suffix)
+        if kind is None:
+            raise SourceNotFoundError(
+                f"{path}: a '{suffix or 'extensionless'}' file: expected a URDF (.urdf), "
+                "xacro (.xacro), MJCF (.xml, .mjcf) file, an HRDF folder or a robot name"
+            )
+        return ResolvedSource(kind, path, _stem(path))
+    if suffix in FILE_KINDS or _looks_like_path(raw):
+        raise SourceNotFoundError(f"{path}: no such file or folder")
+    entry = _catalog_entry(raw)
+    if entry is None:
+        from robotwright._suggest import did_you_mean
+        from robotwright.catalog import list_robots
+
+        refs = [e.ref for e in list_robots()]
+        raise SourceNotFoundError(
+            f"no robot named '{raw}' and no such file or folder ('robotwright robots' lists "
+            f"the {len(refs)} robots known by name)" + did_you_mean(raw, refs)
+        )
+    return _from_entry(entry)
+
+
+def _looks_like_path(text: str) -> bool:
+    return text.startswith((".", "~", os.sep)) or (os.altsep is not None and os.altsep in text)
+
+
+def _stem(path: Path) -> str:
+    name = path.name
+    for suffix in (".urdf.xacro", *FILE_KINDS):
+        if name.lower().endswith(suffix):
+            return name[: -len(suffix)]
+    return path.stem
+
+
+def _catalog_entry(text: str) -> RobotEntry | None:
+    from robotwright.catalog import RobotEntry, find_entry
+
+    # $HURODES_ASSETS_PATH and the bundled robots first, without a scan of the
+    # installed packages (nested names, a/b, are found there only).
+    if ":" not in text:
+        from robotwright.hrdf.assets import RobotNotFoundError, find_robot
+
+        try:
+            folder = find_robot(text)
+        except RobotNotFoundError:
+            pass
+        else:
+            return RobotEntry(text, "assets-or-bundled", "hrdf", folder, text)
+    return find_entry(text)
+
+
+def _from_entry(entry: RobotEntry) -> ResolvedSource:
+    title = entry.path.name if entry.format == "hrdf" else _stem(entry.path)
+    return ResolvedSource(entry.format, entry.path, title, entry)
+
+
+@contextmanager
+def _quiet_parser_log() -> Iterator[None]:
+    """The parsers log each note; a command reports them as warnings instead (one
+    summary line), so the log is kept from the console while a source is read."""
+    log = logging.getLogger("robotwright.parsers")
+    old = log.propagate
+    handler = logging.NullHandler()
+    log.addHandler(handler)
+    log.propagate = False
+    try:
+        yield
+    finally:
+        log.removeHandler(handler)
+        log.propagate = old
+
+
+def _check_applies(source: ResolvedSource, options: Mapping[str, Any]) -> None:
+    applies = {
+        "hrdf": (),
+        "urdf": URDF_OPTIONS,
+        "xacro": (*URDF_OPTIONS, *XACRO_OPTIONS),
+        "mjcf": MJCF_OPTIONS,
+    }[source.kind]
+    unknown = sorted(k for k in options if k not in applies and k not in _PASSED)
+    if unknown:
+        flags = ", ".join(
+            "--" + k.replace("_", "-").replace("xacro-args", "xacro-arg") for k in unknown
+        )
+        what = {"hrdf": "an HRDF folder", "mjcf": "an MJCF file"}.get(source.kind, "a URDF")
+        raise RobotwrightError(f"{source.path}: {flags} do(es) not apply to {what}")
+
+
+#: Keyword arguments :func:`load_robot` passes on to every reader whatever the kind.
+_PASSED = ("asset_roots", "package_map", "work_dir", "strict_kinds")
+
+
+def load_robot_with_notes(
+    source: str | os.PathLike[str],
+    *,
+    strict: bool = False,
+    asset_roots: tuple[str | os.PathLike[str], ...] = (),
+    **options: Any,
+) -> tuple[HRDF, list[str]]:
+    """Read ``source`` (a robot name, HRDF folder, URDF, xacro or MJCF file) into an HRDF;
+    returns it and the readers' notes (values or elements not kept), one line each.
+
+    ``options`` are those of :class:`~robotwright.parsers.URDFOptions` or
+    :class:`~robotwright.parsers.mjcf.MJCFOptions` (over the command line's, see
+    :func:`given_source_options`).
+
+    Raises:
+        SourceNotFoundError: ``source`` names nothing loadable.
+        RobotwrightError: what the readers raise (naming file, element and field), or an
+            option that does not apply to the source's kind.
+    """
+    from robotwright.hrdf.model import HRDF
+
+    resolved = resolve_source(source)
+    opts = {**_GIVEN.get(), **options}
+    _check_applies(resolved, opts)
+    roots = tuple(asset_roots)
+    if resolved.kind == "hrdf":
+        from robotwright.hrdf.io import HRDFWarning
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", HRDFWarning)
+            hrdf = HRDF.from_dir(resolved.path, asset_roots=list(roots) or None)
+        notes = [str(w.message) for w in caught if issubclass(w.category, HRDFWarning)]
+        for w in caught:
+            if not issubclass(w.category, HRDFWarning):
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return hrdf, notes
+    from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
+
+    parse = mjcf_to_hrdf_with_warnings if resolved.kind == "mjcf" else urdf_to_hrdf_with_warnings
+    if roots:
+        opts["asset_roots"] = roots
+    with _quiet_parser_log():
+        result = parse(resolved.path, strict=strict, **opts)
+    return result.hrdf, [str(w) for w in result.warnings]
+
+
+def load_robot(
+    source: str | os.PathLike[str] | HRDF,
+    *,
+    strict: bool = False,
+    asset_roots: tuple[str | os.PathLike[str], ...] = (),
+    **options: Any,
+) -> HRDF:
+    """Read ``source`` into an HRDF (an HRDF is returned as is); each note of the readers
+    is issued as a :class:`~robotwright.errors.ConversionWarning` (the command line
+    counts them in one summary line). See :func:`load_robot_with_notes`."""
+    from robotwright.hrdf.model import HRDF
+
+    if isinstance(source, HRDF):
+        return source
+    hrdf, notes = load_robot_with_notes(source, strict=strict, asset_roots=asset_roots, **options)
+    for note in notes:
+        warnings.warn(note, ConversionWarning, stacklevel=2)
+    return hrdf
+
+
+def wants_parse() -> bool:
+    """Whether the command line asked for the robot read out of an MJCF file
+    (``--root-body``) rather than the file compiled by MuJoCo as it stands."""
+    return any(k in _GIVEN.get() for k in MJCF_OPTIONS)
