@@ -322,7 +322,8 @@ def track(
     Reference: centred on the tool point at the limb's display pose (revolute joints at
     +-0.5 rad, prismatic at mid-stroke), radius ``scale`` times the limb's reach (the
     largest tool-point distance from the base over 256 seeded poses, or ``reach`` m).
-    Joint reference: damped-least-squares IK at 100 Hz, interpolated to each step.
+    Joint reference: damped-least-squares IK at 100 Hz; it, its velocity and acceleration
+    (finite differences at 100 Hz) are interpolated to each step.
     Controller (every 0.002 s step of the carrier model): ``tau = M(q) (qdd_ref + kp e +
     kd de) + bias(q, dq)`` with ``kp = omega^2``, ``kd = 2 omega`` (a PD law scaled by
     the inertia, plus gravity and velocity-bias compensation), clipped by MuJoCo to
@@ -354,9 +355,13 @@ def track(
     tc = np.linspace(0.0, duration, coarse)
     qc = ik_path(m, reference_path(center, scale * reach, duration, coarse), qn)
     t = np.linspace(0.0, duration, steps + 1)
-    qr = np.stack([np.interp(t, tc, qc[:, i]) for i in range(nv)], axis=1)
-    vr = np.gradient(qr, dt, axis=0)
-    ar = np.gradient(vr, dt, axis=0)
+    # Velocities and accelerations from the 100 Hz samples, then interpolated: the
+    # derivatives of the piecewise-linear interpolant would be spikes at every sample.
+    vc = np.gradient(qc, tc, axis=0)
+    ac = np.gradient(vc, tc, axis=0)
+    qr, vr, ar = (
+        np.stack([np.interp(t, tc, x[:, i]) for i in range(nv)], axis=1) for x in (qc, vc, ac)
+    )
     model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
     try:
         data = mujoco.MjData(model)

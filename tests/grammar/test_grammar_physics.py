@@ -1,0 +1,183 @@
+"""Physics objectives of a limb worn by its carrier: payload, track, energy, and the
+no-carrier-collision constraint; the winners written by ``grammar search -o``."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import pickle
+import random
+
+import mujoco
+import numpy as np
+import pytest
+
+from robotwright.cli import main
+from robotwright.grammar import default_grammar
+from robotwright.grammar import physics as P
+from robotwright.grammar.build import Limb, build
+from robotwright.grammar.derive import Counter, sample
+from robotwright.grammar.design import Design
+from robotwright.grammar.objectives import (
+    Energy,
+    EvalContext,
+    NoCarrierCollision,
+    Payload,
+    Track,
+    evaluate,
+    make_constraint,
+)
+
+ARM = """# grammar=srl
+r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()
+r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r3 @3: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r4 @5: E=tool(length=0.08)
+"""
+
+
+@pytest.fixture(scope="module")
+def grammar():
+    return default_grammar()
+
+
+@pytest.fixture(scope="module")
+def arm(grammar) -> Limb:
+    return build(grammar, Design.from_text(ARM))
+
+
+def scaled(limb: Limb, factor: float) -> Limb:
+    """The same limb with every peak torque times ``factor``."""
+    joints = [dataclasses.replace(j, peak_torque=j.peak_torque * factor) for j in limb.joints]
+    return dataclasses.replace(limb, joints=joints)
+
+
+def some_designs(grammar, n: int = 6, seed: int = 3):
+    rng, counter = random.Random(seed), Counter(grammar)
+    return [sample(grammar, 3, rng, counter) for _ in range(n)]
+
+
+def test_same_seed_same_values_and_objectives_pickle(grammar):
+    objs = (Payload(), Track(), Energy())
+    cons = (NoCarrierCollision(), make_constraint("no-self-collision"))
+    for d in some_designs(grammar, 4):
+        a = evaluate(grammar, d, objs, cons)
+        b = evaluate(grammar, d, pickle.loads(pickle.dumps(objs)), cons)
+        assert a.values == b.values and a.violations == b.violations
+        assert set(a.values) == {"payload", "track", "energy"}
+        assert all(np.isfinite(v) and v >= 0 for v in a.values.values())
+    # another sampling seed draws other poses
+    d = some_designs(grammar, 1)[0]
+    limb = build(grammar, d)
+    p0, p1 = P.payload(limb, seed=0), P.payload(limb, seed=1)
+    assert not np.array_equal(
+        P.sample_poses(P.mount(limb), 8, 0), P.sample_poses(P.mount(limb), 8, 1)
+    )
+    assert p0.poses.shape[1] == p1.poses.shape[1] == limb.dof
+
+
+def test_mounted_model_locks_the_carrier_and_limits_the_motors(arm):
+    m = P.mount(arm)
+    assert m.model.nv == arm.dof == m.model.nu  # only the limb moves
+    assert m.model.ngeom > sum(len(b.geoms) for b in arm.bodies)  # the carrier is there
+    np.testing.assert_array_equal(
+        m.model.jnt_actfrcrange[:, 1], [j.peak_torque for j in arm.joints]
+    )
+    np.testing.assert_array_equal(m.model.actuator_ctrlrange[:, 1], m.peak)
+
+
+def test_payload_is_verified_by_hanging_the_mass(arm):
+    res = P.payload(arm)
+    assert 0 < res.mass < 100
+    worst = res.poses[res.worst]
+    # Independent check: a body of that mass at the tool point, torques by mj_inverse.
+    xml, body, pos, quat = P._carrier_xml(P.Carrier())
+    spec = mujoco.MjSpec.from_string(xml)
+    spec.compiler.degree = False
+    arm.add_to(spec, spec.body(body), pos, quat, "srl_")
+    site = next(s for s in arm.sites if s.name == arm.branches[0].site)
+    load = spec.body("srl_" + site.body).add_body(name="load", pos=site.pos)
+    load.mass = res.mass
+    load.ipos = (0.0, 0.0, 0.0)  # a point mass at the tool point
+    load.iquat = (1.0, 0.0, 0.0, 0.0)
+    load.inertia = (1e-9, 1e-9, 1e-9)
+    load.explicitinertial = True
+    model = spec.compile()
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    data = mujoco.MjData(model)
+    data.qpos[:] = worst
+    mujoco.mj_inverse(model, data)
+    ratio = np.abs(data.qfrc_inverse) / np.array([j.peak_torque for j in arm.joints])
+    assert ratio.max() == pytest.approx(1.0, abs=1e-6)
+    # the closed form agrees with itself at that pose
+    assert P._max_mass(*P.holding_torques(P.mount(arm), worst), P.mount(arm).peak) == (
+        pytest.approx(res.mass)
+    )
+
+
+def test_payload_grows_with_torque_and_is_zero_when_the_limb_cannot_hold_itself(arm, grammar):
+    base = P.payload(arm).mass
+    assert P.payload(scaled(arm, 2.0)).mass >= base
+    assert P.payload(scaled(arm, 2.0)).mass > base  # uncapped here: torque-limited
+    assert P.payload(scaled(arm, 1e-4)).mass == 0.0
+    for d in some_designs(grammar):
+        limb = build(grammar, d)
+        if limb.dof:
+            assert P.payload(scaled(limb, 2.0)).mass >= P.payload(limb).mass
+
+
+def test_tracking_strong_vs_weak_and_static_reference(arm):
+    strong = P.track(scaled(arm, 100.0), scale=0.05)
+    weak = P.track(scaled(arm, 0.01), scale=0.05)
+    assert strong.error < 0.01 < weak.error
+    assert weak.error > 10 * strong.error
+    assert strong.power >= 0 and weak.power >= 0
+    assert strong.path.shape == strong.reference.shape == (1001, 3)
+    # the reference is a circle of 5 % of the reach about the display pose's tool point
+    assert np.linalg.norm(strong.reference[0] - strong.reference[500]) == pytest.approx(0, abs=1e-9)
+    static = P.track(arm, scale=0.0)
+    assert static.error == pytest.approx(0.0, abs=1e-9)
+    assert static.power == pytest.approx(0.0, abs=1e-9)
+
+
+def test_no_carrier_collision_matches_mujoco_contacts(grammar, arm):
+    far = P.Carrier(pos=(0.0, 0.0, 1.5))  # 1.5 m out along the limb's base normal
+    ctx = EvalContext(grammar, Design.from_text(ARM))
+    assert NoCarrierCollision(carrier=far)(ctx) is None
+    msg = NoCarrierCollision()(ctx)
+    assert msg is not None and "touches the carrier" in msg
+    m = P.mount(arm)
+    k = int(msg.split("first: pose ")[1].split(",")[0])
+    data = mujoco.MjData(m.model)
+    data.qpos[:] = P.sample_poses(m, 32, 0)[k]
+    mujoco.mj_forward(m.model, data)
+    assert any(with_carrier for _, _, with_carrier in P.contacts(m, data))
+
+
+def test_search_writes_winners_view_can_open(tmp_path, capsys):
+    out = tmp_path / "win"
+    argv = ["grammar", "search", "--objective", "track", "--budget", "6", "--max-links", "2"]
+    argv += ["--workers", "1", "--method", "random", "-o", str(out), "--top", "2"]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "best_1, best_2" in printed
+    for rank in (1, 2):
+        folder = out / f"best_{rank}"
+        values = json.loads((folder / "values.json").read_text())
+        assert values["rank"] == rank and values["objectives"]["track"]["unit"] == "m"
+        for name in ("srl.xml", "design.txt", "on_carrier.png", "track.png", "values.txt"):
+            assert (folder / name).stat().st_size > 0
+        assert (folder / "on_carrier.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    first = json.loads((out / "best_1" / "values.json").read_text())["values"]["track"]
+    second = json.loads((out / "best_2" / "values.json").read_text())["values"]["track"]
+    assert first <= second
+    assert f"best track = {first:.4f}" in printed
+    from robotwright.view.scene import load_source
+
+    scene = load_source(out / "best_1")  # what `robotwright view OUT/best_1` shows
+    limb_xml = mujoco.MjModel.from_xml_path(str(out / "best_1" / "srl.xml"))
+    assert scene.kind == "design" and scene.model.nbody == limb_xml.nbody
+    # all or nothing, and never over an existing output without --overwrite
+    assert main(argv) == 2
+    assert main([*argv, "--overwrite", "--no-picture"]) == 0
+    assert not (out / "best_1" / "on_carrier.png").exists()
