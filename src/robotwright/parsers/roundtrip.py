@@ -890,6 +890,14 @@ def _roundtrip_on(
         # hold (a chain deeper than MJCF allows) that import can take far longer than
         # this answer (MuJoCo 4.0 spends 20 s refusing a chain of 2,000 links).
         report.error = f"our MJCF is not written: {type(exc).__name__}: {exc}"
+        from robotwright.errors import HRDFError
+
+        if isinstance(exc, HRDFError):
+            # The robot's own values are refused (non-physical inertias): bad input, exit
+            # 2, as convert refuses it.
+            report.input_error = ConversionError(
+                exc.problems, summary=f"{path}: the robot is not a valid HRDF"
+            )
         return report
     try:
         loader = reference_loader(
