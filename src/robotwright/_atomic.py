@@ -70,9 +70,17 @@ _NOFOLLOW_DIR = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW if hasattr(os, "O_N
 
 @contextmanager
 def mesh_size_limit(mb: float | None) -> Iterator[None]:
-    """Copy mesh and asset files of at most ``mb`` megabytes (10**6 bytes) into outputs
-    within the block (``None``: the default, :data:`DEFAULT_MAX_MESH_MB`); a larger file
-    raises :class:`~robotwright.errors.InputFileError` naming it and the limit."""
+    """Within the block, mesh and asset files of at most ``mb`` megabytes (10**6 bytes)
+    are copied into outputs and read by models (``None``: the default,
+    :data:`DEFAULT_MAX_MESH_MB`); a larger file, or a height field or image declaring more
+    data (see :mod:`robotwright._assets`), raises
+    :class:`~robotwright.errors.InputFileError` naming it and the limit.
+
+    Example::
+
+        with robotwright.mesh_size_limit(2000):  # a 1.5 GB scan mesh
+            robot = HRDF.from_dir("big_robot")
+    """
     if mb is not None and not mb > 0:
         raise ValueError(f"mesh size limit must be a positive number of MB, got {mb}")
     token = _MESH_LIMIT.set(round(mb * 10**6) if mb is not None else _MESH_LIMIT.get())
@@ -364,7 +372,12 @@ class StagedFiles:
             staged.write_text(text, encoding="utf-8")
 
     def copy(self, src: Path, rel: str | os.PathLike[str]) -> None:
-        """Stage a copy of the regular file ``src`` as ``out_dir/rel``."""
+        """Stage a copy of the regular file ``src`` as ``out_dir/rel`` (refused before
+        anything is copied when it would replace a different file and the overwrite rule
+        forbids it: :func:`robotwright._outputs.check_copy_destination`)."""
+        from robotwright._outputs import check_copy_destination
+
+        check_copy_destination(self.out_dir / rel, src)
         _copy(src, self.path(rel), self.out_dir / rel)
 
     def _commit(self) -> None:

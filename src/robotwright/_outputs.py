@@ -10,6 +10,13 @@ the home folder, or a symbolic link. It is checked before any work, so a refused
 writes nothing. ``robotwright demo`` refreshes its own output folder without the flag
 (see :mod:`robotwright.demo`), under the same rule.
 
+Files copied next to a file output (``export``/``compose --copy-meshes``, ``convert`` to
+a model file: ``meshes/<robot>/...``; ``things``: ``assets/...``) follow the rule too:
+without ``--overwrite`` an existing file at a copy's name is refused unless it already
+holds the same bytes (a repeated export is not refused for its own copies); with it, it
+is replaced. Other files in those folders are never touched. See
+:func:`check_copy_destination`.
+
 Writers called from Python take ``overwrite=`` keyword arguments with the same meaning;
 this module is the command line's side of it, importable without MuJoCo or numpy.
 """
@@ -20,7 +27,10 @@ import argparse
 import json
 import os
 import re
-from collections.abc import Iterable
+import stat
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 
 from robotwright.errors import OutputExistsError
@@ -28,8 +38,10 @@ from robotwright.errors import OutputExistsError
 __all__ = [
     "MARKER",
     "add_overwrite_flag",
+    "check_copy_destination",
     "check_folder_output",
     "check_overwrite",
+    "copies_replace",
     "existing_output",
     "write_marker",
 ]
@@ -230,3 +242,63 @@ def write_marker(folder: str | os.PathLike[str], kind: str) -> None:
     files = sorted(_listing(folder) - {MARKER})
     text = json.dumps({"written_by": "robotwright", "kind": kind, "files": files}, indent=1)
     (folder / MARKER).write_text(text + "\n", encoding="utf-8")
+
+
+#: Whether a copied file may replace a different file of the same name: True for Python
+#: callers (``export(path)`` replaces its output), the command's ``--overwrite`` on the
+#: command line (:func:`copies_replace`, set around every command that has the flag).
+_REPLACE_COPIES: ContextVar[bool] = ContextVar("robotwright_replace_copies", default=True)
+
+
+@contextmanager
+def copies_replace(allowed: bool) -> Iterator[None]:
+    """Within the block, files copied into an output replace different files of the same
+    name only when ``allowed`` (see :func:`check_copy_destination`)."""
+    token = _REPLACE_COPIES.set(bool(allowed))
+    try:
+        yield
+    finally:
+        _REPLACE_COPIES.reset(token)
+
+
+def _same_bytes(a: Path, b: Path) -> bool:
+    """Whether regular files ``a`` and ``b`` hold the same bytes (sizes compared first)."""
+    if os.stat(a).st_size != os.stat(b).st_size:
+        return False
+    with open(a, "rb") as fa, open(b, "rb") as fb:
+        while True:
+            x, y = fa.read(1 << 20), fb.read(1 << 20)
+            if x != y:
+                return False
+            if not x:
+                return True
+
+
+def check_copy_destination(dst: str | os.PathLike[str], src: str | os.PathLike[str]) -> None:
+    """Raise :class:`OutputExistsError` when copying ``src`` to ``dst`` would replace
+    something else and replacing is not allowed (:func:`copies_replace`): ``dst`` exists
+    and is not a regular file holding exactly the bytes of ``src`` (a link, a folder, a
+    FIFO, or a file with other content). Only ``lstat`` is asked of anything that is not
+    a regular file: nothing there is opened or followed."""
+    if _REPLACE_COPIES.get():
+        return
+    dst = Path(dst)
+    try:
+        mode = os.lstat(dst).st_mode
+    except FileNotFoundError:
+        return
+    except OSError:
+        mode = 0  # unreadable: not known to hold the same bytes
+    if stat.S_ISREG(mode):
+        try:
+            if _same_bytes(Path(src), dst):
+                return
+        except OSError:
+            pass  # cannot be compared: refused below
+        what = "exists with other content"
+    else:
+        what = "exists and is not a regular file"
+    raise OutputExistsError(
+        f"{dst}: {what}; not replacing a file the output copies there (give --overwrite to "
+        "replace it, or another output path)"
+    )

@@ -30,6 +30,7 @@ from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
+from robotwright._assets import check_asset_file, check_declared_sizes
 from robotwright._inputs import MAX_XML_BYTES, _kind, read_bytes
 from robotwright.errors import InputFileError, UnsafePathError
 
@@ -241,15 +242,16 @@ def check_mjcf_includes(
             for attr, value in el.attrib.items():
                 if attr.startswith("file") and value:
                     for folder in dirs:
+                        elem = _element(el.tag, el.get("name"), attr, value)
                         try:
-                            check_regular(
+                            found = check_regular(
                                 resolve_inside(
                                     Path(folder) / value, base=model_dir, root=root, trusted=trusted
                                 )
                             )
                         except UnsafePathError as exc:
-                            elem = _element(el.tag, el.get("name"), attr, value)
                             raise UnsafePathError(exc.reason, file=where, element=elem) from None
+                        _check_size(found, where, elem)
 
 
 def check_mjcf_spec(
@@ -282,15 +284,28 @@ def check_mjcf_spec(
                 if not value:
                     continue
                 file = os.path.basename(value) if strip else value
+                elem = _element(tag, item.name, attr, value)
                 try:
-                    check_regular(
+                    found = check_regular(
                         resolve_inside(
                             Path(folder or "") / file, base=model_dir, root=root, trusted=trusted
                         )
                     )
                 except UnsafePathError as exc:
-                    elem = _element(tag, item.name, attr, value)
                     raise UnsafePathError(exc.reason, file=source, element=elem) from None
+                _check_size(found, source, elem)
+    # Sizes the model declares (height field samples, built-in textures) are allocated
+    # when it compiles: refuse them over the same limit first.
+    check_declared_sizes(spec, source=source)
+
+
+def _check_size(path: Path, source: str, element: str) -> None:
+    """The asset size cap (:func:`robotwright._assets.check_asset_file`) on a file
+    named by ``element`` of ``source``: the message names all three."""
+    try:
+        check_asset_file(path)
+    except InputFileError as exc:
+        raise InputFileError(f"{source}: {element}: {exc.path}", exc.reason) from None
 
 
 def checked_mjcf_spec(path: PathLike, *, trusted: Sequence[Path] | None = None) -> Any:

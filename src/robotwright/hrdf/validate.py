@@ -21,9 +21,10 @@ from pathlib import Path
 import defusedxml
 import defusedxml.ElementTree as SafeET
 
+from robotwright._assets import check_asset_file
 from robotwright._limits import keyframes_problem
 from robotwright._names import name_problem
-from robotwright.errors import Problem, UnsafePathError
+from robotwright.errors import InputFileError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
     ACTUATOR_TYPES,
     EXTRA_MAX_DEPTH,
@@ -511,6 +512,8 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             and os.sep not in m.name
             and f"{m.name}.{ext}" in _listing(default_dir, listings)
         ):
+            if check_files:
+                out += _too_large(f"{default_dir}{os.sep}{m.name}.{ext}", i, "name")
             continue
         column = "file" if m.file is not None else "name"
         if root is not None:
@@ -531,16 +534,30 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
                 continue
             if check_files and not os.path.isfile(source):
                 out.append(_missing(source, i, column))
+            elif check_files:
+                out += _too_large(source, i, column)
         elif check_files:
             path = _mesh_file(hrdf, m)
             if not os.path.isfile(path):
                 out.append(_missing(path, i, column))
+            else:
+                out += _too_large(path, i, column)
     return out
 
 
 def _missing(path: str | Path, row: int, column: str) -> Problem:
     why = "is not a regular file" if os.path.exists(path) else "does not exist"
     return Problem("mesh.csv", f"mesh file '{path}' {why}", row=row, column=column)
+
+
+def _too_large(path: str | Path, row: int, column: str) -> list[Problem]:
+    """The mesh size cap (``--max-mesh-mb``), checked with ``stat`` before MuJoCo or a
+    mesh reader opens the file (see :mod:`robotwright._assets`)."""
+    try:
+        check_asset_file(path)
+    except InputFileError as exc:
+        return [Problem("mesh.csv", f"mesh file {exc}", row=row, column=column)]
+    return []
 
 
 def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:

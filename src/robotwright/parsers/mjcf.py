@@ -24,7 +24,7 @@ import numpy as np
 
 from robotwright._limits import keyframes_problem
 from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
-from robotwright.errors import ConversionError, Problem, UnsafePathError
+from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
     HRDF,
     SENSOR_OBJTYPES,
@@ -918,6 +918,8 @@ def parse_mjcf(
     except UnsafePathError as exc:
         problem = Problem(exc.file or str(path), exc.reason, element=exc.element)
         raise ConversionError([problem]) from exc
+    except InputFileError:
+        raise  # a file over the size limit: refused before MuJoCo read it
     except ValueError as exc:
         raise ConversionError([Problem(str(path), f"MuJoCo cannot load it: {exc}")]) from exc
 

@@ -28,7 +28,7 @@ import mujoco
 import numpy as np
 
 from robotwright._paths import trusted_asset_roots
-from robotwright.errors import ConversionError, Problem
+from robotwright.errors import ConversionError, InputFileError, Problem
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
@@ -880,6 +880,8 @@ def _roundtrip_on(
         report.error = f"parse failed: {type(exc).__name__}: {exc}"
         if isinstance(exc, ConversionError):
             report.input_error = exc
+        elif isinstance(exc, InputFileError):  # a file refused unread (over a size cap)
+            report.input_error = ConversionError([Problem(exc.path, exc.reason)])
         return report
     report.warnings = [str(w) for w in result.warnings]
     mimic = mimic_map(path)
