@@ -69,7 +69,9 @@ def test_misspelt_command_and_choice_suggest_the_close_name(capsys) -> None:
 def test_unknown_robot_suggests_the_close_name(capsys) -> None:
     assert main(["info", "mini_humanoi"]) == 2
     err = capsys.readouterr().err
-    assert "no robot named 'mini_humanoi'" in err and "did you mean 'mini_humanoid'?" in err
+    # Installed description packages add names: the close one is among the suggestions.
+    assert "no robot named 'mini_humanoi'" in err and "did you mean" in err
+    assert "'mini_humanoid'" in err.split("did you mean")[1]
     assert "Traceback" not in err
 
 
@@ -112,7 +114,7 @@ def test_things_takes_a_bundled_robot_name(tmp_path: Path, capsys) -> None:
     assert np.allclose(model.body_mass, reference.body_mass)
     assert np.allclose(model.body_inertia, reference.body_inertia)
     assert main(["things", "arm7", str(tmp_path / "x.xml")]) == 2
-    assert "did you mean 'arm6'?" in capsys.readouterr().err
+    assert "'arm6'" in capsys.readouterr().err.split("did you mean")[1]
 
 
 def _scene(tmp_path: Path) -> Path:

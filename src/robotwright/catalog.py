@@ -238,10 +238,25 @@ def _named(source: str, files: list[tuple[Path, str]], package: str | None) -> l
             out.append(RobotEntry(stem, source, fmt, path))
             continue
         for path, fmt in by_folder.values():
-            out.append(RobotEntry(f"{_package_of(path)}/{stem}", source, fmt, path))
+            out.append(RobotEntry(_folder_name(path, stem, by_folder), source, fmt, path))
     names = {e.name for e in out}
     out += _aliases(source, out, names, package)
     return out
+
+
+def _folder_name(path: Path, stem: str, others: dict[Path, tuple[Path, str]]) -> str:
+    """``FOLDER/STEM`` with as many folders above the file (``urdf``/``robots``/... left
+    out) as make it differ from the other files of that stem."""
+
+    def folders(p: Path) -> list[str]:
+        return [f for f in p.parent.parts if f not in _ROBOT_FOLDERS]
+
+    mine = folders(path)
+    rest = [folders(p) for p, _ in others.values() if p != path]
+    for k in range(1, len(mine) + 1):
+        if all(r[-k:] != mine[-k:] for r in rest):
+            return "/".join([*mine[-k:], stem])
+    return "/".join([*mine, stem])
 
 
 def _package_of(path: Path) -> str:

@@ -66,10 +66,12 @@ def test_file_or_plain_folder_given_as_robot_is_named(tmp_path, capsys, command)
     (tmp_path / "robot.urdf").write_text("<robot name='r'/>", encoding="utf-8")
     (tmp_path / "empty").mkdir()
     extra = ["-o", str(tmp_path / "o.xml")] if command == "export" else []
-    assert main([command, str(tmp_path / "robot.urdf"), *extra]) == 2
-    err = capsys.readouterr().err
-    assert "robot.urdf: is a file; expected an HRDF folder (with meta.yaml)" in err
-    assert "robotwright convert" in err
+    # A URDF is read as one (every command takes any robot source): this one has no
+    # links, which is bad input (validate: an invalid robot, exit 1, its problem listed).
+    code = main([command, str(tmp_path / "robot.urdf"), *extra])
+    captured = capsys.readouterr()
+    assert code == (1 if command == "validate" else 2)
+    assert "robot.urdf" in captured.err + captured.out
     assert main([command, str(tmp_path / "empty"), *extra]) == 2
-    assert "empty: not an HRDF folder: it has no meta.yaml" in capsys.readouterr().err
+    assert "empty: a folder without meta.yaml" in capsys.readouterr().err
     assert not (tmp_path / "o.xml").exists()
