@@ -42,8 +42,11 @@ _FINGER_WIDTH_FRACTION = 0.25
 _CLEARANCE = 0.002
 
 
+_EYE4 = np.eye(4)
+
+
 def trans(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
-    T = np.eye(4)
+    T = _EYE4.copy()
     T[:3, 3] = (x, y, z)
     return T
 
@@ -60,7 +63,20 @@ def _clean(v: np.ndarray) -> np.ndarray:
 
 
 def _vec(v: np.ndarray) -> tuple[float, float, float]:
-    return tuple(float(x) for x in _clean(np.asarray(v, dtype=float)))  # type: ignore[return-value]
+    # _clean on plain floats: numpy's round(x, 12) is rint(x * 1e12) / 1e12, which
+    # Python's round() to an int (exact below 2**53) followed by the division repeats.
+    return tuple(  # type: ignore[return-value]
+        0.0 if abs(x) < 1e-12 else round(x * 1e12) / 1e12 for x in map(float, v)
+    )
+
+
+def _rigid_inv(T: np.ndarray) -> np.ndarray:
+    """Inverse of a rigid transform (rotation and translation): R^T and -R^T p."""
+    out = _EYE4.copy()
+    rt = T[:3, :3].T
+    out[:3, :3] = rt
+    out[:3, 3] = -rt @ T[:3, 3]
+    return out
 
 
 _GEOM_TYPES = {
@@ -160,13 +176,13 @@ class Limb:
     def joint_ranges(self) -> np.ndarray:
         return np.array([j.range for j in self.joints], dtype=float).reshape(-1, 2)
 
-    def to_spec(self) -> mujoco.MjSpec:
+    def to_spec(self, motors: bool = False) -> mujoco.MjSpec:
         """A bare MjSpec of the limb (fixed base, geoms with densities); used to compute
         mass properties with MuJoCo. User-facing MJCF goes through the generators."""
         spec = mujoco.MjSpec()
         spec.compiler.degree = False
         spec.modelname = self.name
-        self.add_to(spec, spec.worldbody)
+        self.add_to(spec, spec.worldbody, motors=motors)
         return spec
 
     def add_to(
@@ -203,7 +219,7 @@ class Limb:
                 rel = base @ root
                 into = parent
             else:
-                rel = np.linalg.inv(self.bodies[b.parent].frame) @ b.frame
+                rel = _rigid_inv(self.bodies[b.parent].frame) @ b.frame
                 into = made[b.parent]
             body = into.add_body(name=prefix + b.name, pos=rel[:3, 3], quat=mat2quat(rel[:3, :3]))
             for g in b.geoms:
@@ -261,7 +277,7 @@ class Limb:
         props = self.mass_properties()
         bodies = []
         for b, p in zip(self.bodies, props):
-            rel = b.frame if b.parent < 0 else np.linalg.inv(self.bodies[b.parent].frame) @ b.frame
+            rel = b.frame if b.parent < 0 else _rigid_inv(self.bodies[b.parent].frame) @ b.frame
             bodies.append(
                 Body(
                     name=b.name,
@@ -410,7 +426,7 @@ class _Builder:
         kind = comp.kind
         if kind == "mount":
             body = self.bodies[body_index]
-            rel = np.linalg.inv(body.frame) @ frame if body_index else np.eye(4)
+            rel = _rigid_inv(body.frame) @ frame if body_index else _EYE4.copy()
             self.sites.append(
                 Site(
                     name=self.name("mount"),
@@ -440,7 +456,7 @@ class _Builder:
             frame = frame @ rot_x(acc[1]) @ trans(x=acc[0])
             acc = (0.0, 0.0)
         body = LimbBody(self.name(stem), body_index, frame, node.id, comp.name)
-        inv = np.linalg.inv(frame)
+        inv = _rigid_inv(frame)
         rows = list(rows)
         for i, (jnode, jcomp, k, jframe, row) in enumerate(pending):
             rel = inv @ jframe
@@ -573,7 +589,7 @@ class _Builder:
         # the tool transform is taken from the frame fk() ends in.
         n = len(rows)
         end = base_frame @ fk(rows, np.zeros(n)) if n else base_frame
-        tool = np.linalg.inv(end) @ tip
+        tool = _rigid_inv(end) @ tip
         self.branches.append(
             Branch(list(rows), [r.name for r in rows], base_frame, _clean(tool), site)
         )
