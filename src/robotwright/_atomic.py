@@ -377,8 +377,9 @@ class StagedFiles:
         forbids it: :func:`robotwright._outputs.check_copy_destination`)."""
         from robotwright._outputs import check_copy_destination
 
+        staged = self.path(rel)  # refuses a link among the output's folders first
         check_copy_destination(self.out_dir / rel, src)
-        _copy(src, self.path(rel), self.out_dir / rel)
+        _copy(src, staged, self.out_dir / rel)
 
     def _commit(self) -> None:
         """Move every staged file onto its place, in the order staged (the caller stages

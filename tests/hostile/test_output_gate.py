@@ -205,8 +205,9 @@ def test_random_link_positions_in_a_copy_tree(
     seed: int, arm: Path, outside: Path, tmp_path: Path, capsys
 ) -> None:
     """A link at a random depth of the copy folders (folder or file position) of a
-    random writer: refused when it is a folder on the way, replaced when it is the
-    copied file itself; what it points at never changes."""
+    random writer: refused when it is a folder on the way; when it is the copied file
+    itself, refused without --overwrite (as any other file there) and replaced with it;
+    what it points at never changes."""
     rng = random.Random(seed)
     writer = rng.choice(sorted(FILE_WRITERS))
     template, _name, folders = FILE_WRITERS[writer]
@@ -223,6 +224,9 @@ def test_random_link_positions_in_a_copy_tree(
     if cut < len(parts):
         assert code == 2 and "is a symbolic link" in err, err
     else:
+        assert code == 2 and "--overwrite" in err and link.is_symlink(), err
+        code, err = _run([*_argv(template, arm, out), "--overwrite"], capsys)
+        assert snapshot(outside) == before
         assert code == 0, err
         assert not link.is_symlink() and link.read_bytes() == (arm / "meshes/a.stl").read_bytes()
 
