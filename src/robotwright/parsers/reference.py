@@ -615,15 +615,49 @@ def _repair(
     return mass, vectors @ np.diag(values) @ vectors.T
 
 
+def _geom_inertias(
+    path: Path, links: list[str], density: float | None
+) -> dict[str, tuple[float, np.ndarray, np.ndarray]]:
+    """Mass, centre of mass and tensor (link frame) that MuJoCo's URDF import gives the
+    ``links`` without ``<inertial>`` (from their collision geoms), for a URDF MuJoCo
+    refuses as written: every explicit ``<inertial>`` is replaced by a unit one (a link's
+    inertia from its geoms does not depend on the others) so that the other links'
+    faults do not stop the import. Empty when MuJoCo refuses even that."""
+    try:
+        root = DET.fromstring(urdf_for_mujoco(path))  # mesh paths under the usual rule
+        for inertial in root.iter("inertial"):
+            inertial.clear()
+            ET.SubElement(inertial, "mass", {"value": "1"})
+            unit = {k: "1" if k in ("ixx", "iyy", "izz") else "0" for k in _INERTIA_KEYS}
+            ET.SubElement(inertial, "inertia", unit)
+        model = compile_urdf(ET.tostring(root, encoding="unicode"), density)
+    except Exception:  # noqa: BLE001 - MuJoCo computes nothing: those links stay massless
+        return {}
+    out = {}
+    for n in links:
+        try:
+            i = model.body(n).id
+        except KeyError:
+            continue
+        rot = quat_to_mat(model.body_iquat[i])
+        tensor = rot @ np.diag(model.body_inertia[i]) @ rot.T
+        out[n] = (float(model.body_mass[i]), np.array(model.body_ipos[i]), tensor)
+    return out
+
+
 def urdf_yourdfpy_view(
     path: Path,
     *,
     balance_inertia: bool = False,
     bound_mass: float | None = None,
     bound_inertia: float | None = None,
+    inertia_from_geoms: str = "auto",
+    density: float | None = None,
 ) -> RobotView:
     """An independent reference: ``yourdfpy`` kinematics and the URDF's inertials (with
-    the same repairs as the parser options, when given)."""
+    the same repairs as the parser options, when given). A link without ``<inertial>``
+    gets, with ``inertia_from_geoms="auto"``, what MuJoCo's import computes from its
+    collision geoms (see :func:`_geom_inertias`), where MuJoCo can compute it."""
     import yourdfpy
 
     robot = yourdfpy.URDF.load(
@@ -639,9 +673,19 @@ def urdf_yourdfpy_view(
     links = [n for n in robot.link_map if n != "world" or base != "world"]
     mass, inertia = {}, {}
     robot.update_cfg(np.zeros(len(robot.actuated_joint_names)))
+    without = [n for n in links if robot.link_map[n].inertial is None]
+    from_geoms = (
+        _geom_inertias(path, without, density) if without and inertia_from_geoms == "auto" else {}
+    )
     for n in links:
         link = robot.link_map[n]
         tf = robot.get_transform(n, base)
+        if n in from_geoms:
+            m, com, tensor = from_geoms[n]
+            rot = tf[:3, :3]
+            mass[n] = m
+            inertia[n] = (tf[:3, :3] @ com + tf[:3, 3], rot @ tensor @ rot.T)
+            continue
         if link.inertial is None:
             mass[n] = 0.0
             inertia[n] = (tf[:3, 3].copy(), np.zeros((3, 3)))
