@@ -10,6 +10,7 @@ worn by its carrier (:mod:`robotwright.grammar.physics`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Protocol, runtime_checkable
@@ -24,6 +25,7 @@ from robotwright.grammar.physics import (
     Mounted,
     TrackResult,
     carrier_collisions,
+    check_settings,
     mount,
     payload,
     sample_poses,
@@ -264,6 +266,9 @@ class Payload:
     name: str = "payload"
     maximize: bool = True
 
+    def __post_init__(self) -> None:
+        check_settings("Payload", samples=self.samples, seed=self.seed)
+
     def __call__(self, ctx: EvalContext) -> float:
         m = ctx.mounted(self.carrier)
         return payload(ctx.limb, self.carrier, samples=self.samples, seed=self.seed, mounted=m).mass
@@ -281,6 +286,9 @@ class Track:
     name: str = "track"
     maximize: bool = False
 
+    def __post_init__(self) -> None:
+        check_settings("Track", duration=self.duration, scale=self.scale)
+
     def __call__(self, ctx: EvalContext) -> float:
         return ctx.tracking(self.carrier, self.duration, self.scale).error
 
@@ -296,6 +304,9 @@ class Energy:
     name: str = "energy"
     maximize: bool = False
 
+    def __post_init__(self) -> None:
+        check_settings("Energy", duration=self.duration, scale=self.scale)
+
     def __call__(self, ctx: EvalContext) -> float:
         return ctx.tracking(self.carrier, self.duration, self.scale).power
 
@@ -309,6 +320,9 @@ class NoCarrierCollision:
     seed: int = 0
     carrier: Carrier = Carrier()
     name: str = "no-carrier-collision"
+
+    def __post_init__(self) -> None:
+        check_settings("NoCarrierCollision", samples=self.samples, seed=self.seed)
 
     def __call__(self, ctx: EvalContext) -> str | None:
         m = ctx.mounted(self.carrier)
@@ -331,28 +345,43 @@ OBJECTIVES: dict[str, type] = {
 }
 
 
+_FLAGS = {
+    "no-self-collision": NoSelfCollision,
+    "no-carrier-collision": NoCarrierCollision,
+    "joint-limits": JointLimitsFeasible,
+}
+_EXPECTED = (
+    "no-self-collision, no-carrier-collision, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
+)
+
+
 def make_constraint(text: str) -> Constraint:
     """Parse ``no-self-collision``, ``no-carrier-collision``, ``joint-limits``,
-    ``max-mass=KG``, ``max-dof=N``, ``min-dof=N``."""
-    name, _, value = text.partition("=")
+    ``max-mass=KG`` (a finite number >= 0), ``max-dof=N``, ``min-dof=N`` (integers >= 0).
+
+    Raises:
+        ValueError: an unknown name, a value where none is taken, or a bad number.
+    """
+    name, eq, value = text.partition("=")
+    if name in _FLAGS:
+        if eq:
+            raise ValueError(f"constraint {text!r}: {name} takes no value")
+        return _FLAGS[name]()
+    if name not in ("max-mass", "max-dof", "min-dof"):
+        raise ValueError(f"unknown constraint {text!r}: expected {_EXPECTED}")
     try:
-        if name == "no-self-collision":
-            return NoSelfCollision()
-        if name == "no-carrier-collision":
-            return NoCarrierCollision()
-        if name == "joint-limits":
-            return JointLimitsFeasible()
-        if name == "max-mass":
-            return MaxMass(float(value))
-        if name == "max-dof":
-            return DoFRange(high=int(value))
-        if name == "min-dof":
-            return DoFRange(low=int(value))
+        number = float(value) if name == "max-mass" else int(value)
     except ValueError:
-        raise ValueError(f"constraint {text!r}: {name} needs a number, e.g. {name}=2") from None
-    raise ValueError(
-        f"unknown constraint {text!r}: expected no-self-collision, no-carrier-collision, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
-    )
+        number = None
+    if number is None or not math.isfinite(number) or number < 0:
+        raise ValueError(
+            f"constraint {text!r}: {name} needs a "
+            f"{'finite number >= 0 (kg)' if name == 'max-mass' else 'whole number >= 0'}, "
+            f"e.g. {name}=2"
+        )
+    if name == "max-mass":
+        return MaxMass(float(number))
+    return DoFRange(high=int(number)) if name == "max-dof" else DoFRange(low=int(number))
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,33 @@ class Carrier:
     prefix: str = "srl_"
 
 
+def check_settings(what: str, **values: float) -> None:
+    """Refuse a setting that is not a finite number, or is below its floor: ``samples``
+    (>= 0, whole), ``duration``/``omega``/``limit`` (> 0), ``scale`` (>= 0).
+
+    Raises:
+        ValueError: naming ``what``, the setting and the expectation.
+    """
+    for name, v in values.items():
+        whole = name in ("samples", "seed")
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        if ok and whole:
+            ok = float(v).is_integer() and v >= 0
+        elif ok:
+            ok = v > 0 if name in ("duration", "omega", "limit") else v >= 0
+        if not ok:
+            floor = (
+                "a whole number >= 0"
+                if whole
+                else (
+                    "a finite number > 0"
+                    if name in ("duration", "omega", "limit")
+                    else "a finite number >= 0"
+                )
+            )
+            raise ValueError(f"{what}: {name} must be {floor}, got {v!r}")
+
+
 #: The default carrier: the bundled humanoid, the limb on its back.
 DEFAULT_CARRIER = Carrier()
 
@@ -200,6 +227,7 @@ def payload(
     carrier carries it). Poses where the limb touches itself or the carrier are not
     reachable and are skipped; when every pose is, the payload is 0.
     """
+    check_settings("payload", samples=samples, seed=seed, limit=limit)
     m = mounted or mount(limb, carrier)
     poses = sample_poses(m, samples, seed)
     data = mujoco.MjData(m.model)
@@ -334,6 +362,9 @@ def track(
         RMS distance (m) between tool point and reference over the run, and the mean
         over steps of ``sum |tau_i * dq_i|`` (W; N m rad/s or N m/s).
     """
+    check_settings("track", duration=duration, scale=scale, omega=omega)
+    if reach is not None:
+        check_settings("track", reach=reach)
     m = mounted or mount(limb, carrier)
     model = m.model
     dt = float(model.opt.timestep)
