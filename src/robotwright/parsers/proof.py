@@ -760,7 +760,10 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
 
     try:
         if kind == "mjcf":
-            return mujoco.MjSpec.from_file(str(path)).compile()
+            spec = mujoco.MjSpec.from_file(str(path))
+            model = spec.compile()
+            _SOURCE_MESHES[id(model)] = _mesh_files(spec)
+            return model
         compiler = {
             k: options[k]
             for k in ("balance_inertia", "bound_mass", "bound_inertia")
@@ -788,14 +791,40 @@ def _file_key(path: str | Path) -> tuple[int, str] | None:
     return len(data), hashlib.sha256(data).hexdigest()
 
 
+#: id of a source model compiled by :func:`source_model` -> its mesh files (see
+#: :func:`_mesh_files`); taken by the proof that compiles the output next.
+_SOURCE_MESHES: dict[int, tuple[str, str, dict[tuple[int, str], str]]] = {}
+
+
+def _mesh_files(spec: mujoco.MjSpec) -> tuple[str, str, dict[tuple[int, str], str]]:
+    """The folders and mesh file names of an MJCF as MuJoCo read them: its model folder,
+    its mesh folder, and per file content (size, SHA-256) the name as written."""
+    import os
+
+    folder, meshdir = spec.modelfiledir or "", spec.compiler.meshdir or ""
+    base = Path(folder or ".") / meshdir
+    names: dict[tuple[int, str], str] = {}
+    for mesh in spec.meshes:
+        if mesh.file and not os.path.isabs(mesh.file):
+            key = _file_key(base / mesh.file)
+            if key is not None:
+                names.setdefault(key, mesh.file)
+    return folder, meshdir, names
+
+
 def _compile_with_same_files(
-    xml: str, originals: Iterable[Path], discard_visual: bool = False
+    xml: str,
+    originals: Iterable[Path],
+    discard_visual: bool = False,
+    source: tuple[str, str, dict[tuple[int, str], str]] | None = None,
 ) -> mujoco.MjModel:
     """Compile ``xml``; a mesh file with the same bytes as one of ``originals`` (a copy or
-    a link the writer made) is read through that path, whose compiled mesh MuJoCo has
-    cached: the values compared are the same, the second processing of every mesh
-    (most of a compile) is saved. ``discard_visual``: compile as MuJoCo's URDF import
-    does (``discardvisual``: geoms that neither collide nor carry mass left out)."""
+    a link the writer made) is read through that path, or, given the ``source``'s mesh
+    files (:func:`_mesh_files`), by the name the source's compile read it by: MuJoCo
+    caches a compiled mesh by that name, so the values compared are the same and the
+    second processing of every mesh (most of a compile) is saved. ``discard_visual``:
+    compile as MuJoCo's URDF import does (``discardvisual``: geoms that neither collide
+    nor carry mass left out)."""
     by_key: dict[tuple[int, str], str] = {}
     for p in originals:
         key = _file_key(p)
@@ -804,22 +833,49 @@ def _compile_with_same_files(
     spec = mujoco.MjSpec.from_string(xml)
     if discard_visual:
         spec.compiler.discardvisual = True
+    folder, meshdir, names = source or ("", "", {})
+    # Where MuJoCo reads each file (the writer may give a mesh folder); every file is
+    # then given as an absolute path or, read as the source read it, by the source's name.
+    own = Path(spec.modelfiledir or ".") / (spec.compiler.meshdir or "")
+    relative = False
     for mesh in spec.meshes:
         if mesh.file:
-            key = _file_key(mesh.file)
-            if key is not None and key in by_key:
-                mesh.file = by_key[key]
+            path = own / mesh.file
+            key = _file_key(path)
+            if key is not None and key in names:
+                mesh.file = names[key]
+                relative = True
+            else:
+                mesh.file = by_key.get(key, str(path.absolute())) if key else str(path.absolute())
+    if relative:
+        # Other files, read from the writer's folders, by absolute paths.
+        home = Path(spec.modelfiledir or ".")
+        for tex in spec.textures:
+            if tex.file:
+                tex.file = str((home / (spec.compiler.texturedir or "") / tex.file).absolute())
+        for other in (*spec.hfields, *spec.skins):
+            if other.file:
+                other.file = str((home / other.file).absolute())
+        spec.compiler.texturedir = ""
+    spec.modelfiledir, spec.compiler.meshdir = (folder, meshdir) if relative else ("", "")
     return spec.compile()
 
 
 def result_model(
-    hrdf: HRDF, out_kind: str, work_dir: Path | None, *, discard_visual: bool = False
+    hrdf: HRDF,
+    out_kind: str,
+    work_dir: Path | None,
+    *,
+    discard_visual: bool = False,
+    source: mujoco.MjModel | None = None,
 ) -> tuple[mujoco.MjModel, list[str]]:
     """What the output of ``hrdf`` compiles to, and the notes its writer gives: an HRDF
     folder saved and read back (into ``work_dir``), then generated as MJCF; an MJCF as
     ``export`` writes it; a URDF as MuJoCo imports it. ``discard_visual``: the MJCF
     compiled as MuJoCo compiles a URDF (visual geoms left out), to compare with a URDF
-    source."""
+    source. ``source``: the source as :func:`source_model` compiled it (its meshes are
+    read by the same names, from MuJoCo's cache)."""
+    files = _SOURCE_MESHES.pop(id(source), None) if source is not None else None
     import tempfile
     import warnings
 
@@ -837,7 +893,9 @@ def result_model(
                 except Exception:  # noqa: BLE001 - an unreadable mesh fails the compile
                     continue
             if out_kind == "mjcf":
-                model = _compile_with_same_files(our_mjcf_text(hrdf), originals, discard_visual)
+                model = _compile_with_same_files(
+                    our_mjcf_text(hrdf), originals, discard_visual, files
+                )
             else:
                 from robotwright.hrdf.model import HRDF as _HRDF
 
@@ -846,7 +904,7 @@ def result_model(
                     hrdf.save(folder)
                     loaded = _HRDF.from_dir(folder, asset_roots=hrdf.asset_roots)
                     model = _compile_with_same_files(
-                        our_mjcf_text(loaded), originals, discard_visual
+                        our_mjcf_text(loaded), originals, discard_visual, files
                     )
     return model, [str(w.message) for w in caught]
 
@@ -879,7 +937,7 @@ def prove(
     src = source_model(source, kind, options)
     if src is None:
         return []
-    res, written = result_model(hrdf, out_kind, work_dir, discard_visual=kind == "urdf")
+    res, written = result_model(hrdf, out_kind, work_dir, discard_visual=kind == "urdf", source=src)
     root = options.get("root_body")
     families = None
     if out_kind == "urdf" or kind == "urdf":
