@@ -461,3 +461,69 @@ def test_urdf_source_changed_inertia_is_named(tmp_path: Path, monkeypatch) -> No
     messages = convert(_write(tmp_path, URDF, "u.urdf"), tmp_path / "out")
     lost = [m for m in messages if "proof:" in m]
     assert any("body_mass" in m and "'arm'" in m for m in lost), messages
+
+
+# -- URDF outputs: MuJoCo's import of our URDF against our MJCF ---------------------------------
+def _lose_urdf_damping(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A URDF writer that loses every joint's damping silently."""
+    from robotwright.generators.urdf import URDFHumanoidGenerator
+
+    real = URDFHumanoidGenerator.generate
+
+    def generate(self, *a, **kw):
+        root = real(self, *a, **kw)
+        for joint in root.iter("joint"):
+            for dyn in joint.findall("dynamics"):
+                dyn.attrib.pop("damping", None)
+        return root
+
+    monkeypatch.setattr(URDFHumanoidGenerator, "generate", generate)
+
+
+@pytest.mark.parametrize("source", ["u.urdf", "r.xml"])
+def test_urdf_output_has_no_unreported_difference(tmp_path: Path, source: str) -> None:
+    src = _write(tmp_path, URDF if source.endswith(".urdf") else PLAIN, source)
+    messages = convert(src, tmp_path / "out.urdf")
+    assert not [m for m in messages if "proof:" in m], messages
+
+
+def test_urdf_output_silent_loss_becomes_a_note(tmp_path: Path, monkeypatch) -> None:
+    _lose_urdf_damping(monkeypatch)
+    messages = convert(_write(tmp_path, PLAIN), tmp_path / "out.urdf")
+    lost = [m for m in messages if "proof:" in m]
+    assert len(lost) == 1 and "dof_damping" in lost[0] and "'shoulder'" in lost[0], messages
+    assert "0.5" in lost[0]
+    with pytest.raises(ConversionError, match="dof_damping"):
+        convert(_write(tmp_path, PLAIN), tmp_path / "strict.urdf", strict=True)
+    assert not (tmp_path / "strict.urdf").exists()
+
+
+def test_urdf_form_names_each_changed_value() -> None:
+    from robotwright.parsers.proof_urdf import compare_urdf_form
+
+    a = _model(PLAIN)
+    assert compare_urdf_form(a, a) == []
+    for old, new, field in [
+        ('damping="0.5"', 'damping="0.6"', "dof_damping"),
+        ('range="-1 1"', 'range="-1 1.2"', "jnt_range"),
+        ('pos="0 0 0.2"', 'pos="0 0 0.25"', "body_pos"),
+        ('mass="0.5"', 'mass="0.6"', "body_mass"),
+        ('axis="0 1 0"', 'axis="1 0 0"', "jnt_axis"),
+    ]:
+        diffs = compare_urdf_form(a, _model(PLAIN.replace(old, new)))
+        assert field in {d.field for d in diffs}, (field, diffs)
+
+
+def test_export_urdf_proof(tmp_path: Path, monkeypatch, capsys) -> None:
+    hrdf_dir = tmp_path / "robot"
+    convert(_write(tmp_path, PLAIN), hrdf_dir)
+    assert main(["-v", "export", str(hrdf_dir), "-o", str(tmp_path / "a.urdf")]) == 0
+    assert "proof:" not in capsys.readouterr().err
+    _lose_urdf_damping(monkeypatch)
+    assert main(["-v", "export", str(hrdf_dir), "-o", str(tmp_path / "b.urdf")]) == 0
+    err = capsys.readouterr().err
+    assert "proof:" in err and "dof_damping" in err and "shoulder" in err
+    out = tmp_path / "c.urdf"
+    assert main(["export", str(hrdf_dir), "-o", str(out), "--strict"]) == 2
+    err = capsys.readouterr().err
+    assert "dof_damping" in err and "Traceback" not in err and not out.exists()

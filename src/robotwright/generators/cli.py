@@ -110,6 +110,8 @@ def _export(args: argparse.Namespace) -> int:
     out = Path(args.output)
     # What MuJoCo refuses is not written (validate calls such a robot invalid).
     require_compiles(hrdf, f"cannot write {out}")
+    if args.format == "urdf":
+        _prove_urdf(hrdf, out, args.strict)
     if args.format == "mjcf":
         MJCFHumanoidGenerator.from_hrdf(hrdf).export(
             out,
@@ -129,6 +131,26 @@ def _export(args: argparse.Namespace) -> int:
         )
     print(f"wrote {out} ({args.format}, robot '{hrdf.name}', {len(hrdf.bodies)} bodies)")
     return 0
+
+
+def _prove_urdf(hrdf, out: Path, strict: bool) -> None:
+    """The proof of a URDF output: MuJoCo's import of it against our MJCF of the robot
+    (:mod:`robotwright.parsers.proof_urdf`); each difference the writer does not report
+    is a warning, under ``strict`` an error before anything is written."""
+    import warnings
+
+    from robotwright.errors import ConversionError, ConversionWarning
+    from robotwright.parsers.proof_urdf import prove_urdf_output
+
+    found = prove_urdf_output(hrdf, str(out))
+    if strict and found:
+        raise ConversionError(
+            found,
+            summary=f"strict export of {out}: {len(found)} value(s) differ between our MJCF "
+            "and MuJoCo's import of the URDF",
+        )
+    for p in found:
+        warnings.warn(str(p), ConversionWarning, stacklevel=2)
 
 
 def parse_robot_spec(spec: str) -> tuple[str | None, str, Placement | None]:

@@ -721,9 +721,12 @@ def uncovered(diffs: Sequence[Difference], notes: Sequence[str]) -> list[Differe
 LISTED_PER_FIELD = 20
 
 
-def as_problems(file: str, diffs: Sequence[Difference]) -> list[Problem]:
+def as_problems(
+    file: str, diffs: Sequence[Difference], sides: tuple[str, str] = ("source", "result")
+) -> list[Problem]:
     """Conversion notes for differences no note reported: one per object and field (the
-    first :data:`LISTED_PER_FIELD` of each field, then one line with the count)."""
+    first :data:`LISTED_PER_FIELD` of each field, then one line with the count);
+    ``sides`` names the two models compared."""
     out: list[Problem] = []
     per_field: dict[str, int] = {}
     for d in diffs:
@@ -734,7 +737,8 @@ def as_problems(file: str, diffs: Sequence[Difference]) -> list[Problem]:
             out.append(
                 Problem(
                     file,
-                    f"proof: {what} differs after conversion: source {d.source}, result {d.result}",
+                    f"proof: {what} differs after conversion: {sides[0]} {d.source}, "
+                    f"{sides[1]} {d.result}",
                     element=d.obj,
                     severity="warning",
                 )
@@ -925,18 +929,26 @@ def prove(
     :func:`as_problems`). Empty when MuJoCo does not compile the source.
 
     A URDF source is compared with MuJoCo's own import of it (every link a body, visual
-    geoms discarded as that import does; the output compiled the same way)."""
-    if out_kind == "urdf":
-        # A URDF output is compared with the MJCF of the same robot (prove_urdf_output).
-        return []
+    geoms discarded as that import does; the output compiled the same way). A URDF
+    output is proved in two steps: the source against our MJCF of ``hrdf`` (what the
+    robot holds), and MuJoCo's import of our URDF against that MJCF
+    (:func:`robotwright.parsers.proof_urdf.prove_urdf_output`: what a URDF holds)."""
     options = dict(options or {})
+    found: list[Problem] = []
+    if out_kind == "urdf":
+        # The URDF form against our MJCF of the same robot (what a URDF can hold), and
+        # that MJCF against the source (what the robot holds) below.
+        from robotwright.parsers.proof_urdf import prove_urdf_output
+
+        found = prove_urdf_output(hrdf, str(source), notes)
+        out_kind = "mjcf"
     if kind == "urdf" and options.get("fixed_joints", "keep") != "keep":
         # MuJoCo's import keeps every link a body here (fusing static bodies would fuse
         # the fixed base into the world): links merged on request have no counterpart.
-        return []
+        return found
     src = source_model(source, kind, options)
     if src is None:
-        return []
+        return found
     res, written = result_model(hrdf, out_kind, work_dir, discard_visual=kind == "urdf", source=src)
     root = options.get("root_body")
     families = None
@@ -945,4 +957,4 @@ def prove(
         # <option>: what the parser or generator drops of them is in its notes.
         families = ("body", "jnt", "dof", "geom")
     diffs = compare_models(src, res, root_body=root, families=families, options=families is None)
-    return as_problems(str(source), uncovered(diffs, [*notes, *written]))
+    return found + as_problems(str(source), uncovered(diffs, [*notes, *written]))
