@@ -185,13 +185,19 @@ class PayloadResult:
     per_pose: np.ndarray
 
 
-def holding_torques(m: Mounted, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def holding_torques(
+    m: Mounted, q: np.ndarray, data: mujoco.MjData | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Joint torques (N m / N) that hold pose ``q`` still: ``tau0`` for the limb alone
     (``mj_inverse`` at zero velocity and acceleration, contacts and other constraints
     off) and ``per_kg``, the extra torque per kilogram hung at each tool point
     (``J^T (-g)`` summed over the tool sites). Holding ``M`` kg needs
-    ``tau0 + M * per_kg``: torque is linear in the payload mass at a fixed pose."""
-    model, data = m.model, mujoco.MjData(m.model)
+    ``tau0 + M * per_kg``: torque is linear in the payload mass at a fixed pose.
+    ``data`` (reused between calls when given) gets zero velocity and acceleration."""
+    model = m.model
+    data = data if data is not None else mujoco.MjData(model)
+    data.qvel[:] = 0.0
+    data.qacc[:] = 0.0
     flags = model.opt.disableflags
     model.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
     try:
@@ -243,7 +249,7 @@ def payload(
         return PayloadResult(0.0, -1, poses, np.zeros(0))
     per_pose = np.empty(len(poses))
     for k, qk in enumerate(poses):
-        tau0, a = holding_torques(m, qk)
+        tau0, a = holding_torques(m, qk, data)
         per_pose[k] = _max_mass(tau0, a, m.peak)
     worst = int(np.argmin(per_pose))
     return PayloadResult(float(min(per_pose[worst], limit)), worst, poses, per_pose)
@@ -291,15 +297,16 @@ def ik_path(
     m: Mounted,
     targets: np.ndarray,
     q0: np.ndarray,
-    iters: int = 10,
+    iters: int = 6,
     damping: float = 0.01,
     max_step: float = 0.02,
+    tol: float = 1e-5,
 ) -> np.ndarray:
     """Joint vectors following ``targets`` (m) with the first tool point, by damped least
     squares (``dq = J^T (J J^T + damping^2 I)^-1 e``, ``damping`` in m, the error ``e``
     shortened to at most ``max_step`` m per iteration so the solution moves
     continuously), warm-started from the previous point (``q0`` first; the first point
-    gets ten times the iterations) and clipped to the joint ranges."""
+    gets ten times the iterations), clipped to the joint ranges, stopping at ``tol`` m."""
     model, data = m.model, mujoco.MjData(m.model)
     site = m.sites[0]
     jac = np.zeros((3, model.nv))
@@ -312,7 +319,7 @@ def ik_path(
             mujoco.mj_kinematics(model, data)
             err = target - data.site_xpos[site]
             norm = float(np.sqrt(err @ err))
-            if norm < 1e-7:
+            if norm < tol:
                 break
             if norm > max_step:
                 err *= max_step / norm

@@ -121,7 +121,8 @@ def draw_on_carrier(model: mujoco.MjModel, q: np.ndarray, path: Path, rank: int)
     data = mujoco.MjData(model)
     data.qpos[:] = q
     mujoco.mj_forward(model, data)
-    opts = RenderOptions(width=480, height=360, camera="back")
+    # from behind and to the left: the limb on the back and its depth both show
+    opts = RenderOptions(width=360, height=300, camera="225,-15")
     save_png(render_model(model, data, opts), path, title=f"best_{rank} on its carrier")
 
 
