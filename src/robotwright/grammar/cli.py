@@ -245,6 +245,33 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="allow --workers above the CPU count (each worker is a process started at once)",
     )
     q.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="evaluate on Ray workers (pip install 'robotwright[ray]'): alone, a local Ray "
+        "cluster of --workers CPUs (default: the CPU count; not capped); 'auto', "
+        "'ray://HOST:PORT' or 'HOST:PORT' joins a running cluster. Same result as without",
+    )
+    q.add_argument(
+        "--log",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="write one JSON line per evaluated design to FILE as it comes (design, "
+        "objective values, constraint violations, seed, iteration)",
+    )
+    q.add_argument(
+        "--resume",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="take the evaluations of a log written by --log instead of repeating them, "
+        "and append the new ones to it (or to --log FILE); same result as an "
+        "uninterrupted search with the same seed",
+    )
+    q.add_argument(
         "-o",
         "--out",
         type=Path,
@@ -405,11 +432,30 @@ def _search(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    try:
-        check_workers(args.workers, args.force_workers, "--force-workers")
-    except ValueError as exc:
-        print(f"error: --workers: {exc}", file=sys.stderr)
+    if args.ray is None:
+        try:
+            check_workers(args.workers, args.force_workers, "--force-workers")
+        except ValueError as exc:
+            print(f"error: --workers: {exc}", file=sys.stderr)
+            return 2
+    elif args.ray and args.workers is not None:
+        print(
+            "error: --workers: a Ray cluster joined (--ray ADDRESS) has the workers it has; "
+            "expected --workers only with --ray alone (a local cluster)",
+            file=sys.stderr,
+        )
         return 2
+    _check_log_paths(args)
+    if args.ray is not None:
+        from robotwright.grammar.executors import check_ray_address, import_ray
+
+        try:
+            if args.ray:
+                check_ray_address(args.ray)
+            import_ray()
+        except (ValueError, ImportError) as exc:
+            print(f"error: --ray: {exc}", file=sys.stderr)
+            return 2
     objective = OBJECTIVES[args.objective]()
     t0 = time.perf_counter()
     kw = dict(
@@ -420,12 +466,15 @@ def _search(args: argparse.Namespace) -> int:
         force_workers=args.force_workers,
         progress=_search_progress(args.budget, objective.name),
     )
-    if args.method == "beam":
-        res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
-    elif args.method == "mcts":
-        res = mcts_search(g, [objective], constraints, **kw)
-    else:
-        res = random_search(g, [objective], constraints, **kw)
+    kw.update(log=args.log, resume=args.resume)
+    with _ray_executor(args) as executor:
+        kw.update(executor=executor)
+        if args.method == "beam":
+            res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
+        elif args.method == "mcts":
+            res = mcts_search(g, [objective], constraints, **kw)
+        else:
+            res = random_search(g, [objective], constraints, **kw)
     dt = time.perf_counter() - t0
     print(f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s")
     if res.best is None:
@@ -443,6 +492,39 @@ def _search(args: argparse.Namespace) -> int:
         )
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
     return 0
+
+
+def _check_log_paths(args: argparse.Namespace) -> None:
+    """Before any work: --resume must be a file; --log must not replace a file unless it
+    is the log resumed (appended to) or --overwrite is given."""
+    if args.resume is not None and not args.resume.is_file():
+        what = "is not a file" if args.resume.exists() else "does not exist"
+        raise InputFileError(args.resume, f"{what}; expected a log written by --log")
+    if args.log is None:
+        return
+    check_output_path(args.log)
+    if args.resume is not None and args.log.exists() and args.log.samefile(args.resume):
+        return
+    check_overwrite(args.log, args.overwrite)
+
+
+def _ray_executor(args: argparse.Namespace):
+    """A :class:`RayExecutor` for ``--ray`` (stopped at the end when it started a local
+    cluster), else a context giving ``None`` (the local process pool)."""
+    from contextlib import nullcontext
+
+    if args.ray is None:
+        return nullcontext(None)
+    from robotwright.grammar.executors import RayExecutor
+
+    try:
+        if args.ray:
+            return RayExecutor(address=args.ray)
+        return RayExecutor(num_cpus=args.workers)
+    except (ConnectionError, RuntimeError, ValueError) as exc:
+        # Ray's own words, on one line: the cluster could not be started or joined.
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise InputFileError("--ray", f"cannot start or join the Ray cluster: {first}") from None
 
 
 def _read_design(path: Path):

@@ -2,31 +2,39 @@
 and uniform random search, with evaluations run through an executor.
 
 Reproducible: all randomness comes from one ``random.Random(seed)``; evaluation order
-does not depend on the executor, because results are gathered in submission order.
+does not depend on the executor, because results are gathered in submission order. The
+executor is a local process pool, a Ray cluster (:class:`RayExecutor`), or any
+:class:`concurrent.futures.Executor` given. Evaluations may stream to a JSON-lines log
+and a stopped search resume from it (:mod:`robotwright.grammar.searchlog`).
 """
 
 from __future__ import annotations
 
 import os
 import random
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial as bind
+from pathlib import Path
+from typing import Any
 
 from robotwright.grammar.derive import Counter, Partial, choices_at, options, random_step, sample
 from robotwright.grammar.design import Design
+from robotwright.grammar.executors import RayExecutor, pool_size, usable_cores
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, evaluate
 from robotwright.grammar.rules import Grammar
+from robotwright.grammar.searchlog import SearchLog, read_log
 
-
-def usable_cores() -> int:
-    """The number of CPU cores this process may run on (its affinity where the system
-    reports one, else the machine's count)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
+__all__ = [
+    "RayExecutor",
+    "SearchResult",
+    "beam_search",
+    "check_workers",
+    "mcts_search",
+    "random_search",
+    "usable_cores",
+]
 
 
 def check_workers(
@@ -66,7 +74,8 @@ class SearchResult:
 
 
 class _Evaluator:
-    """Evaluates batches of designs once each (by hash) through an executor."""
+    """Evaluates batches of designs once each (by hash) through an executor, taking
+    those found in a resumed log from it and appending the others to the log."""
 
     def __init__(
         self,
@@ -78,31 +87,50 @@ class _Evaluator:
         workers: int | None,
         progress: Callable[[int, Evaluation | None], None] | None = None,
         force_workers: bool = False,
+        *,
+        log: str | os.PathLike[str] | None = None,
+        resume: str | os.PathLike[str] | None = None,
+        header: Mapping[str, Any] | None = None,
     ) -> None:
         if executor is None:  # the pool started here has ``workers`` processes
             check_workers(workers, force_workers)
         self.progress = progress
-        self.fn = bind(
-            evaluate, grammar, objectives=tuple(objectives), constraints=tuple(constraints)
-        )
+        objectives, constraints = tuple(objectives), tuple(constraints)
+        self.fn = bind(evaluate, grammar, objectives=objectives, constraints=constraints)
         self.budget = budget
         self.cache: dict[str, Evaluation] = {}
         self.order: list[Evaluation] = []
         self._own = executor is None
         self.executor = executor
         self.workers = workers
+        # Read before the log is opened: resuming into the same file appends to it.
+        self.known: dict[str, Evaluation] = (
+            read_log(resume, grammar.name, objectives, constraints) if resume else {}
+        )
+        same = resume is not None and (log is None or _same_file(log, resume))
+        # Appending to the resumed log: its own evaluations are in it already.
+        self._log_known = not same
+        path = resume if same else log
+        self.log = (
+            SearchLog(path, grammar.name, objectives, constraints, append=same, **(header or {}))
+            if path is not None
+            else None
+        )
 
     def __enter__(self) -> _Evaluator:
         if self.executor is None:
             # Never more processes than evaluations: a forced count above the budget
             # would only start idle processes.
-            wanted = self.workers or usable_cores()
-            self.executor = ProcessPoolExecutor(max_workers=max(1, min(wanted, self.budget)))
+            self.executor = ProcessPoolExecutor(max_workers=pool_size(self.workers, self.budget))
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._own and self.executor is not None:
-            self.executor.shutdown()
+        try:
+            if self._own and self.executor is not None:
+                self.executor.shutdown()
+        finally:
+            if self.log is not None:
+                self.log.close()
 
     @property
     def left(self) -> int:
@@ -118,14 +146,29 @@ class _Evaluator:
                 todo.append(d)
                 seen.add(h)
         assert self.executor is not None
-        # A few chunks per worker: fewer pickles of the grammar, still balanced.
-        chunk = max(1, len(todo) // (4 * (self.workers or os.cpu_count() or 1)))
-        for d, ev in zip(todo, self.executor.map(self.fn, todo, chunksize=chunk)):
-            self.cache[d.hash()] = ev
+        new = [d for d in todo if d.hash() not in self.known]
+        # A few batches per worker: fewer pickles of the grammar, still balanced.
+        workers = getattr(self.executor, "workers", None) or self.workers or usable_cores()
+        chunk = max(1, len(new) // (4 * workers))
+        results = iter(self.executor.map(self.fn, new, chunksize=chunk)) if new else iter(())
+        for d in todo:  # submission order: the same on every executor
+            h = d.hash()
+            known = self.known.get(h)
+            ev = known if known is not None else next(results)
+            self.cache[h] = ev
             self.order.append(ev)
+            if self.log is not None and (known is None or self._log_known):
+                self.log.write(ev, len(self.order) - 1)
         if self.progress is not None and todo:
             self.progress(len(self.order), _best(self.order))
         return [self.cache.get(d.hash()) for d in designs]
+
+
+def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return Path(a).resolve() == Path(b).resolve()
 
 
 def _best(evals: list[Evaluation]) -> Evaluation | None:
@@ -145,12 +188,33 @@ def random_search(
     workers: int | None = None,
     progress: Callable[[int, Evaluation | None], None] | None = None,
     force_workers: bool = False,
+    log: str | os.PathLike[str] | None = None,
+    resume: str | os.PathLike[str] | None = None,
 ) -> SearchResult:
-    """Evaluate ``budget`` distinct designs drawn uniformly (baseline for beam search)."""
+    """Evaluate ``budget`` distinct designs drawn uniformly (baseline for beam search).
+
+    Shared by the three searches: ``executor`` runs the evaluations (default: a pool of
+    ``workers`` processes, at most the usable cores unless ``force_workers``; or a
+    :class:`RayExecutor`); ``progress(n, best)`` is called after each batch; ``log``
+    names a JSON-lines file that gets one line per evaluation as it comes, and
+    ``resume`` a log whose evaluations are taken instead of evaluated again (appended
+    to when ``log`` is not given or is the same file). Results do not depend on the
+    executor, nor on a stop and a resume: the same seed gives the same result.
+    """
     rng = random.Random(seed)
     counter = Counter(grammar)
     with _Evaluator(
-        grammar, objectives, constraints, budget, executor, workers, progress, force_workers
+        grammar,
+        objectives,
+        constraints,
+        budget,
+        executor,
+        workers,
+        progress,
+        force_workers,
+        log=log,
+        resume=resume,
+        header=dict(method="random", seed=seed, budget=budget, max_links=max_links),
     ) as ev:
         tries = 0
         while ev.left > 0 and tries < 20 * budget:
@@ -174,6 +238,8 @@ def beam_search(
     workers: int | None = None,
     progress: Callable[[int, Evaluation | None], None] | None = None,
     force_workers: bool = False,
+    log: str | os.PathLike[str] | None = None,
+    resume: str | os.PathLike[str] | None = None,
 ) -> SearchResult:
     """Beam search over partial derivations in canonical order.
 
@@ -188,7 +254,17 @@ def beam_search(
     counter = Counter(grammar)
     beam = [Partial.start(grammar)]
     with _Evaluator(
-        grammar, objectives, constraints, budget, executor, workers, progress, force_workers
+        grammar,
+        objectives,
+        constraints,
+        budget,
+        executor,
+        workers,
+        progress,
+        force_workers,
+        log=log,
+        resume=resume,
+        header=dict(method="beam", seed=seed, budget=budget, max_links=max_links),
     ) as ev:
         while beam and ev.left > 0:
             children: list[Partial] = []
@@ -264,6 +340,8 @@ def mcts_search(
     workers: int | None = None,
     progress: Callable[[int, Evaluation | None], None] | None = None,
     force_workers: bool = False,
+    log: str | os.PathLike[str] | None = None,
+    resume: str | os.PathLike[str] | None = None,
 ) -> SearchResult:
     """Monte Carlo tree search (UCT) over the decisions of canonical derivations.
 
@@ -292,7 +370,17 @@ def mcts_search(
         return 0.5 * (n.total / n.visits) + 0.5 * n.best if n.visits else 0.0
 
     with _Evaluator(
-        grammar, objectives, constraints, budget, executor, workers, progress, force_workers
+        grammar,
+        objectives,
+        constraints,
+        budget,
+        executor,
+        workers,
+        progress,
+        force_workers,
+        log=log,
+        resume=resume,
+        header=dict(method="mcts", seed=seed, budget=budget, max_links=max_links),
     ) as ev:
         k = batch or max(1, 2 * (ev.workers or os.cpu_count() or 1))
         stalls = 0
