@@ -1,116 +1,68 @@
-"""The semantic LiDAR as an mjlab sensor, with observation terms (``robotwright[mjlab]``).
+"""The semantic LiDAR as an mjlab ``RayCastSensor`` whose data is a ``RayCastData``.
 
-:class:`SemanticLidarSensorCfg` goes into ``SceneCfg.sensors`` like mjlab's own
-``RayCastSensorCfg``; the sensor it builds *is* an mjlab ``RayCastSensor``, so the scene
-wires it to the shared ``SensorContext`` (one BVH for every ray sensor and camera) and
-casts inside mjlab's sense graph (a CUDA graph on GPU). Inside that graph, per step, it
-launches robotwright's kernels around mjlab's ray cast: ``advance_frame`` (the pattern
-window, counter on the device), ``sensor_pose``, ``world_rays`` (the window of the
-pattern table), MuJoCo Warp ``rays`` (the call of mjlab's ``RayCastSensor`` with its
-arguments: BVH, parent-body exclusion, geom-group filter), then ``finish_rays`` (float64
-refinement of curved hits, range model, labels, points); on warp's CPU device the last
-three run in column blocks on parallel threads. Nothing runs on the host per step and
-nothing is copied:
-mjlab's ``prepare_rays`` (host, before the graph) is replaced by the in-graph kernels and
+The sensor *is* an mjlab ``RayCastSensor``, so the scene wires it to the shared
+``SensorContext`` (one BVH for every ray sensor and camera) and casts inside mjlab's sense
+graph (a CUDA graph on GPU). Inside that graph, per step, it launches robotwright's
+kernels around mjlab's ray cast: ``advance_frame`` (the pattern window, counter on the
+device), ``sensor_pose`` (sensor and carrier frame poses), ``world_rays`` (the window of
+the pattern table), MuJoCo Warp ``rays`` (the call of mjlab's ``RayCastSensor`` with its
+arguments: BVH, parent-body exclusion, geom-group filter), ``finish_rays`` (float64
+refinement of curved hits, range model, labels, points) and ``mjlab_misses`` (mjlab's
+miss values); on warp's CPU device the last four run in column blocks on parallel
+threads. Nothing runs on the host per step and nothing is copied: mjlab's
+``prepare_rays`` (host, before the graph) is replaced by the in-graph kernels and
 ``postprocess_rays`` (host, after it) only marks the data fresh.
 
-``env.scene["lidar"].data`` is a :class:`MjlabSemanticLidarData` of torch tensors on the
-environment's device, views of the device buffers (the same tensors every step):
-``distances``, ``semantic_labels``, ``geom_ids``, ``hit_mask`` ``(num_envs, num_rays)``
-and ``hit_pos_w`` ``(num_envs, num_rays, 3)`` (world frame [m], NaN for misses).
-
-Which geoms rays see (the robot's own geoms included or not): mjlab's
-``include_geom_groups``, here ``(0,)`` by default (mjlab's robots keep their visual
-meshes in group 2 and collision geoms in group 3, terrain and plain props sit in group
-0, so the robot does not see itself), and ``exclude_parent_body`` (the carrier body).
-:meth:`MjlabSemanticLidarSensor.initialize` warns when geoms of the carrier's own robot
-are left in an included group.
-
-Terrain: mjlab names its terrain geoms ``terrain`` (plane) or ``terrain_<n>`` (boxes and
-heightfields of generated terrain), under the terrain entity's body: their paths are
-``/world/terrain/terrain[_<n>]``, which none of the default mapping's terrain keywords
-("ground", "wall", "floor", "plane") matches. The default mapping is kept as
-is; :func:`mjlab_class_mapping` adds the keyword ``/world/terrain/`` to the
-terrain class, and the sensor warns when the terrain would read class 0.
-
-This module imports mjlab; ``robotwright.sensors`` never imports it.
+``env.scene["lidar"].data`` is a :class:`MjlabSemanticLidarData`, a ``RayCastData`` with
+mjlab's meanings (so ``height_scan``, ``terrain_normal_from_sensors`` and the ``upright``
+reward read it as they read mjlab's sensor) plus the semantic fields.
 """
 
 from __future__ import annotations
 
 import copy
-import math
 import warnings
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Literal
 
 import mujoco
+import mujoco_warp as mjw
 import numpy as np
 import torch
+import warp as wp  # no global warp setting is changed here: mjlab configures warp
+from mjlab.sensor.raycast_sensor import RayCastData, RayCastSensor
 
 from robotwright.errors import SensorError
-from robotwright.sensors.device import import_warp, ray_blocks
-
-# Before mjlab initialises warp: warp quiet, as the core's warp engine keeps it.
-wp, mjw = import_warp()
-
-from mjlab.sensor.builtin_sensor import ObjRef  # noqa: E402
-from mjlab.sensor.raycast_sensor import RayCastSensor, RayCastSensorCfg  # noqa: E402
-
-from robotwright.sensors import _warp_kernels as kernels  # noqa: E402
-from robotwright.sensors.config import (  # noqa: E402
-    DEFAULT_SEMANTIC_CLASS_MAPPING,
-    SemanticLidarCfg,
+from robotwright.sensors import _warp_kernels as kernels
+from robotwright.sensors.device import ray_blocks
+from robotwright.sensors.lidar import geom_paths
+from robotwright.sensors.mjlab import _kernels as mjlab_kernels
+from robotwright.sensors.mjlab.config import (
+    MJLAB_TERRAIN_KEYWORD,
+    ResolvedLidarCfg,
+    SemanticLidarSensorCfg,
+    resolve,
 )
-from robotwright.sensors.lidar import geom_paths  # noqa: E402
-from robotwright.sensors.patterns import (  # noqa: E402
-    GridPatternCfg,
-    LivoxPatternCfg,
-    PatternCfg,
-    RayTable,
-)
-from robotwright.sensors.semantic import classify_path, geom_class_table  # noqa: E402
+from robotwright.sensors.patterns import PatternCfg, RayTable
+from robotwright.sensors.semantic import classify_path, geom_class_table
 
-__all__ = [
-    "MJLAB_TERRAIN_KEYWORD",
-    "MjlabSemanticLidarData",
-    "MjlabSemanticLidarSensor",
-    "SemanticLidarSensorCfg",
-    "lidar_class_ids",
-    "lidar_distances_normalized",
-    "lidar_one_hot_classes",
-    "lidar_semantic_obs",
-    "mjlab_class_mapping",
-]
+__all__ = ["CLASS_COLORS", "MjlabSemanticLidarData", "MjlabSemanticLidarSensor"]
 
 _ALIGN = {"base": kernels.ALIGN_BASE, "yaw": kernels.ALIGN_YAW, "world": kernels.ALIGN_WORLD}
 
-#: Path prefix of the geoms of mjlab's terrain entity (plane, boxes, heightfields).
-MJLAB_TERRAIN_KEYWORD = "/world/terrain/"
+#: RGBA of the class ids drawn by ``debug_vis`` (id modulo the length; 0 = unknown).
+CLASS_COLORS: tuple[tuple[float, float, float, float], ...] = (
+    (0.5, 0.5, 0.5, 1.0),
+    (0.55, 0.35, 0.15, 1.0),
+    (0.9, 0.1, 0.1, 1.0),
+    (0.1, 0.4, 0.95, 1.0),
+    (0.1, 0.8, 0.2, 1.0),
+    (0.9, 0.7, 0.1, 1.0),
+    (0.7, 0.2, 0.8, 1.0),
+)
 
-
-def mjlab_class_mapping(
-    mapping: dict[str, list[str]] | None = None, terrain_class: str = "terrain"
-) -> dict[str, list[str]]:
-    """A class mapping under which mjlab's terrain geoms belong to ``terrain_class``.
-
-    Returns a copy of ``mapping`` (``None``: the default mapping) with
-    :data:`MJLAB_TERRAIN_KEYWORD` appended to the keywords of ``terrain_class`` (the class
-    is added last when the mapping lacks it). Keyword matching stays the default
-    case-insensitive substring rule, so nothing else changes class.
-    """
-    base = DEFAULT_SEMANTIC_CLASS_MAPPING if mapping is None else mapping
-    out = {k: list(v) for k, v in base.items()}
-    keywords = out.setdefault(terrain_class, [])
-    if MJLAB_TERRAIN_KEYWORD not in keywords:
-        keywords.append(MJLAB_TERRAIN_KEYWORD)
-    return out
-
-
-def _is_mjlab_pattern(pattern: object) -> bool:
-    """mjlab's own patterns (grid, pinhole, ring) and anything with its protocol."""
-    return not isinstance(pattern, PatternCfg) and callable(getattr(pattern, "generate_rays", None))
+EnvIds = torch.Tensor | np.ndarray | list[int] | slice | None
 
 
 def _table_of(pattern: Any, mj_model: mujoco.MjModel) -> RayTable:
@@ -138,139 +90,63 @@ class _TablePattern:
         )
 
 
-@dataclass(kw_only=True)
-class SemanticLidarSensorCfg(RayCastSensorCfg):
-    """mjlab config of a semantic LiDAR: the SemanticLidarCfg fields on mjlab's ray-cast sensor.
-
-    Frames: the pattern is given in the sensor frame (+x forward, +z up), which sits at
-    ``offset_pos``/``offset_rot`` in the ``frame`` object's frame; outputs are in the
-    world frame; distances [m].
-
-    Attributes:
-        name: the sensor's key in ``env.scene``.
-        frame: the body, site or geom carrying the sensor (one ``ObjRef``, e.g.
-            ``ObjRef(type="body", name="trunk", entity="robot")``).
-        pattern: any robotwright pattern (:class:`~robotwright.sensors.LivoxPatternCfg`
-            Mid-360/Avia rosettes advance one window per step; spinning, grid, pinhole
-            and file patterns repeat), or one of mjlab's own patterns (grid, pinhole,
-            ring), cast as a repeating pattern. Default: a 20 000-ray Mid-360.
-        offset_pos: sensor position in the frame object's frame [m] (default: at its
-            origin, as mjlab's ray sensor).
-        offset_rot: sensor orientation in that frame, quaternion (w, x, y, z).
-        semantic_class_mapping: class -> keywords matched case-insensitively in geom
-            paths (``/world/<bodies>/<geom>[/<mesh>]``); class ids 1..K in mapping
-            order, 0 = miss/unknown. ``None``: the default mapping (see
-            :func:`mjlab_class_mapping` for mjlab's terrain).
-        min_distance, max_distance: hits nearer or further are misses [m].
-        range_noise_std: Gaussian range noise on hits [m], clipped to the range.
-        dropout_prob: probability that a hit is dropped (becomes a miss).
-        seed: base seed of the per-environment noise streams (``None``: fresh entropy).
-        miss_distance: distance of a miss [m]; ``None``: ``max_distance``.
-        num_threads: on warp's CPU device, cast the rays in this many column blocks on
-            parallel threads (``None``: one per core); CUDA always casts in one launch.
-        refine_curved_hits: recompute hits on spheres, capsules, ellipsoids and cylinders
-            in float64 from the compiled geom sizes (turn off when ``geom_size`` is
-            randomised per environment).
-        ray_alignment: ``"base"``, ``"yaw"`` or ``"world"`` (as mjlab's).
-        exclude_parent_body: rays ignore the body carrying the sensor (as mjlab's).
-        include_geom_groups: geom groups rays can hit (as mjlab's; here ``(0,)`` by
-            default: terrain and props, not the robot's visual and collision groups).
-    """
-
-    frame: ObjRef
-    pattern: Any = field(default_factory=LivoxPatternCfg)
-    offset_pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    offset_rot: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
-    semantic_class_mapping: dict[str, list[str]] | None = None
-    min_distance: float = 0.0
-    max_distance: float = 40.0
-    range_noise_std: float = 0.0
-    dropout_prob: float = 0.0
-    seed: int | None = 0
-    miss_distance: float | None = None
-    refine_curved_hits: bool = True
-    num_threads: int | None = None
-    include_geom_groups: tuple[int, ...] | None = (0,)
-
-    def __post_init__(self) -> None:
-        name = type(self).__name__
-        if not isinstance(self.frame, ObjRef) or self.frame.type not in ("body", "site", "geom"):
-            raise SensorError(
-                f"{name}.frame: expected one ObjRef of a body, site or geom, got {self.frame!r}"
-            )
-        if not isinstance(self.pattern, PatternCfg) and not _is_mjlab_pattern(self.pattern):
-            raise SensorError(
-                f"{name}.pattern: expected a robotwright PatternCfg or an mjlab pattern, "
-                f"got {type(self.pattern).__name__}"
-            )
-        if not isinstance(self.refine_curved_hits, bool):
-            raise SensorError(f"{name}.refine_curved_hits: expected True or False")
-        # The core config validates and normalises the shared fields (ranges, noise,
-        # mapping, offsets, alignment, seed) with the same rules and messages.
-        core = SemanticLidarCfg(
-            prim_path=self.frame.prefixed_name(),
-            pattern_cfg=self.pattern if isinstance(self.pattern, PatternCfg) else GridPatternCfg(),
-            offset_pos=self.offset_pos,
-            offset_rot=self.offset_rot,
-            ray_alignment=self.ray_alignment,
-            min_distance=self.min_distance,
-            max_distance=self.max_distance,
-            range_noise_std=self.range_noise_std,
-            dropout_prob=self.dropout_prob,
-            seed=self.seed,
-            miss_distance=self.miss_distance,
-            num_threads=self.num_threads,
-            semantic_class_mapping=self.semantic_class_mapping,
-        )
-        self.offset_pos = core.offset_pos
-        self.offset_rot = core.offset_rot
-        self.miss_distance = float(core.miss_distance)  # type: ignore[arg-type]
-        if not math.isfinite(self.miss_distance):
-            raise SensorError(f"{name}.miss_distance: expected a finite number [m]")
-        self.semantic_class_mapping = {
-            k: list(v) for k, v in (core.semantic_class_mapping or {}).items()
-        }
-
-    def build(self) -> MjlabSemanticLidarSensor:
-        return MjlabSemanticLidarSensor(self)
-
-
 @dataclass
-class MjlabSemanticLidarData:
-    """Torch views of the device buffers (``E`` envs, ``N`` rays), world frame.
+class MjlabSemanticLidarData(RayCastData):
+    """mjlab's ``RayCastData`` (``E`` envs, ``N`` rays, one frame ``F = 1``) plus labels.
 
-    Overwritten in place by every ``sim.sense()``; the same tensor objects every step.
+    Torch views of the device buffers, overwritten in place by every ``sim.sense()``;
+    the same tensor objects every step. mjlab's fields keep mjlab's meanings:
 
     Attributes:
-        distances: ``(E, N)`` float32 range [m]; misses hold ``miss_distance``.
+        distances: ``(E, N)`` float32 range [m]; -1 for a miss (nothing hit, out of
+            ``[min_distance, max_distance]``, or dropped).
+        normals_w: ``(E, N, 3)`` unit surface normal at the hit (world frame, computed by
+            MuJoCo Warp); zero for a miss.
+        hit_pos_w: ``(E, N, 3)`` hit point [m] (world); the ray origin for a miss.
+        pos_w: ``(E, 3)`` position of the frame object [m]; quat_w: ``(E, 4)`` its
+            orientation (w, x, y, z) (``frame_*[:, 0]``, as mjlab's).
+        frame_pos_w: ``(E, 1, 3)``; frame_quat_w: ``(E, 1, 4)``: the frame object's pose.
         hit_mask: ``(E, N)`` bool, True where the ray returned a point.
-        semantic_labels: ``(E, N)`` int32 class id (1..K in mapping order, 0 miss/unknown).
+        semantic_labels: ``(E, N)`` int32 class id (1..K in mapping order, the robot's
+            own class after them, 0 miss/unknown).
         geom_ids: ``(E, N)`` int32 MuJoCo geom id of the hit, -1 on a miss.
-        hit_pos_w: ``(E, N, 3)`` float32 hit points [m], NaN on a miss.
         ray_origins_w: ``(E, N, 3)`` this step's ray origins [m].
         ray_directions_w: ``(E, N, 3)`` this step's unit ray directions.
-        pos_w: ``(E, 3)`` sensor position [m]; quat_w: ``(E, 4)`` orientation (w, x, y, z).
+        sensor_pos_w: ``(E, 3)`` the LiDAR's position (``offset_pos`` applied) [m];
+            sensor_quat_w: ``(E, 4)`` its orientation (w, x, y, z).
         frame: ``(1,)`` int32 index of the last cast pattern frame (0 for the first).
     """
 
-    distances: torch.Tensor
     hit_mask: torch.Tensor
     semantic_labels: torch.Tensor
     geom_ids: torch.Tensor
-    hit_pos_w: torch.Tensor
     ray_origins_w: torch.Tensor
     ray_directions_w: torch.Tensor
-    pos_w: torch.Tensor
-    quat_w: torch.Tensor
+    sensor_pos_w: torch.Tensor
+    sensor_quat_w: torch.Tensor
     frame: torch.Tensor
+
+    @property
+    def mesh_ids(self) -> torch.Tensor:
+        """The seed's name of :attr:`geom_ids`."""
+        return self.geom_ids
+
+
+def _rows(tensor: torch.Tensor, env_ids: EnvIds) -> torch.Tensor:
+    if env_ids is None:
+        return tensor
+    if isinstance(env_ids, slice):
+        return tensor[env_ids]
+    return tensor[torch.as_tensor(env_ids, dtype=torch.long, device=tensor.device)]
 
 
 class MjlabSemanticLidarSensor(RayCastSensor):
     """mjlab ``RayCastSensor`` whose rays follow a robotwright pattern and carry labels.
 
     Attributes (after ``initialize``):
+        resolved: the checked values of the config (:class:`ResolvedLidarCfg`).
         table: the pattern's :class:`~robotwright.sensors.RayTable` (sensor frame).
-        class_names: ``("unknown", *classes)``, indexed by class id.
+        class_names: ``("unknown", *classes[, self_class])``, indexed by class id.
         geom_paths: classification path of every geom of the compiled scene.
         geom_semantic_class: ``(ngeom,)`` class id of every geom (0 where not hittable).
         hittable_geom_mask: ``(ngeom,)`` geoms the rays can hit (included groups, minus
@@ -280,15 +156,24 @@ class MjlabSemanticLidarSensor(RayCastSensor):
     cfg: SemanticLidarSensorCfg
 
     def __init__(self, cfg: SemanticLidarSensorCfg) -> None:
+        self.resolved: ResolvedLidarCfg = resolve(cfg)
         super().__init__(cfg)
-        self.semantic_class_mapping: dict[str, list[str]] = dict(cfg.semantic_class_mapping or {})
-        self.class_names: tuple[str, ...] = ("unknown", *self.semantic_class_mapping)
         self._buffers: dict[str, Any] = {}
         self._pool: ThreadPoolExecutor | None = None
         self._blocks: list[tuple[int, int]] = []
 
+    @property
+    def class_names(self) -> tuple[str, ...]:
+        return self.resolved.class_names
+
+    @property
+    def semantic_class_mapping(self) -> dict[str, list[str]]:
+        return self.resolved.mapping
+
     def initialize(self, mj_model: mujoco.MjModel, model: Any, data: Any, device: str) -> None:
         cfg = self.cfg
+        # Fields may have changed since build(): check and derive again.
+        self.resolved = res = resolve(cfg)
         self.table = _table_of(cfg.pattern, mj_model)
         # mjlab's own initialisation resolves the frame and sizes its ray buffers from
         # cfg.pattern: hand it frame 0 of the table, then restore the user's config.
@@ -305,17 +190,19 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         self._carrier, self._kind = obj, kind
         self.geom_paths = geom_paths(mj_model)
         self.hittable_geom_mask = self._hittable(mj_model, body)
-        lut = geom_class_table(
-            self.geom_paths, self.semantic_class_mapping, self.hittable_geom_mask
-        )
+        lut = geom_class_table(self.geom_paths, res.mapping, self.hittable_geom_mask)
+        own = self._own_geoms(mj_model, body) & self.hittable_geom_mask
+        if res.self_class_id:
+            lut[:-1][own] = res.self_class_id
         self.geom_semantic_class = lut[:-1]
-        self._check_scene(mj_model, body)
+        self._check_scene(own)
         e, n = int(data.nworld), int(self.table.rays_per_frame)
         seeds = np.random.SeedSequence(cfg.seed).generate_state(e).astype(np.uint32)
         dev = self._wp_device
         # Load the kernels now: mjlab captures its sense graph later, and no module may
         # be compiled or loaded during a CUDA graph capture.
         wp.load_module(kernels, device=dev)
+        wp.load_module(mjlab_kernels, device=dev)
         with wp.ScopedDevice(dev):
             b = {
                 "table_o": wp.array(self.table.origins.astype(np.float32), dtype=wp.vec3),
@@ -330,32 +217,48 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 "quat_w": wp.zeros(e, dtype=wp.vec4),
                 "sensor_mat": wp.zeros(e, dtype=wp.mat33),
                 "ray_rot": wp.zeros(e, dtype=wp.mat33),
-                "distances": wp.full((e, n), float(cfg.miss_distance), dtype=wp.float32),
+                "frame_pos": wp.zeros(e, dtype=wp.vec3),
+                "frame_quat": wp.zeros(e, dtype=wp.vec4),
+                "frame_mat": wp.zeros(e, dtype=wp.mat33),
+                "frame_rot": wp.zeros(e, dtype=wp.mat33),
+                "distances": wp.full((e, n), -1.0, dtype=wp.float32),
                 "hit_mask": wp.zeros((e, n), dtype=wp.bool),
                 "geom_ids": wp.full((e, n), -1, dtype=wp.int32),
                 "labels": wp.zeros((e, n), dtype=wp.int32),
-                "points": wp.full((e, n), wp.vec3(np.nan, np.nan, np.nan), dtype=wp.vec3),
+                "points": wp.zeros((e, n), dtype=wp.vec3),
             }
         rot = np.empty(9)
-        mujoco.mju_quat2Mat(rot, np.asarray(cfg.offset_rot, dtype=np.float64))
-        self._offset_pos = wp.vec3(*np.asarray(cfg.offset_pos, dtype=np.float32))
+        mujoco.mju_quat2Mat(rot, np.asarray(res.offset_rot, dtype=np.float64))
+        self._offset_pos = wp.vec3(*np.asarray(res.offset_pos, dtype=np.float32))
         self._offset_mat = wp.mat33(*rot.astype(np.float32))
+        self._zero_pos = wp.vec3(0.0, 0.0, 0.0)
+        self._identity = wp.mat33(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
         self._buffers = b
         self._blocks = ray_blocks(n, dev, cfg.num_threads)
         self._pool = ThreadPoolExecutor(len(self._blocks)) if len(self._blocks) > 1 else None
         t = wp.to_torch
+        frame_pos, frame_quat = t(b["frame_pos"]), t(b["frame_quat"])
         self._lidar_data = MjlabSemanticLidarData(
             distances=t(b["distances"]),
+            normals_w=t(self._ray_normal),
+            hit_pos_w=t(b["points"]),
+            pos_w=frame_pos,
+            quat_w=frame_quat,
+            frame_pos_w=frame_pos.view(e, 1, 3),
+            frame_quat_w=frame_quat.view(e, 1, 4),
             hit_mask=t(b["hit_mask"]),
             semantic_labels=t(b["labels"]),
             geom_ids=t(b["geom_ids"]),
-            hit_pos_w=t(b["points"]),
             ray_origins_w=t(self._ray_pnt),
             ray_directions_w=t(self._ray_vec),
-            pos_w=t(b["pos_w"]),
-            quat_w=t(b["quat_w"]),
+            sensor_pos_w=t(b["pos_w"]),
+            sensor_quat_w=t(b["quat_w"]),
             frame=t(b["frame"]),
         )
+        self._sensor_mat = t(b["sensor_mat"])
+        self._ray_rot = t(b["ray_rot"])
+        self._frame_mat = t(b["frame_mat"])
+        self._obs_cache: dict[Any, Any] = {}
 
     def __del__(self) -> None:  # pragma: no cover - best effort at teardown
         if getattr(self, "_pool", None) is not None:
@@ -371,21 +274,27 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             mask &= mj_model.geom_bodyid != parent_body
         return mask
 
-    def _check_scene(self, mj_model: mujoco.MjModel, parent_body: int) -> None:
-        """Warn about self-hits and unclassified terrain (both silent otherwise)."""
-        name = self.cfg.name
+    @staticmethod
+    def _own_geoms(mj_model: mujoco.MjModel, parent_body: int) -> np.ndarray:
+        """Geoms of the robot (kinematic tree under the world) carrying the sensor."""
         root = int(mj_model.body_rootid[parent_body])
-        if root != 0:
-            own = self.hittable_geom_mask & (mj_model.body_rootid[mj_model.geom_bodyid] == root)
-            if own.any():
-                first = self.geom_paths[int(np.flatnonzero(own)[0])]
-                warnings.warn(
-                    f"{name}: {int(own.sum())} geoms of the robot carrying the sensor are in "
-                    f"include_geom_groups={self.cfg.include_geom_groups} (e.g. {first}): the "
-                    "LiDAR will see its own robot; move them to another geom group or "
-                    "narrow include_geom_groups",
-                    stacklevel=3,
-                )
+        if root == 0:
+            return np.zeros(mj_model.ngeom, dtype=bool)
+        return mj_model.body_rootid[mj_model.geom_bodyid] == root
+
+    def _check_scene(self, own: np.ndarray) -> None:
+        """Warn about unlabelled self-hits and unclassified terrain (both silent otherwise)."""
+        name = self.cfg.name
+        if own.any() and not self.resolved.self_class_id:
+            first = self.geom_paths[int(np.flatnonzero(own)[0])]
+            warnings.warn(
+                f"{name}: {int(own.sum())} geoms of the robot carrying the sensor are in "
+                f"include_geom_groups={self.cfg.include_geom_groups} (e.g. {first}): the "
+                "LiDAR will see its own robot and, with self_class=None, label it by path; "
+                "set self_class, move them to another geom group or narrow "
+                "include_geom_groups",
+                stacklevel=3,
+            )
         terrain = [
             g
             for g, p in enumerate(self.geom_paths)
@@ -405,7 +314,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         """Nothing to do on the host: the world rays are made in the graph."""
 
     def raycast_kernel(self, rc: Any) -> None:
-        """IN-GRAPH: pattern window, sensor pose, world rays, mjlab's cast, range model, labels.
+        """IN-GRAPH: pattern window, poses, world rays, mjlab's cast, range model, labels.
 
         On CUDA every step is one launch (captured in mjlab's sense graph). On warp's CPU
         device, which runs a kernel on one core, the rays are cast in column blocks by
@@ -428,6 +337,15 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             outputs=[b["window"]],
             device=dev,
         )
+        align = _ALIGN[cfg.ray_alignment]
+        wp.launch(
+            kernels.sensor_pose,
+            dim=e,
+            inputs=[cpos, cmat, self._carrier, self._offset_pos, self._offset_mat, align],
+            outputs=[b["pos_w"], b["quat_w"], b["sensor_mat"], b["ray_rot"]],
+            device=dev,
+        )
+        # The frame object's own pose (mjlab's pos_w / frame_pos_w): no offset.
         wp.launch(
             kernels.sensor_pose,
             dim=e,
@@ -435,11 +353,11 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 cpos,
                 cmat,
                 self._carrier,
-                self._offset_pos,
-                self._offset_mat,
-                _ALIGN[cfg.ray_alignment],
+                self._zero_pos,
+                self._identity,
+                align,
             ],
-            outputs=[b["pos_w"], b["quat_w"], b["sensor_mat"], b["ray_rot"]],
+            outputs=[b["frame_pos"], b["frame_quat"], b["frame_mat"], b["frame_rot"]],
             device=dev,
         )
         if self._pool is None:
@@ -498,7 +416,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 float(cfg.max_distance),
                 float(cfg.range_noise_std),
                 float(cfg.dropout_prob),
-                float(cfg.miss_distance),  # type: ignore[arg-type]
+                -1.0,  # mjlab's miss value; get_distances() applies miss_distance
                 b["env_seed"],
                 b["frame"],
                 b["lut"],
@@ -513,6 +431,13 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             ],
             device=dev,
         )
+        wp.launch(
+            mjlab_kernels.mjlab_misses,
+            dim=(e, b_ - a),
+            inputs=[cols(b["hit_mask"]), pnt],
+            outputs=[cols(b["points"]), cols(self._ray_normal)],
+            device=dev,
+        )
 
     def postprocess_rays(self) -> None:
         """Fresh results: drop data cached before this step's cast (nothing per ray)."""
@@ -524,65 +449,77 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         return self._lidar_data
 
     def debug_vis(self, visualizer: Any) -> None:
-        """No ray drawing (mjlab's would loop over every ray on the host)."""
+        """Hit points coloured by class (:data:`CLASS_COLORS`), at most
+        ``debug_vis_max_points`` evenly spaced hits per drawn environment."""
+        if not self.cfg.debug_vis or not self._debug_vis_enabled or not self._buffers:
+            return
+        data = self.data
+        envs = list(visualizer.get_env_indices(data.distances.shape[0]))
+        if not envs:
+            return
+        points = data.hit_pos_w[envs].cpu().numpy()
+        labels = data.semantic_labels[envs].cpu().numpy()
+        hits = data.hit_mask[envs].cpu().numpy()
+        radius = 0.2 * float(visualizer.meansize)
+        limit = self.cfg.debug_vis_max_points
+        name = self.cfg.name
+        for k, env in enumerate(envs):
+            idx = np.flatnonzero(hits[k])
+            if idx.size > limit:
+                idx = idx[np.linspace(0, idx.size - 1, limit).astype(np.int64)]
+            for i in idx:
+                visualizer.add_sphere(
+                    center=points[k, i],
+                    radius=radius,
+                    color=CLASS_COLORS[int(labels[k, i]) % len(CLASS_COLORS)],
+                    label=f"{name}_hit_{env}_{i}",
+                )
 
-    # Isaac Lab-style getters, so such observation code runs on this sensor as written.
-    def get_distances(self) -> torch.Tensor:
-        """``(num_envs, num_rays)`` ranges [m]; misses hold ``miss_distance``."""
-        return self.data.distances
+    # The seed's getters (Isaac Lab style), so such observation code runs as written.
+    def get_distances(self, env_ids: EnvIds = None) -> torch.Tensor:
+        """``(E, N)`` ranges [m]; misses hold ``miss_distance`` (default ``max_distance``)."""
+        data = self.data
+        miss = torch.full((), self.resolved.miss_distance, device=data.distances.device)
+        return _rows(torch.where(data.hit_mask, data.distances, miss), env_ids)
 
-    def get_semantic_labels(self) -> torch.Tensor:
-        """``(num_envs, num_rays)`` int32 class ids (0 = miss/unknown)."""
-        return self.data.semantic_labels
+    def get_semantic_labels(self, env_ids: EnvIds = None) -> torch.Tensor:
+        """``(E, N)`` int32 class ids (0 = miss/unknown)."""
+        return _rows(self.data.semantic_labels, env_ids)
 
-    def get_mesh_ids(self) -> torch.Tensor:
-        """``(num_envs, num_rays)`` int32 hit geom ids (-1 = miss)."""
+    def get_mesh_ids(self, env_ids: EnvIds = None) -> torch.Tensor:
+        """``(E, N)`` int32 hit geom ids (-1 = miss)."""
+        return _rows(self.data.geom_ids, env_ids)
+
+    def get_hit_mask(self, env_ids: EnvIds = None) -> torch.Tensor:
+        """``(E, N)`` bool, True where a ray returned a point."""
+        return _rows(self.data.hit_mask, env_ids)
+
+    @property
+    def mesh_ids(self) -> torch.Tensor:
+        """The seed's name of ``data.geom_ids``."""
         return self.data.geom_ids
 
-    def get_pointcloud(self) -> torch.Tensor:
-        """``(num_envs, num_rays, 3)`` world-frame hit points [m], NaN for misses."""
-        return self.data.hit_pos_w
+    def get_pointcloud(
+        self, env_ids: EnvIds = None, frame: Literal["world", "sensor"] = "world"
+    ) -> torch.Tensor:
+        """``(E, N, 3)`` hit points [m], NaN for misses (as the core sensor).
+
+        Args:
+            env_ids: environments (``None``: all).
+            frame: ``"world"``, or ``"sensor"`` (the LiDAR's own frame, offset included).
+        """
+        if frame not in ("world", "sensor"):
+            raise SensorError(f"get_pointcloud: frame must be 'world' or 'sensor', got {frame!r}")
+        data = self.data
+        points = _rows(data.hit_pos_w, env_ids)
+        if frame == "sensor":
+            rot = _rows(self._sensor_mat, env_ids)
+            points = torch.einsum("eji,enj->eni", rot, points - _rows(data.sensor_pos_w, env_ids)[:, None])
+        nan = torch.full((), float("nan"), device=points.device)
+        return torch.where(_rows(data.hit_mask, env_ids)[..., None], points, nan)
 
     def classify_geom(self, geom_id: int) -> int:
-        """Class id of a geom's path under this sensor's mapping (seed rule)."""
-        return classify_path(self.geom_paths[geom_id], self.semantic_class_mapping)
-
-
-# ---------------------------------------------------------------------- observations
-def _sensor(env: Any, sensor_name: str) -> MjlabSemanticLidarSensor:
-    sensor = env.scene[sensor_name]
-    if not isinstance(sensor, MjlabSemanticLidarSensor):
-        raise SensorError(
-            f"{sensor_name!r} is a {type(sensor).__name__}, not a robotwright "
-            "SemanticLidarSensorCfg sensor"
-        )
-    return sensor
-
-
-def lidar_distances_normalized(env: Any, sensor_name: str) -> torch.Tensor:
-    """``(num_envs, num_rays)`` distances divided by ``max_distance``, in [0, 1] for hits;
-    misses read ``miss_distance / max_distance`` (1 by default)."""
-    s = _sensor(env, sensor_name)
-    return s.data.distances / s.cfg.max_distance
-
-
-def lidar_class_ids(env: Any, sensor_name: str) -> torch.Tensor:
-    """``(num_envs, num_rays)`` class ids as floats (0 = miss/unknown, 1..K classes)."""
-    return _sensor(env, sensor_name).data.semantic_labels.float()
-
-
-def lidar_one_hot_classes(env: Any, sensor_name: str) -> torch.Tensor:
-    """``(num_envs, num_rays * (K + 1))`` one-hot classes, ray-major, class 0 included."""
-    s = _sensor(env, sensor_name)
-    labels = s.data.semantic_labels.long()
-    one_hot = torch.nn.functional.one_hot(labels, num_classes=len(s.class_names))
-    return one_hot.float().reshape(labels.shape[0], -1)
-
-
-def lidar_semantic_obs(env: Any, sensor_name: str) -> torch.Tensor:
-    """The stacked observation: ``(num_envs, num_rays * 2)``, per ray (distance [m], class id)."""
-    s = _sensor(env, sensor_name)
-    distances = s.get_distances()
-    semantic_labels = s.get_semantic_labels()
-    obs = torch.stack([distances, semantic_labels.float()], dim=-1)
-    return obs.reshape(distances.shape[0], -1)
+        """Class id of a geom under this sensor's mapping (the robot's own class included)."""
+        if self.resolved.self_class_id and self.geom_semantic_class[geom_id] == self.resolved.self_class_id:
+            return self.resolved.self_class_id
+        return classify_path(self.geom_paths[geom_id], self.resolved.mapping)

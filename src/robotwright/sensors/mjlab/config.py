@@ -1,0 +1,237 @@
+"""mjlab config of the semantic LiDAR: plain fields, validated and resolved in ``build()``.
+
+mjlab's idiom is to change a config after creating it (``cfg.frame.name = "trunk"``,
+``--env.scene.sensors.2.max-distance 10`` on ``train``), so nothing is derived at
+construction: :func:`resolve` checks every field and computes the derived values
+(default mapping, miss value, offsets) when the sensor is built, and again when mjlab
+initialises it, so a change made at any time before the scene compiles takes effect.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from mjlab.sensor.builtin_sensor import ObjRef
+from mjlab.sensor.raycast_sensor import RayCastSensorCfg
+
+from robotwright.errors import SensorError
+from robotwright.sensors.config import DEFAULT_SEMANTIC_CLASS_MAPPING, SemanticLidarCfg
+from robotwright.sensors.patterns import GridPatternCfg, LivoxPatternCfg, PatternCfg
+
+if TYPE_CHECKING:
+    from robotwright.sensors.mjlab.sensor import MjlabSemanticLidarSensor
+
+__all__ = [
+    "MJLAB_TERRAIN_KEYWORD",
+    "ResolvedLidarCfg",
+    "SemanticLidarSensorCfg",
+    "mjlab_class_mapping",
+    "resolve",
+]
+
+#: Path prefix of the geoms of mjlab's terrain entity (plane, boxes, heightfields).
+MJLAB_TERRAIN_KEYWORD = "/world/terrain/"
+
+
+def mjlab_class_mapping(
+    mapping: dict[str, list[str]] | None = None, terrain_class: str = "terrain"
+) -> dict[str, list[str]]:
+    """A class mapping under which mjlab's terrain geoms belong to ``terrain_class``.
+
+    Returns a copy of ``mapping`` (``None``: the default mapping) with
+    :data:`MJLAB_TERRAIN_KEYWORD` appended to the keywords of ``terrain_class`` (the class
+    is added last when the mapping lacks it). Keyword matching stays the default
+    case-insensitive substring rule, so nothing else changes class. This is the mjlab
+    sensor's default mapping.
+    """
+    base = DEFAULT_SEMANTIC_CLASS_MAPPING if mapping is None else mapping
+    out = {k: list(v) for k, v in base.items()}
+    keywords = out.setdefault(terrain_class, [])
+    if MJLAB_TERRAIN_KEYWORD not in keywords:
+        keywords.append(MJLAB_TERRAIN_KEYWORD)
+    return out
+
+
+def is_mjlab_pattern(pattern: object) -> bool:
+    """mjlab's own patterns (grid, pinhole, ring) and anything with its protocol."""
+    return not isinstance(pattern, PatternCfg) and callable(getattr(pattern, "generate_rays", None))
+
+
+@dataclass(kw_only=True)
+class SemanticLidarSensorCfg(RayCastSensorCfg):
+    """mjlab config of a semantic LiDAR: the SemanticLidarCfg fields on mjlab's ray-cast sensor.
+
+    Every field may be changed after construction (by code or by tyro on ``train`` /
+    ``play``) until the scene is built: validation and derived values happen in
+    :meth:`build` and again when mjlab initialises the sensor.
+
+    Frames: the pattern is given in the sensor frame (+x forward, +z up), which sits at
+    ``offset_pos``/``offset_rot`` in the ``frame`` object's frame; outputs are in the
+    world frame; distances [m].
+
+    Attributes:
+        name: the sensor's key in ``env.scene``.
+        frame: the body, site or geom carrying the sensor (one ``ObjRef``, e.g.
+            ``ObjRef(type="body", name="trunk", entity="robot")``).
+        pattern: any robotwright pattern (:class:`~robotwright.sensors.LivoxPatternCfg`
+            Mid-360/Avia rosettes advance one window per step; spinning, grid, pinhole
+            and file patterns repeat), or one of mjlab's own patterns (grid, pinhole,
+            ring), cast as a repeating pattern. Default: a 20 000-ray Mid-360.
+        offset_pos: sensor position in the frame object's frame [m].
+        offset_rot: sensor orientation in that frame, quaternion (w, x, y, z).
+        semantic_class_mapping: class -> keywords matched case-insensitively in geom
+            paths (``/world/<bodies>/<geom>[/<mesh>]``); class ids 1..K in mapping
+            order, 0 = miss/unknown. ``None``: :func:`mjlab_class_mapping` (the default
+            mapping with mjlab's terrain geoms as terrain).
+        self_class: class of the geoms of the robot carrying the sensor when rays can
+            hit them (``include_geom_groups`` holding their group); appended after the
+            mapping's classes unless the mapping has it. ``None``: such geoms are
+            classified by their paths like any other.
+        min_distance, max_distance: hits nearer or further are misses [m].
+        range_noise_std: Gaussian range noise on hits [m], clipped to the range.
+        dropout_prob: probability that a hit is dropped (becomes a miss).
+        seed: base seed of the per-environment noise streams (``None``: fresh entropy).
+        miss_distance: the distance ``get_distances()`` and the distance observation
+            terms give a miss [m] (``None``: ``max_distance``); ``data.distances`` keeps
+            mjlab's miss value -1.
+        num_threads: on warp's CPU device, cast the rays in this many column blocks on
+            parallel threads (``None``: one per core); CUDA always casts in one launch.
+        refine_curved_hits: recompute hits on spheres, capsules, ellipsoids and cylinders
+            in float64 from the compiled geom sizes (turn off when ``geom_size`` is
+            randomised per environment).
+        ray_alignment: ``"base"``, ``"yaw"`` or ``"world"`` (as mjlab's).
+        exclude_parent_body: rays ignore the body carrying the sensor (as mjlab's).
+        include_geom_groups: geom groups rays can hit (as mjlab's; here ``(0,)`` by
+            default: terrain and props, not the robot's visual and collision groups).
+        debug_vis: draw hit points coloured by class in mjlab's viewer.
+        debug_vis_max_points: most hit points drawn per environment (evenly spaced).
+    """
+
+    frame: ObjRef
+    pattern: Any = field(default_factory=LivoxPatternCfg)
+    offset_pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    offset_rot: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    semantic_class_mapping: dict[str, list[str]] | None = None
+    self_class: str | None = "robot"
+    min_distance: float = 0.0
+    max_distance: float = 40.0
+    range_noise_std: float = 0.0
+    dropout_prob: float = 0.0
+    seed: int | None = 0
+    miss_distance: float | None = None
+    refine_curved_hits: bool = True
+    num_threads: int | None = None
+    include_geom_groups: tuple[int, ...] | None = (0,)
+    debug_vis_max_points: int = 2000
+
+    def build(self) -> MjlabSemanticLidarSensor:
+        from robotwright.sensors.mjlab.sensor import MjlabSemanticLidarSensor
+
+        resolve(self)  # a bad field fails here, naming it
+        return MjlabSemanticLidarSensor(self)
+
+
+@dataclass(frozen=True)
+class ResolvedLidarCfg:
+    """The values a :class:`SemanticLidarSensorCfg` stands for, checked (see :func:`resolve`).
+
+    Attributes:
+        mapping: the class mapping (the default filled in), classes 1..K in order.
+        class_names: ``("unknown", *mapping, [self_class])``, indexed by class id.
+        self_class_id: class id of the carrier robot's own geoms (0: classify by path).
+        miss_distance: the miss value of ``get_distances()`` [m].
+        offset_pos: sensor position on the frame object [m].
+        offset_rot: unit quaternion (w, x, y, z).
+    """
+
+    mapping: dict[str, list[str]]
+    class_names: tuple[str, ...]
+    self_class_id: int
+    miss_distance: float
+    offset_pos: tuple[float, float, float]
+    offset_rot: tuple[float, float, float, float]
+
+
+def resolve(cfg: Any) -> ResolvedLidarCfg:
+    """Check every field of ``cfg`` and compute the derived values.
+
+    Raises:
+        SensorError: naming the config and the field, when ``cfg`` is not a
+            :class:`SemanticLidarSensorCfg` or a field is out of its domain.
+    """
+    if not isinstance(cfg, SemanticLidarSensorCfg):
+        raise SensorError(
+            f"expected a robotwright.sensors.mjlab.SemanticLidarSensorCfg, got "
+            f"{type(cfg).__name__} (the core SemanticLidarCfg is not an mjlab sensor config)"
+        )
+    name = type(cfg).__name__
+    if not isinstance(cfg.name, str) or not cfg.name:
+        raise SensorError(f"{name}.name: expected a non-empty string")
+    if not isinstance(cfg.frame, ObjRef) or cfg.frame.type not in ("body", "site", "geom"):
+        raise SensorError(
+            f"{name}.frame: expected one ObjRef of a body, site or geom, got {cfg.frame!r}"
+        )
+    if not isinstance(cfg.pattern, PatternCfg) and not is_mjlab_pattern(cfg.pattern):
+        raise SensorError(
+            f"{name}.pattern: expected a robotwright PatternCfg or an mjlab pattern, "
+            f"got {type(cfg.pattern).__name__}"
+        )
+    for flag in ("refine_curved_hits", "exclude_parent_body", "debug_vis"):
+        if not isinstance(getattr(cfg, flag), bool):
+            raise SensorError(f"{name}.{flag}: expected True or False")
+    groups = cfg.include_geom_groups
+    if groups is not None and (
+        not isinstance(groups, tuple)
+        or not all(isinstance(g, int) and not isinstance(g, bool) and 0 <= g < 6 for g in groups)
+    ):
+        raise SensorError(
+            f"{name}.include_geom_groups: expected None or a tuple of geom groups 0..5, "
+            f"got {groups!r}"
+        )
+    vis = cfg.debug_vis_max_points
+    if not isinstance(vis, int) or isinstance(vis, bool) or not 0 <= vis <= 1_000_000:
+        raise SensorError(f"{name}.debug_vis_max_points: expected an integer in [0, 1000000]")
+    if cfg.self_class is not None and (not isinstance(cfg.self_class, str) or not cfg.self_class):
+        raise SensorError(f"{name}.self_class: expected None or a non-empty class name")
+    mapping = (
+        mjlab_class_mapping() if cfg.semantic_class_mapping is None else cfg.semantic_class_mapping
+    )
+    # The core config validates and normalises the shared fields (ranges, noise,
+    # mapping, offsets, alignment, seed) with the same rules and messages.
+    core = SemanticLidarCfg(
+        prim_path=cfg.frame.prefixed_name(),
+        pattern_cfg=cfg.pattern if isinstance(cfg.pattern, PatternCfg) else GridPatternCfg(),
+        offset_pos=cfg.offset_pos,
+        offset_rot=cfg.offset_rot,
+        ray_alignment=cfg.ray_alignment,
+        min_distance=cfg.min_distance,
+        max_distance=cfg.max_distance,
+        range_noise_std=cfg.range_noise_std,
+        dropout_prob=cfg.dropout_prob,
+        seed=cfg.seed,
+        miss_distance=cfg.miss_distance,
+        num_threads=cfg.num_threads,
+        semantic_class_mapping=mapping,
+    )
+    miss = float(core.miss_distance)  # type: ignore[arg-type]
+    if not math.isfinite(miss):
+        raise SensorError(f"{name}.miss_distance: expected a finite number [m]")
+    resolved = {k: list(v) for k, v in (core.semantic_class_mapping or {}).items()}
+    names = ("unknown", *resolved)
+    self_id = 0
+    if cfg.self_class is not None:
+        if cfg.self_class in resolved:
+            self_id = names.index(cfg.self_class)
+        else:
+            names = (*names, cfg.self_class)
+            self_id = len(names) - 1
+    return ResolvedLidarCfg(
+        mapping=resolved,
+        class_names=names,
+        self_class_id=self_id,
+        miss_distance=miss,
+        offset_pos=tuple(float(v) for v in core.offset_pos),  # type: ignore[arg-type]
+        offset_rot=tuple(float(v) for v in core.offset_rot),  # type: ignore[arg-type]
+    )

@@ -1,0 +1,209 @@
+"""Observation terms of the semantic LiDAR for mjlab's observation manager.
+
+Use them as ``ObservationTermCfg(func=term, params={"sensor_name": "lidar", ...})``.
+Shapes use ``E`` environments, ``N`` rays per step and ``C = len(sensor.class_names)``
+classes (``"unknown"`` included, and the robot's own class when the sensor has one).
+Memory figures are float32 per step for 4096 environments; PPO keeps
+``num_steps_per_env`` (24 in mjlab's velocity tasks) steps of each actor observation.
+
+Which to use:
+  * :func:`lidar_range_image` for any pattern, rosettes (Mid-360, Avia) included: every
+    cell means the same direction every step, so a CNN or a flattened MLP can learn it.
+  * :func:`lidar_point_cloud` for point-cloud encoders (PointNet, PVCNN-style).
+  * :func:`lidar_semantic_obs` and the per-ray terms only for fixed patterns (grid,
+    spinning, pinhole, file), where ray ``i`` always points the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import torch
+
+from robotwright.errors import SensorError
+from robotwright.sensors.mjlab.sensor import MjlabSemanticLidarSensor
+
+__all__ = [
+    "lidar_class_ids",
+    "lidar_distances_normalized",
+    "lidar_one_hot_classes",
+    "lidar_point_cloud",
+    "lidar_range_image",
+    "lidar_semantic_obs",
+]
+
+
+def _sensor(env: Any, sensor_name: str) -> MjlabSemanticLidarSensor:
+    sensor = env.scene[sensor_name]
+    if not isinstance(sensor, MjlabSemanticLidarSensor):
+        raise SensorError(
+            f"{sensor_name!r} is a {type(sensor).__name__}, not a robotwright "
+            "SemanticLidarSensorCfg sensor"
+        )
+    return sensor
+
+
+def lidar_distances_normalized(env: Any, sensor_name: str) -> torch.Tensor:
+    """``(E, N)`` distance / ``max_distance``: in [0, 1] for hits; misses read
+    ``miss_distance / max_distance`` (1 by default). Fixed patterns only (see
+    :func:`lidar_semantic_obs`)."""
+    s = _sensor(env, sensor_name)
+    return s.get_distances() / float(s.cfg.max_distance)
+
+
+def lidar_class_ids(env: Any, sensor_name: str) -> torch.Tensor:
+    """``(E, N)`` class ids as floats (0 = miss/unknown). Fixed patterns only."""
+    return _sensor(env, sensor_name).data.semantic_labels.float()
+
+
+def lidar_one_hot_classes(env: Any, sensor_name: str) -> torch.Tensor:
+    """``(E, N * C)`` one-hot classes, ray-major, class 0 included. Fixed patterns only."""
+    s = _sensor(env, sensor_name)
+    labels = s.data.semantic_labels.long()
+    one_hot = torch.nn.functional.one_hot(labels, num_classes=len(s.class_names))
+    return one_hot.float().reshape(labels.shape[0], -1)
+
+
+def lidar_semantic_obs(env: Any, sensor_name: str) -> torch.Tensor:
+    """The seed's stacked observation: ``(E, N * 2)``, per ray (distance [m], class id).
+
+    Suits fixed patterns only (grid, spinning, pinhole, file patterns, mjlab's grid and
+    ring): the value at index ``2 i`` means ray ``i``'s direction only when ray ``i``
+    points the same way every step. A Livox rosette's window advances every step (ray
+    ``i`` of a 20 000-ray Mid-360 turns about 16 degrees per step), so the same index
+    means a different direction each step and a policy cannot learn from it; use
+    :func:`lidar_range_image` or :func:`lidar_point_cloud` there. Size: 2 N floats per
+    env (20 000 rays: 40 000, 625 MiB per step for 4096 envs, 15 GiB of PPO rollout).
+    Misses read ``miss_distance`` (default ``max_distance``).
+    """
+    s = _sensor(env, sensor_name)
+    distances = s.get_distances()
+    semantic_labels = s.get_semantic_labels()
+    obs = torch.stack([distances, semantic_labels.float()], dim=-1)
+    return obs.reshape(distances.shape[0], -1)
+
+
+def _one_hot(labels: torch.Tensor, classes: int) -> torch.Tensor:
+    return torch.nn.functional.one_hot(labels.long().clamp(0, classes - 1), classes).float()
+
+
+def lidar_point_cloud(
+    env: Any,
+    sensor_name: str,
+    max_points: int,
+    frame: Literal["sensor", "base", "world"] = "sensor",
+) -> torch.Tensor:
+    """``(E, max_points, 3 + C)`` a fixed-size sample of the hit points, with one-hot classes.
+
+    Per env, the hits (ray order) are sampled evenly: all of them when there are at most
+    ``max_points``, else hit ``floor(j * hits / max_points)`` for slot ``j``; the same
+    scan gives the same sample (no randomness). Columns 0..2 are the point [m] in the
+    ``frame``: ``"sensor"`` (the LiDAR, offset included), ``"base"`` (the frame object
+    carrying it) or ``"world"``; columns 3.. the one-hot class. Slots past the hits are
+    zero (their one-hot sums to 0: that is the padding mask).
+
+    For point-cloud encoders (PointNet, PVCNN-style). Size per env: ``max_points * (3 +
+    C)`` floats; 1024 points with 5 classes: 32 KiB, 128 MiB per step for 4096 envs
+    (3 GiB of PPO rollout at 24 steps); flattened into an MLP it is as hard to learn as
+    per-ray terms (slot ``j`` is not a direction), so pair it with an encoder.
+    """
+    if not isinstance(max_points, int) or isinstance(max_points, bool) or max_points < 1:
+        raise SensorError(f"lidar_point_cloud: max_points must be an integer >= 1, got {max_points!r}")
+    if frame not in ("sensor", "base", "world"):
+        raise SensorError(
+            f"lidar_point_cloud: frame must be 'sensor', 'base' or 'world', got {frame!r}"
+        )
+    s = _sensor(env, sensor_name)
+    data = s.data
+    hit = data.hit_mask
+    e, n = hit.shape
+    dev = hit.device
+    count = hit.sum(dim=1, keepdim=True)  # (E, 1)
+    slots = torch.arange(max_points, device=dev).expand(e, max_points)
+    rank = torch.where(count > max_points, (slots * count) // max_points, slots)
+    valid = slots < count
+    cumsum = hit.to(torch.int64).cumsum(dim=1)  # (E, N): hits up to and including i
+    idx = torch.searchsorted(cumsum, (rank + 1).contiguous()).clamp(max=n - 1)
+    points = torch.gather(data.hit_pos_w, 1, idx[..., None].expand(e, max_points, 3))
+    if frame == "sensor":
+        origin, rot = data.sensor_pos_w, s._sensor_mat
+    elif frame == "base":
+        origin, rot = data.pos_w, s._frame_mat
+    if frame != "world":
+        points = torch.einsum("eji,epj->epi", rot, points - origin[:, None])
+    labels = torch.gather(data.semantic_labels, 1, idx)
+    out = torch.cat([points, _one_hot(labels, len(s.class_names))], dim=-1)
+    return out * valid[..., None]
+
+
+def _image_bounds(s: MjlabSemanticLidarSensor) -> tuple[float, float, float, float, bool]:
+    """Azimuth and elevation bounds [rad] of every ray of the pattern (all frames), in the
+    ray frame; a pattern spanning nearly the full circle wraps around at +-pi."""
+    key = "range_image_bounds"
+    if key not in s._obs_cache:
+        d = torch.as_tensor(s.table.directions)
+        az = torch.atan2(d[:, 1], d[:, 0])
+        el = torch.atan2(d[:, 2], torch.hypot(d[:, 0], d[:, 1]))
+        az0, az1 = float(az.min()), float(az.max())
+        full = az1 - az0 > 2 * math.pi * 0.95
+        if full:
+            az0, az1 = -math.pi, math.pi
+        el0, el1 = float(el.min()), float(el.max())
+        if el1 - el0 < 1e-6:  # one elevation: a one-row band around it
+            el0, el1 = el0 - 1e-3, el1 + 1e-3
+        if az1 - az0 < 1e-6:
+            az0, az1 = az0 - 1e-3, az1 + 1e-3
+        s._obs_cache[key] = (az0, az1, el0, el1, full)
+    return s._obs_cache[key]
+
+
+def lidar_range_image(
+    env: Any, sensor_name: str, width: int, height: int, flatten: bool = False
+) -> torch.Tensor:
+    """``(E, 1 + C, height, width)`` distances and class occupancy binned by direction.
+
+    Each ray falls in the cell of its azimuth (columns, left to right from -pi, or from the
+    pattern's smallest azimuth when it spans less than the full circle) and elevation
+    (rows, top = highest elevation of the pattern), measured in the ray frame (the
+    sensor frame under ``ray_alignment``). Channel 0: the nearest hit in the cell /
+    ``max_distance`` (1 where the cell has no hit this step); channels 1..C: the
+    fraction of the cell's rays this step that hit each class (class 0: unknown geoms).
+    Every cell means the same direction every step, whatever the pattern, so a CNN or a
+    flattened MLP can learn from it; a rosette fills different cells each step.
+
+    Size per env: ``(1 + C) * height * width`` floats; 32 x 8 with 5 classes: 1 536
+    floats (6 KiB), 24 MiB per step for 4096 envs (576 MiB of PPO rollout at 24 steps).
+    ``flatten=True`` returns it as ``(E, (1 + C) * height * width)`` (channel-major), the
+    form an MLP actor (rsl_rl's) and mjlab's term concatenation take.
+    """
+    for what, v in (("width", width), ("height", height)):
+        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 4096:
+            raise SensorError(f"lidar_range_image: {what} must be an integer in [1, 4096], got {v!r}")
+    s = _sensor(env, sensor_name)
+    data = s.data
+    e, n = data.hit_mask.shape
+    classes = len(s.class_names)
+    az0, az1, el0, el1, _ = _image_bounds(s)
+    # The rays in the ray frame: R^T d (R = this step's ray rotation).
+    local = torch.einsum("eji,enj->eni", s._ray_rot, data.ray_directions_w)
+    az = torch.atan2(local[..., 1], local[..., 0])
+    el = torch.atan2(local[..., 2], torch.hypot(local[..., 0], local[..., 1]))
+    col = ((az - az0) / (az1 - az0) * width).floor().long().clamp(0, width - 1)
+    row = ((el1 - el) / (el1 - el0) * height).floor().long().clamp(0, height - 1)
+    cell = row * width + col  # (E, N)
+    cells = height * width
+    hit = data.hit_mask
+    scaled = torch.where(hit, data.distances / float(s.cfg.max_distance), 1.0).clamp(0.0, 1.0)
+    depth = torch.ones(e, cells, device=hit.device)
+    depth.scatter_reduce_(1, cell, scaled, reduce="amin", include_self=True)
+    rays = torch.zeros(e, cells, device=hit.device)
+    rays.scatter_add_(1, cell, torch.ones_like(scaled))
+    per_class = torch.zeros(e, classes * cells, device=hit.device)
+    slot = data.semantic_labels.long().clamp(0, classes - 1) * cells + cell
+    per_class.scatter_add_(1, slot, hit.float())
+    occupancy = per_class.view(e, classes, cells) / rays.clamp(min=1.0)[:, None]
+    out = torch.cat([depth[:, None], occupancy], dim=1)
+    if flatten:
+        return out.reshape(e, -1)
+    return out.view(e, 1 + classes, height, width)
