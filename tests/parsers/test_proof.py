@@ -337,7 +337,8 @@ def _corpus_params() -> list:
         if not root.is_dir():
             out.append(pytest.param(corpus, "", marks=pytest.mark.skip(reason="absent"), id=corpus))
             continue
-        for p in sorted(root.rglob("*.xml")):
+        files = [*root.rglob("*.xml"), *root.rglob("*.urdf")]
+        for p in sorted(f for f in files if "random_urdfs" not in f.parts):
             key = f"{corpus}/{p.relative_to(root).as_posix()}"
             marks = [pytest.mark.xfail(reason=KNOWN[key], strict=True)] if key in KNOWN else []
             out.append(pytest.param(corpus, p.relative_to(root).as_posix(), marks=marks, id=key))
@@ -346,11 +347,20 @@ def _corpus_params() -> list:
 
 @pytest.mark.realdata
 @pytest.mark.parametrize(("corpus", "rel"), _corpus_params())
-def test_corpus_mjcf_proof_has_no_unreported_difference(
-    corpus: str, rel: str, tmp_path: Path
-) -> None:
+def test_corpus_proof_has_no_unreported_difference(corpus: str, rel: str, tmp_path: Path) -> None:
     root = CORPORA[corpus]
     path = root / rel
+    if path.suffix == ".urdf":
+        # Compared with MuJoCo's own import of the URDF; a file MuJoCo or the parser
+        # refuses is the business of test_corpora.py.
+        if proof.source_model(path, "urdf", {}) is None:
+            pytest.skip("MuJoCo does not import it")
+        try:
+            messages = convert(path, tmp_path / "out", asset_roots=(root,))
+        except ConversionError as exc:
+            pytest.skip(f"refused: {str(exc).splitlines()[0][:120]}")
+        assert not [m for m in messages if "proof:" in m], messages
+        return
     try:
         source = mujoco.MjModel.from_xml_path(str(path))
     except Exception as exc:  # noqa: BLE001 - a file MuJoCo refuses is out of scope
