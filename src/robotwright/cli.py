@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import platform
 import sys
 from collections.abc import Iterator, Sequence
@@ -242,17 +243,37 @@ def _report_notes(caught: CaughtNotes, verbose: bool) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; returns its exit code (2 for bad input, with a one-line error)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    # Text read from input files (names, CSV cells, paths) reaches the terminal in
-    # messages and listings: control and bidirectional characters are shown escaped
-    # (``\x1b``), never sent raw to the terminal.
     out, err = sys.stdout, sys.stderr
-    sys.stdout, sys.stderr = PrintableStream(out), PrintableStream(err)
     try:
-        return _run(args)
+        parser = build_parser()
+        try:
+            args = parser.parse_args(argv)
+        finally:
+            out.flush()  # --help and --version print, then exit here
+        # Text read from input files (names, CSV cells, paths) reaches the terminal in
+        # messages and listings: control and bidirectional characters are shown escaped
+        # (``\x1b``), never sent raw to the terminal.
+        sys.stdout, sys.stderr = PrintableStream(out), PrintableStream(err)
+        code = _run(args)
+        # Flushed here, not at exit: a reader that closed the pipe ends it quietly.
+        out.flush()
+        return code
+    except BrokenPipeError:
+        return _closed_pipe(out)
     finally:
         sys.stdout, sys.stderr = out, err
+
+
+def _closed_pipe(out: Any) -> int:
+    """The reader of stdout went away (``robotwright info ... | head -5``): end quietly
+    with exit 0 as ``git`` and ``ls`` do. stdout is pointed at the null device so that
+    Python's own flush at exit does not fail on the closed pipe."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, out.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass  # not a real file (a test's StringIO): nothing is flushed at exit
+    return 0
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -289,6 +310,8 @@ def _run(args: argparse.Namespace) -> int:
         # Ctrl-C on long work (grammar enumeration, search): a line, not a traceback.
         print("interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        raise  # main ends quietly: the reader of stdout closed the pipe
     except OSError as exc:
         # The file system refused a path the user gave (permissions, disk full, a file
         # where a folder is needed): name the path, no traceback.
