@@ -79,3 +79,135 @@ def test_one_changed_value_is_found(seed: int, attr: str) -> None:
     # 0.123456 is none of the values the robots are made of: the value always changed.
     assert [d.field for d in diffs] == [field], diffs
     assert "0.123456" in diffs[0].result
+
+
+# -- URDF sources and outputs ---------------------------------------------------------------
+def _tensor(rng: random.Random) -> tuple[float, ...]:
+    """A random physical inertia tensor (ixx iyy izz ixy ixz iyz): random principal
+    moments (A + B >= C) turned by a random rotation."""
+    import numpy as np
+
+    a, b = rng.uniform(0.01, 0.1), rng.uniform(0.01, 0.1)
+    c = rng.uniform(abs(a - b) + 1e-3, a + b - 1e-3)
+    q = np.array([rng.gauss(0, 1) for _ in range(4)])
+    q /= np.linalg.norm(q)
+    m = np.zeros(9)
+    mujoco.mju_quat2Mat(m, q)
+    r = m.reshape(3, 3)
+    t = r @ np.diag([a, b, c]) @ r.T
+    return tuple(float(x) for x in (t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2], t[1, 2]))
+
+
+def _urdf(seed: int) -> str:
+    rng = random.Random(seed)
+    n = rng.randint(2, 9)
+    links, joints = [], []
+    for i in range(n):
+        ixx, iyy, izz, ixy, ixz, iyz = _tensor(rng)
+        rpy = " ".join(f"{rng.uniform(-3, 3)!r}" for _ in range(3))
+        xyz = " ".join(f"{rng.uniform(-0.1, 0.1)!r}" for _ in range(3))
+        geoms = []
+        for _ in range(rng.randint(0, 3)):
+            shape = rng.choice(['<box size="0.1 0.05 0.02"/>', '<sphere radius="0.03"/>',
+                                '<cylinder radius="0.02" length="0.1"/>'])  # fmt: skip
+            pos = " ".join(f"{rng.uniform(-0.1, 0.1)!r}" for _ in range(3))
+            geoms.append(
+                f'<collision><origin xyz="{pos}"/><geometry>{shape}</geometry></collision>'
+            )
+        links.append(
+            f'<link name="l{i}"><inertial><origin xyz="{xyz}" rpy="{rpy}"/>'
+            f'<mass value="{rng.uniform(0.1, 2)!r}"/><inertia ixx="{ixx!r}" iyy="{iyy!r}" '
+            f'izz="{izz!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyz="{iyz!r}"/></inertial>'
+            + "".join(geoms)
+            + "</link>"
+        )
+        if i:
+            kind = rng.choice(["revolute", "prismatic", "continuous"])
+            limit = (
+                '<limit lower="-1" upper="1" effort="3" velocity="2"/>'
+                if kind != "continuous"
+                else ""
+            )
+            axis = rng.choice(["1 0 0", "0 1 0", "0 0 1", "0.6 0.8 0"])
+            damping = f'<dynamics damping="{rng.uniform(0, 1)!r}"/>' if rng.random() < 0.5 else ""
+            joints.append(
+                f'<joint name="j{i}" type="{kind}"><parent link="l{rng.randrange(i)}"/>'
+                f'<child link="l{i}"/><origin xyz="0 0 0.2" rpy="0 0 {rng.uniform(-1, 1)!r}"/>'
+                f'<axis xyz="{axis}"/>{limit}{damping}</joint>'
+            )
+    return f'<robot name="r{seed}">{"".join(links)}{"".join(joints)}</robot>'
+
+
+URDF_SEEDS = range(12)
+
+
+@pytest.mark.parametrize("seed", URDF_SEEDS)
+@pytest.mark.parametrize("out", ["folder", "out.xml", "out.urdf"])
+def test_random_urdf_converts_with_no_false_alarm(tmp_path, seed: int, out: str) -> None:
+    from robotwright.parsers.convert import convert
+
+    src = tmp_path / "r.urdf"
+    src.write_text(_urdf(seed))
+    assert proof.source_model(src, "urdf", {}) is not None  # MuJoCo imports it
+    messages = convert(src, tmp_path / out)
+    assert not [m for m in messages if "proof:" in m], messages
+
+
+@pytest.mark.parametrize("seed", URDF_SEEDS)
+def test_random_urdf_changed_mass_is_found(tmp_path, monkeypatch, seed: int) -> None:
+    import dataclasses
+
+    from robotwright.hrdf.model import HRDF
+    from robotwright.parsers.convert import convert
+
+    target = f"l{random.Random(seed * 3).randrange(random.Random(seed).randint(2, 9))}"
+    real = HRDF.save
+
+    def save(self, path, **kw):
+        bodies = [
+            dataclasses.replace(b, mass=b.mass * 1.001) if b.name == target else b
+            for b in self.bodies
+        ]
+        return real(dataclasses.replace(self, bodies=bodies), path, **kw)
+
+    monkeypatch.setattr(HRDF, "save", save)
+    src = tmp_path / "r.urdf"
+    src.write_text(_urdf(seed))
+    lost = [m for m in convert(src, tmp_path / "out") if "proof:" in m]
+    assert lost and all(f"'{target}'" in m for m in lost), lost
+    assert any("body_mass" in m for m in lost), lost
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_inertia_in_any_axis_order_is_one_tensor(seed: int) -> None:
+    import numpy as np
+
+    rng = random.Random(seed)
+    moments = [rng.uniform(0.01, 0.1) for _ in range(2)]
+    moments.append(rng.uniform(abs(moments[0] - moments[1]) + 1e-3, sum(moments) - 1e-3))
+    perm = rng.sample(range(3), 3)
+
+    def xml(diag, quat) -> str:
+        d = " ".join(repr(float(x)) for x in diag)
+        q = " ".join(repr(float(x)) for x in quat)
+        return (
+            '<mujoco><worldbody><body name="b"><freejoint/><inertial pos="0 0 0" mass="1" '
+            f'diaginertia="{d}" quat="{q}"/></body></worldbody></mujoco>'
+        )
+
+    # The same tensor: axes permuted (and signed) by a rotation matrix whose columns are
+    # the original axes in the new order.
+    r = np.zeros((3, 3))
+    for new, old in enumerate(perm):
+        r[old, new] = rng.choice([-1.0, 1.0])
+    if np.linalg.det(r) < 0:
+        r[:, 0] = -r[:, 0]
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, r.flatten())
+    a = mujoco.MjModel.from_xml_string(xml(moments, [1, 0, 0, 0]))
+    b = mujoco.MjModel.from_xml_string(xml([moments[i] for i in perm], q))
+    assert proof.compare_models(a, b) == []
+    # Another rotation of the same moments is another tensor (unless they are equal).
+    turn = [np.cos(0.3), 0, 0, np.sin(0.3)]
+    c = mujoco.MjModel.from_xml_string(xml(moments, turn))
+    assert [d.field for d in proof.compare_models(a, c)] == ["body_inertia"]
