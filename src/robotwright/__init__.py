@@ -10,3 +10,34 @@ from robotwright._atomic import mesh_size_limit  # noqa: E402
 from robotwright._paths import trusted_asset_roots  # noqa: E402
 
 __all__ = ["__version__", "mesh_size_limit", "trusted_asset_roots"]
+
+#: Subpackages and modules reachable as attributes after ``import robotwright``
+#: (``robotwright.view.show(...)``): each is imported on first use, so ``import
+#: robotwright`` stays quick and imports no viewer, renderer or mesh library.
+_SUBMODULES = frozenset(
+    {
+        "catalog",
+        "errors",
+        "generators",
+        "grammar",
+        "hrdf",
+        "parsers",
+        "render",
+        "sensors",
+        "sources",
+        "things",
+        "view",
+    }
+)
+
+
+def __getattr__(name: str) -> object:
+    if name in _SUBMODULES:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | _SUBMODULES)

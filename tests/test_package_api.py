@@ -1,0 +1,53 @@
+"""``import robotwright`` gives every subpackage as an attribute, imported on first use."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+_HEAVY = ("mujoco", "numpy", "trimesh", "viser", "PIL")
+
+
+def _run(code: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+
+
+def test_import_robotwright_imports_no_heavy_dependency() -> None:
+    done = _run(
+        f"import sys, robotwright\nprint(sorted(m for m in {_HEAVY!r} if m in sys.modules))"
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize(
+    ("attribute", "function"),
+    [("view", "show"), ("render", "render"), ("hrdf", "HRDF"), ("sensors", "LidarSensor")],
+)
+def test_subpackages_are_attributes_after_import(attribute: str, function: str) -> None:
+    """``robotwright.view.show(...)`` and ``robotwright.render.render(...)``, as the
+    README writes them, work after a plain ``import robotwright``."""
+    done = _run(
+        "import robotwright\n"
+        f"f = getattr(robotwright.{attribute}, {function!r})\n"
+        "print(callable(f))"
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "True"
+
+
+def test_render_after_import_draws_a_picture(tmp_path) -> None:
+    out = tmp_path / "arm.png"
+    done = _run(f"import robotwright\nrobotwright.render.render('arm6', {str(out)!r})")
+    assert done.returncode == 0, done.stderr
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_unknown_attribute_is_an_attribute_error() -> None:
+    import robotwright
+
+    with pytest.raises(AttributeError):
+        robotwright.no_such_part  # noqa: B018
+    assert hasattr(robotwright, "view") and "view" in dir(robotwright)
