@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING
 from robotwright._lazy import attach
 
 if TYPE_CHECKING:
-    from robotwright.render.api import render
+    from robotwright.render.anim import Animation, save_animation
+    from robotwright.render.api import render, render_animation
     from robotwright.render.camera import VIEWS, CameraError
     from robotwright.render.core import Picture, RenderError, RenderOptions, render_model
     from robotwright.render.png import save_png
@@ -20,6 +21,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "VIEWS",
+    "Animation",
     "CameraError",
     "Picture",
     "RenderError",
@@ -27,7 +29,9 @@ __all__ = [
     "SourceError",
     "load_model",
     "render",
+    "render_animation",
     "render_model",
+    "save_animation",
     "save_png",
 ]
 

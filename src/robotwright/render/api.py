@@ -5,12 +5,23 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from robotwright.render.core import Picture, RenderOptions, render_model
+import numpy as np
+
+from robotwright.render.anim import (
+    Animation,
+    animate,
+    frame_count,
+    require_writer,
+    save_animation,
+    simulate_states,
+    sweep_states,
+)
+from robotwright.render.core import Picture, RenderError, RenderOptions, render_model
 from robotwright.render.png import save_png
 from robotwright.render.scan import render_scan
 from robotwright.render.source import load_model
 
-__all__ = ["render"]
+__all__ = ["render", "render_animation"]
 
 
 def render(
@@ -58,3 +69,56 @@ def render(
     if output is not None:
         save_png(picture, Path(output), title=title)
     return picture
+
+
+def render_animation(
+    source: str | os.PathLike[str],
+    output: str | os.PathLike[str] | None = None,
+    options: RenderOptions | None = None,
+    *,
+    sweep: float | None = None,
+    simulate: float | None = None,
+    fps: float = 20.0,
+    asset_roots: tuple[str | os.PathLike[str], ...] = (),
+) -> Animation:
+    """Draw ``source`` moving: a joint sweep of ``sweep`` seconds (every limited hinge
+    and slide joint from the first pose to its upper limit, its lower limit and back)
+    or ``simulate`` seconds of MuJoCo simulation from the first pose (keyframe 0 with
+    its ``ctrl``, else ``qpos0`` with zero controls); one of the two.
+
+    Args:
+        source: what to draw (as :func:`render`; not a scan).
+        output: ``.gif`` or ``.mp4`` file to write (nothing is written when None).
+        options: size, camera, backend and geom groups of every frame.
+        sweep: length of the sweep [s].
+        simulate: simulated time [s] (played back in real time).
+        fps: frames per second.
+        asset_roots: folders outside the source's folder its files may come from.
+
+    Raises:
+        RenderError: neither or both of ``sweep``/``simulate``, bad lengths, too many
+            frames, an unstable simulation, an output that is not ``.gif``/``.mp4``.
+    """
+    if (sweep is None) == (simulate is None):
+        raise RenderError("an animation is a sweep or a simulation: give one of the two")
+    if output is not None:
+        require_writer(output)  # before drawing: a missing extra fails at once
+    seconds = sweep if sweep is not None else simulate
+    assert seconds is not None
+    count = frame_count(seconds, fps)
+    loaded = load_model(source, asset_roots=asset_roots)
+    if loaded.scan is not None:
+        raise RenderError(f"{os.fspath(source)}: a scan does not move; draw it as a .png")
+    data = loaded.initial_data()
+    if sweep is not None:
+        states = sweep_states(loaded.model, loaded.qpos, count)
+        times = np.arange(count) / fps
+    else:
+        if loaded.model.nkey:
+            data.ctrl[:] = loaded.model.key_ctrl[0]
+        states, times = simulate_states(loaded.model, data, count, fps)
+    animation = animate(loaded.model, states, times, fps, options)
+    animation.notes[:0] = loaded.warnings
+    if output is not None:
+        save_animation(animation, output)
+    return animation

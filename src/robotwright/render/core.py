@@ -31,6 +31,9 @@ Backend = Literal["auto", "gl", "software"]
 #: Largest picture side [px]: a larger one is a typo more often than a wish (and the
 #: software renderer holds several float arrays of the picture's size).
 MAX_SIDE = 4096
+#: MuJoCo's geom groups (mjNGROUP) and the ones its viewer shows by default.
+GEOM_GROUPS = 6
+DEFAULT_GEOM_GROUPS = (0, 1, 2)
 #: Most geoms MuJoCo may put in the scene (robots with sites, composed scenes).
 _MAX_SCENE_GEOMS = 20_000
 #: Background, top and bottom rows (a light sky gradient: geoms stand out from it).
@@ -57,6 +60,8 @@ class RenderOptions:
             averages down (smooth edges); 1..4, lowered for large pictures (at most
             3000 x 3000 pixels are drawn).
         point_radius: radius of a drawn point [px].
+        geom_groups: MuJoCo geom groups drawn (0..5; MuJoCo's default 0, 1, 2).
+            Robots often keep collision geoms in group 3: leave it out to hide them.
     """
 
     width: int = 800
@@ -65,6 +70,7 @@ class RenderOptions:
     backend: Backend = "auto"
     supersample: int = 2
     point_radius: float = 1.5
+    geom_groups: tuple[int, ...] = DEFAULT_GEOM_GROUPS
 
     def __post_init__(self) -> None:
         for name in ("width", "height"):
@@ -79,6 +85,15 @@ class RenderOptions:
             raise RenderError(f"supersample {self.supersample!r}: expected 1, 2, 3 or 4")
         if not (math.isfinite(self.point_radius) and 0 < self.point_radius <= 20):
             raise RenderError(f"point_radius {self.point_radius!r}: expected (0, 20] px")
+        groups = self.geom_groups
+        if not isinstance(groups, tuple) or any(
+            isinstance(g, bool) or not isinstance(g, int) or not 0 <= g < GEOM_GROUPS
+            for g in groups
+        ):
+            raise RenderError(
+                f"geom_groups {groups!r}: expected a tuple of MuJoCo geom groups "
+                f"0..{GEOM_GROUPS - 1}"
+            )
         parse_camera(self.camera)  # raises CameraError naming the problem
 
     @property
@@ -107,10 +122,18 @@ class Picture:
     depth: np.ndarray | None = None
 
 
-def _scene(model: mujoco.MjModel, data: mujoco.MjData, cam: mujoco.MjvCamera) -> mujoco.MjvScene:
+def _scene(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    cam: mujoco.MjvCamera,
+    groups: tuple[int, ...] = DEFAULT_GEOM_GROUPS,
+) -> mujoco.MjvScene:
+    """MuJoCo's scene of ``data`` seen by ``cam``, with the geoms of ``groups`` only."""
     scene = mujoco.MjvScene(model, maxgeom=_MAX_SCENE_GEOMS)
+    option = mujoco.MjvOption()
+    option.geomgroup[:] = [int(g in groups) for g in range(GEOM_GROUPS)]
     mujoco.mjv_updateScene(
-        model, data, mujoco.MjvOption(), mujoco.MjvPerturb(), cam, mujoco.mjtCatBit.mjCAT_ALL, scene
+        model, data, option, mujoco.MjvPerturb(), cam, mujoco.mjtCatBit.mjCAT_ALL, scene
     )
     return scene
 
@@ -288,6 +311,7 @@ def render_model(
     *,
     points: np.ndarray | None = None,
     point_colors: np.ndarray | None = None,
+    bounds: np.ndarray | None = None,
 ) -> Picture:
     """Draw ``model`` in the state ``data`` (``qpos0`` after ``mj_forward`` if None).
 
@@ -298,6 +322,8 @@ def render_model(
         points: ``(N, 3)`` world-frame points [m] to draw over the scene (e.g. LiDAR
             hits), hidden where a surface is in front of them.
         point_colors: ``(N, 3)`` RGB in [0, 1] per point (default black).
+        bounds: ``(K, 3)`` world points [m] a free camera frames instead of what is
+            drawn (the frames of an animation share one camera this way).
 
     Raises:
         RenderError: bad options or points; ``backend="gl"`` with no GL platform.
@@ -309,12 +335,14 @@ def render_model(
         mujoco.mj_forward(model, data)
     pts, cols = _check_points(points, point_colors)
     spec = opts.camera_spec
-    probe = _scene(model, data, mujoco.MjvCamera())
-    corners = drawn_bounds(model, probe)
+    if bounds is None:
+        corners = drawn_bounds(model, _scene(model, data, mujoco.MjvCamera(), opts.geom_groups))
+    else:
+        corners = np.asarray(bounds, dtype=np.float64).reshape(-1, 3)
     if pts is not None and len(pts):  # the points are framed too (a scan without scene)
         corners = np.concatenate([corners, pts.min(axis=0)[None], pts.max(axis=0)[None]])
     cam = make_camera(model, spec, corners, opts.width / opts.height)
-    scene = _scene(model, data, cam)
+    scene = _scene(model, data, cam, opts.geom_groups)
     notes: list[str] = []
     image: np.ndarray | None = None
     backend = "software"

@@ -93,7 +93,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--plain",
         action="store_true",
-        help="default lights only, no environment map or shadows (faster without a GPU)",
+        help="simple lights, no environment map or shadows (faster without a GPU)",
+    )
+    p.add_argument(
+        "--simulate",
+        action="store_true",
+        help="start the MuJoCo simulation playing (the page's Simulation folder has "
+        "play/pause, step, actuator sliders, contacts and camera follow either way)",
     )
     p.set_defaults(func=_run, shows_only=True)
 
@@ -123,6 +129,7 @@ def _run(args: argparse.Namespace) -> int:
         body_frames=args.frames,
         site_frames=args.frames,
         plain=args.plain,
+        simulate=args.simulate,
         allowed_origins=tuple(args.allow_origins),
         **options,
     )

@@ -35,6 +35,7 @@ from robotwright.view.geometry import (
     site_frames,
 )
 from robotwright.view.scene import ViewError, ViewScene
+from robotwright.view.simulate import Contacts, Simulation, contacts, ctrl_problem, ctrl_range
 
 if TYPE_CHECKING:
     import viser
@@ -77,6 +78,9 @@ class ViewerConfig:
         plain: light with the default lights only, no environment map and no shadows:
             much faster where the browser draws without a GPU (software WebGL).
         verbose: let viser print its own banner and connection messages.
+        simulate: start the simulation playing (the page's *Simulation* folder has
+            play/pause, step and reset either way).
+        contacts: draw contact points and forces while simulating.
     """
 
     host: str = "127.0.0.1"
@@ -89,6 +93,8 @@ class ViewerConfig:
     grid: bool = True
     plain: bool = False
     verbose: bool = False
+    simulate: bool = False
+    contacts: bool = True
 
     def __post_init__(self) -> None:
         port_ok = isinstance(self.port, int) and not isinstance(self.port, bool)
@@ -144,6 +150,13 @@ class Viewer:
         self.refused_count = 0
         self._refusals = threading.Condition()
         self._slider_joint: dict[str, int] = {}  # slider uuid -> joint id
+        self._slider_actuator: dict[str, int] = {}  # slider uuid -> actuator id
+        self._ctrl_sliders: dict[int, Any] = {}
+        self.simulation = Simulation(self.model, self.data, self._lock)
+        self._follow: int | None = None  # body the cameras follow
+        self._follow_at: np.ndarray | None = None
+        self._fit_radius = 1.0
+        self._contact_nodes: list[Any] = []
         listener = bind_listener(self.config.host, self.config.port)
         address, port = listener.getsockname()[:2]
         self.exposure = (
@@ -260,9 +273,88 @@ class Viewer:
                 box.value = group in wanted
 
     def stop(self) -> None:
-        """Stop the server (the page stops updating)."""
+        """Stop the simulation thread and the server (the page stops updating)."""
+        self.simulation.stop()
         with contextlib.nullcontext() if self.config.verbose else _quiet_stdout():
             self.server.stop()
+
+    # -- simulation ---------------------------------------------------------------------
+    @property
+    def sim_time(self) -> float:
+        """Simulated time [s] since the start or the last reset."""
+        return float(self.data.time)
+
+    def play(self) -> None:
+        """Run the simulation in real time (as the page's *Play*)."""
+        self._set_playing(True)
+
+    def pause(self) -> None:
+        """Stop stepping; the state stays (as the page's *Pause*)."""
+        self._set_playing(False)
+
+    def step(self, n: int = 1) -> None:
+        """Pause, advance ``n`` timesteps (``mj_step``) and draw the state."""
+        self.pause()
+        self.simulation.step(n)
+        self._draw_state()
+
+    def reset(self) -> None:
+        """Pause and return to the first state: time 0, the first pose (keyframe 0 or
+        ``qpos0``), zero velocities, the keyframe's controls (else zero)."""
+        self.pause()
+        with self._lock:
+            mujoco.mj_resetData(self.model, self.data)
+            self.data.qpos[:] = self.scene.initial_qpos()
+            if self.model.nkey:
+                self.data.ctrl[:] = self.model.key_ctrl[0]
+        with self._sliders_quiet():
+            for i, slider in self._ctrl_sliders.items():
+                slider.value = float(np.clip(self.data.ctrl[i], slider.min, slider.max))
+        self._draw_state()
+
+    def set_ctrl(self, name: str | int, value: float) -> None:
+        """Set the control of actuator ``name`` (or its index; its slider's value),
+        checked.
+
+        Raises:
+            ViewError (a ``ValueError``): no actuator of that name, or ``value`` not a
+                finite number inside its ``ctrlrange`` (a control the model does not
+                limit takes any finite number).
+        """
+        if isinstance(name, (int, np.integer)) and not isinstance(name, bool):
+            i = int(name)
+        elif isinstance(name, str):
+            i = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+        else:
+            i = -1
+        if i < 0 or i not in self._ctrl_sliders:
+            names = [self._actuator_label(a) for a in self._ctrl_sliders]
+            raise ViewError(f"actuator '{name}': no such actuator; actuators: {names}")
+        problem = ctrl_problem(self.model, i, value)
+        if problem:
+            raise ViewError(f"actuator '{name}': {problem}")
+        self.simulation.set_ctrl(i, float(value))
+        slider = self._ctrl_sliders[i]
+        with self._sliders_quiet():
+            slider.value = float(np.clip(float(value), slider.min, slider.max))
+
+    def contacts(self) -> Contacts:
+        """The active contacts and their forces in the world frame (see
+        :func:`robotwright.view.simulate.contacts`)."""
+        with self._lock:
+            return contacts(self.model, self.data)
+
+    def follow(self, body: str | None) -> None:
+        """Make the page's cameras follow ``body`` (None: stop following)."""
+        if body is None:
+            self._follow, self._follow_at = None, None
+            return
+        b = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, body)
+        if b <= 0:
+            raise ViewError(f"body '{body}': no such body to follow")
+        with self._lock:
+            self._follow_at = self.data.xpos[b].copy()
+        self._follow = b
 
     def __enter__(self) -> Viewer:
         return self
@@ -276,6 +368,16 @@ class Viewer:
         if self.config.plain:
             server.scene.configure_environment_map(hdri=None)
             server.scene.configure_default_lights(True, cast_shadow=False)
+            # Without the environment map nothing lights a face turned away from the
+            # default lights (walls came out black): a sky/ground light and an ambient
+            # term give every face some of its colour, shaded by its direction.
+            server.scene.add_light_hemisphere(
+                "/lights/sky",
+                sky_color=(255, 255, 255),
+                ground_color=(150, 140, 130),
+                intensity=1.2,
+            )
+            server.scene.add_light_ambient("/lights/ambient", intensity=0.5)
         self.data.qpos[:] = self.scene.initial_qpos()
         xpos, xquat = body_poses(model, self.data)
         extent = max(float(model.stat.extent), 0.1)
@@ -311,6 +413,13 @@ class Viewer:
             self._add_scan()
         self._frame_camera()
         self._add_controls()
+        self._sent = body_poses(model, self.data)
+        if self.model.nkey:
+            self.data.ctrl[:] = self.model.key_ctrl[0]
+        self._add_simulation()
+        self.simulation.start(self._draw_state)
+        if self.config.simulate:
+            self.play()
 
     def _first_groups(self) -> set[int]:
         """The configured groups; when they are MuJoCo's default and hold no geom of the
@@ -365,28 +474,31 @@ class Viewer:
 
     def _frame_camera(self) -> None:
         """Look from the front-left (+x, -y, above) at what matters, far enough to see
-        all of it: the robot's geoms (those not on the world body), or for a scan the
-        bulk of its points (2nd to 98th percentile, so a few far hits do not shrink the
-        room)."""
+        all of it: the robots (see :func:`robot_bodies`; in a composed scene the robots,
+        not the room), else every geom not on the world body, else every geom but
+        planes; for a scan the bulk of its points (2nd to 98th percentile, so a few far
+        hits do not shrink the room)."""
         model, data = self.model, self.data
         scan = self.scene.scan
         if scan is not None and len(scan.points):
             lo, hi = np.percentile(scan.points, [2, 98], axis=0)
         else:
             mujoco.mj_kinematics(model, data)
-            moving = np.flatnonzero(
-                (model.geom_bodyid > 0) & np.isin(model.geom_group, list(self._visible_groups))
-            )
-            if moving.size == 0:
-                moving = np.flatnonzero(model.geom_type != int(mujoco.mjtGeom.mjGEOM_PLANE))
-            if moving.size:
-                r = model.geom_rbound[moving][:, None]
-                lo = (data.geom_xpos[moving] - r).min(axis=0)
-                hi = (data.geom_xpos[moving] + r).max(axis=0)
-            else:
-                lo, hi = -np.ones(3), np.ones(3)
+            shown = np.isin(model.geom_group, list(self._visible_groups))
+            not_plane = model.geom_type != int(mujoco.mjtGeom.mjGEOM_PLANE)
+            robots = np.isin(model.geom_bodyid, robot_bodies(model))
+            lo = hi = None
+            for pick in (robots & shown, (model.geom_bodyid > 0) & shown, not_plane):
+                if pick.any():
+                    lo, hi = geom_box(model, data, np.flatnonzero(pick))
+                    break
+            if lo is None or hi is None:  # nothing but planes: MuJoCo's own statistic
+                centre = np.asarray(model.stat.center, dtype=np.float64)
+                half = np.full(3, max(float(model.stat.extent), 0.2) / 2)
+                lo, hi = centre - half, centre + half
         centre = 0.5 * (lo + hi)
         radius = max(0.5 * float(np.linalg.norm(hi - lo)), 0.1)
+        self._fit_radius = radius
         direction = np.array([1.0, -1.0, 0.6])
         direction /= np.linalg.norm(direction)
         # The sphere around the box fills most of the (vertical) field of view.
@@ -525,6 +637,166 @@ class Viewer:
                 return f"{float(value):g} {unit} is outside the joint's range [{lo:g}, {hi:g}]"
         return None
 
+    # -- the simulation's controls ---------------------------------------------------------
+    def _actuator_label(self, i: int) -> str:
+        name = mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, i)
+        if name:
+            return name
+        model = self.model
+        target = ""
+        if int(model.actuator_trntype[i]) == int(mujoco.mjtTrn.mjTRN_JOINT):
+            target = self._joint_label(int(model.actuator_trnid[i, 0]))
+        return f"actuator {i}" + (f" ({target})" if target else "")
+
+    def _add_simulation(self) -> None:
+        """The *Simulation* folder: play/pause, step, reset, the time and real-time
+        factor, contacts, camera follow and one slider per actuator (its ``ctrl``)."""
+        gui, model = self.server.gui, self.model
+        with gui.add_folder("Simulation"):
+            self._play_button = gui.add_button("Play", hint="run MuJoCo in real time")
+            step = gui.add_button("Step", hint=f"one timestep ({model.opt.timestep:g} s)")
+            reset = gui.add_button("Reset", hint="time 0, the first pose, its controls")
+            self._clock = gui.add_markdown(self._clock_text())
+            shown = gui.add_checkbox("Contacts", initial_value=self.config.contacts)
+            self._contacts_box = shown
+            bodies = [
+                mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or ""
+                for b in range(1, model.nbody)
+            ]
+            options = ["(none)", *dict.fromkeys(n for n in bodies if n)]
+            follow = gui.add_dropdown("Follow", options, initial_value="(none)")
+            self._follow_menu = follow
+
+            @self._play_button.on_click
+            def _(_: Any) -> None:
+                self._set_playing(not self.simulation.playing)
+
+            @step.on_click
+            def _(_: Any) -> None:
+                self.step(1)
+
+            @reset.on_click
+            def _(_: Any) -> None:
+                self.reset()
+
+            @shown.on_update
+            def _(_: Any) -> None:
+                self._draw_contacts()
+
+            @follow.on_update
+            def _(_: Any) -> None:
+                self.follow(None if follow.value == "(none)" else follow.value)
+
+            if model.nu:
+                with gui.add_folder("Actuators"):
+                    for i in range(model.nu):
+                        self._ctrl_sliders[i] = self._add_ctrl_slider(i)
+
+    def _add_ctrl_slider(self, i: int) -> Any:
+        lo, hi, limited = ctrl_range(self.model, i)
+        slider = self.server.gui.add_slider(
+            self._actuator_label(i),
+            min=lo,
+            max=hi,
+            step=max((hi - lo) / 500.0, 1e-6),
+            initial_value=float(np.clip(self.data.ctrl[i], lo, hi)),
+            hint="ctrl" + ("" if limited else ", no ctrlrange in the model"),
+        )
+
+        @slider.on_update
+        def _(_: Any) -> None:
+            if self._quiet:
+                return
+            problem = check_value(0.0, slider.value, slider.min, slider.max)
+            if problem is None:
+                problem = ctrl_problem(self.model, i, slider.value)
+            if problem:
+                self._note_refusal(f"actuator '{self._actuator_label(i)}': {problem}")
+                return
+            self.simulation.set_ctrl(i, float(slider.value))
+
+        self._slider_actuator[slider._impl.uuid] = i
+        return slider
+
+    def _set_playing(self, on: bool) -> None:
+        if on:
+            self.simulation.play()
+        else:
+            self.simulation.pause()
+        self._play_button.label = "Pause" if on else "Play"
+        # Joint sliders set positions; while the physics runs they would fight it.
+        for slider in self._sliders.values():
+            slider.disabled = on
+        if not on:
+            with self._sliders_quiet():
+                for j, slider in self._sliders.items():
+                    value = float(self.data.qpos[self.model.jnt_qposadr[j]])
+                    slider.value = float(np.clip(value, slider.min, slider.max))
+
+    def _clock_text(self) -> str:
+        rtf = self.simulation.real_time_factor
+        shown = f"{rtf:.2f}" if rtf is not None and self.simulation.playing else "-"
+        text = f"t = {self.data.time:.3f} s, real-time factor {shown}"
+        if self.simulation.unstable:
+            text += f"  \n{_md(self.simulation.unstable)}"
+        return text
+
+    def _draw_state(self) -> None:
+        """Send the current state: body poses, contacts, the clock."""
+        if self.simulation.unstable and self._play_button.label != "Play":
+            self._set_playing(False)
+            self._note_refusal(self.simulation.unstable)
+        self._update_poses()
+        self._draw_contacts()
+        self._clock.content = self._clock_text()
+
+    def _draw_contacts(self) -> None:
+        """Contact points (red dots) and forces (arrows from the point along the force
+        on geom2; the robots' weight is drawn half as long as the robots are wide)."""
+        for node in self._contact_nodes:
+            node.remove()
+        self._contact_nodes = []
+        if not self._contacts_box.value:
+            return
+        found = self.contacts()
+        if not len(found.pos):
+            return
+        size = 0.015 * self._fit_radius
+        self._contact_nodes.append(
+            self.server.scene.add_point_cloud(
+                "/contacts/points",
+                points=found.pos.astype(np.float32),
+                colors=(230, 40, 40),
+                point_size=size * 2,
+                point_shape="circle",
+                precision="float32",
+            )
+        )
+        ends = found.pos + found.force * self._force_scale()
+        long = np.linalg.norm(ends - found.pos, axis=1) > 1e-6
+        if long.any():
+            self._contact_nodes.append(
+                self.server.scene.add_arrows(
+                    "/contacts/forces",
+                    points=np.stack([found.pos[long], ends[long]], axis=1).astype(np.float32),
+                    colors=(230, 120, 20),
+                    shaft_radius=0.3 * size,
+                    head_radius=0.8 * size,
+                    head_length=2.0 * size,
+                )
+            )
+
+    def _force_scale(self) -> float:
+        """Metres of arrow per newton: the weight of the robots (or of the model) is
+        drawn as long as the radius of what the camera was fitted to."""
+        model = self.model
+        roots = robot_bodies(model, roots_only=True)
+        mass = float(model.body_subtreemass[roots].sum()) if len(roots) else 0.0
+        if mass <= 0:
+            mass = float(model.body_subtreemass[0])
+        weight = mass * float(np.linalg.norm(model.opt.gravity))
+        return self._fit_radius / weight if weight > 0 else self._fit_radius / 10.0
+
     # -- messages from the page ----------------------------------------------------------
     def _check_message(self, message: Any) -> str | None:
         """Why a message from the page is refused, or None: a control update must set
@@ -541,7 +813,15 @@ class Viewer:
             return "a control update may set its value only"
         value = updates["value"]
         j = self._slider_joint.get(message.uuid)
-        label = f"joint '{self._joint_label(j)}'" if j is not None else f"control {handle.label!r}"
+        a = self._slider_actuator.get(message.uuid)
+        if j is not None:
+            label = f"joint '{self._joint_label(j)}'"
+        elif a is not None:
+            label = f"actuator '{self._actuator_label(a)}'"
+        else:
+            label = f"control {handle.label!r}"
+        if getattr(handle, "disabled", False):
+            return f"{label}: the control is disabled (joint sliders are while simulating)"
         problem = check_value(
             handle.value, value, getattr(handle, "min", None), getattr(handle, "max", None)
         )
@@ -587,10 +867,11 @@ class Viewer:
         self._update_poses()
 
     def _update_poses(self) -> None:
-        """Forward kinematics, then send the pose of every body that moved."""
+        """Forward kinematics, then send the pose of every body that moved since the
+        poses were last sent."""
         with self._lock:
-            old = self.data.xpos.copy(), self.data.xquat.copy()
             xpos, xquat = body_poses(self.model, self.data)
+        old = self._sent
         moved = np.flatnonzero(
             (np.abs(xpos - old[0]).max(axis=1) > 0) | (np.abs(xquat - old[1]).max(axis=1) > 0)
         )
@@ -599,6 +880,17 @@ class Viewer:
                 node = self._body_nodes[b]
                 node.position = xpos[b]
                 node.wxyz = xquat[b]
+        self._sent = (xpos, xquat)
+        if self._follow is not None and self._follow_at is not None:
+            target = xpos[self._follow]
+            shift = target - self._follow_at
+            self._follow_at = target.copy()
+            if np.abs(shift).max() > 0:
+                for client in self.server.get_clients().values():
+                    cam = client.camera
+                    with client.atomic():
+                        cam.position = np.asarray(cam.position) + shift
+                        cam.look_at = np.asarray(cam.look_at) + shift
 
     def _summary_markdown(self) -> str:
         m = self.model
@@ -623,6 +915,39 @@ class Viewer:
         ]
         head = f"<div><b>{len(scan.points)} hits of {scan.num_rays} rays</b></div>"
         return f'<div style="font-size:0.85em">{head}{"".join(rows)}</div>'
+
+
+def robot_bodies(model: mujoco.MjModel, *, roots_only: bool = False) -> np.ndarray:
+    """Ids of the bodies of the robots: the subtrees hanging from the world whose
+    joints are more than one free joint (an articulated robot, fixed or floating),
+    not walls and furniture (no joint) nor loose props (one free joint).
+    ``roots_only``: the subtrees' root bodies only."""
+    free = int(mujoco.mjtJoint.mjJNT_FREE)
+    root_of = np.asarray(model.body_rootid)
+    roots = []
+    for r in np.flatnonzero((np.arange(model.nbody) > 0) & (root_of == np.arange(model.nbody))):
+        joints = np.flatnonzero(root_of[model.jnt_bodyid] == r)
+        if len(joints) > 1 or (len(joints) == 1 and int(model.jnt_type[joints[0]]) != free):
+            roots.append(r)
+    roots_arr = np.array(roots, dtype=np.int64)
+    if roots_only:
+        return roots_arr
+    return np.flatnonzero(np.isin(root_of, roots_arr))
+
+
+def geom_box(
+    model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """World bounding box ``(lo, hi)`` [m] of ``geoms`` (their MuJoCo boxes ``geom_aabb``
+    placed at their world poses; kinematics must be current)."""
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+    points = []
+    for g in geoms:
+        centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
+        rot = data.geom_xmat[g].reshape(3, 3)
+        points.append((centre + signs * half) @ rot.T + data.geom_xpos[g])
+    every = np.concatenate(points)
+    return every.min(axis=0), every.max(axis=0)
 
 
 def _quiet_stdout() -> contextlib.AbstractContextManager[object]:
