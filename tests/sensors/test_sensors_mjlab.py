@@ -147,8 +147,10 @@ def test_mjlab_sensor_matches_the_core_sensor_and_labels_geoms(clutter_model):
         assert int(data.frame[0]) == step == ref.data.frame
         _compare_with_core(data, ref)
         _check_labels(env.sensor, data)
-        np.testing.assert_allclose(data.pos_w.numpy(), ref.data.pos_w, atol=1e-5)
-        assert (data.distances.numpy()[~data.hit_mask.numpy()] == 30.0).all()
+        np.testing.assert_allclose(data.sensor_pos_w.numpy(), ref.data.pos_w, atol=1e-5)
+        miss = ~data.hit_mask.numpy()
+        assert (data.distances.numpy()[miss] == -1.0).all()  # mjlab's miss value
+        assert (env.sensor.get_distances().numpy()[miss] == 30.0).all()  # the seed's
         assert set(np.unique(data.semantic_labels.numpy()).tolist()) == {0, 1, 2, 3}
         assert data.distances.device == torch.device("cpu") and data.distances.shape == (3, 20000)
         dirs = data.ray_directions_w.numpy().copy()
@@ -159,12 +161,14 @@ def test_mjlab_sensor_matches_the_core_sensor_and_labels_geoms(clutter_model):
     # Observation terms.
     obs = rw_mjlab.lidar_semantic_obs(env, "lidar")
     assert obs.shape == (3, 40000) and torch.isfinite(obs).all()
-    assert torch.equal(obs[:, 0::2], data.distances)
+    assert torch.equal(obs[:, 0::2], env.sensor.get_distances())
     assert torch.equal(obs[:, 1::2], data.semantic_labels.float())
     norm = rw_mjlab.lidar_distances_normalized(env, "lidar")
     assert float(norm.max()) == 1.0 and float(norm.min()) >= 0.0
-    assert torch.equal(norm, data.distances / 30.0)
-    one_hot = rw_mjlab.lidar_one_hot_classes(env, "lidar").reshape(3, 20000, 4)
+    assert torch.equal(norm, env.sensor.get_distances() / 30.0)
+    classes = len(env.sensor.class_names)  # unknown, the 3 default classes, robot
+    assert classes == 5
+    one_hot = rw_mjlab.lidar_one_hot_classes(env, "lidar").reshape(3, 20000, classes)
     assert torch.equal(one_hot.sum(-1), torch.ones(3, 20000))
     assert torch.equal(one_hot.argmax(-1).int(), data.semantic_labels)
     assert torch.equal(rw_mjlab.lidar_class_ids(env, "lidar"), data.semantic_labels.float())
@@ -285,7 +289,10 @@ def test_range_model_and_miss_value(clutter_model):
     diff = n.distances.numpy()[n_hit] - c.distances.numpy()[n_hit]
     assert 0.008 < diff.std() < 0.012 and np.abs(diff).max() < 0.1
     assert (n.distances.numpy()[~n_hit] == -1.0).all()
-    assert np.isnan(n.hit_pos_w.numpy()[~n_hit]).all()
+    # mjlab's convention: a miss's hit point is the ray origin, its normal zero.
+    np.testing.assert_array_equal(n.hit_pos_w.numpy()[~n_hit], n.ray_origins_w.numpy()[~n_hit])
+    assert (n.normals_w.numpy()[~n_hit] == 0.0).all()
+    assert np.isnan(noisy.sensor.get_pointcloud().numpy()[~n_hit]).all()
     assert ((n.distances.numpy()[n_hit] >= 0.5) & (n.distances.numpy()[n_hit] <= 6.0)).all()
     # The CPU column blocks (parallel launches) give exactly the one-launch result (the
     # CUDA path), noise and dropout included: each ray's random stream is its own.
@@ -324,11 +331,26 @@ SELF_SEEING_XML = """
 """
 
 
-def test_warnings_for_self_hits_and_unclassified_terrain():
+def test_defaults_class_terrain_and_the_robot_and_warn_only_when_unlabelled():
     model = mujoco.MjModel.from_xml_string(SELF_SEEING_XML)
     host = random_envs(model, 1)
+    shin = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "shin")
+    base = {"name": "lidar", "frame": ObjRef(type="body", name="robot"), "pattern": GridPatternCfg()}
+    # Defaults: mjlab terrain is terrain, the robot's own (included) shin is "robot".
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env = _Env(model, host, rw_mjlab.SemanticLidarSensorCfg(**base))
+    env.sense()
+    names = env.sensor.class_names
+    assert names == ("unknown", *DEFAULT_SEMANTIC_CLASS_MAPPING, "robot")
+    ids, labels = env.sensor.data.geom_ids.numpy(), env.sensor.data.semantic_labels.numpy()
+    assert (ids == shin).any() and (ids == 0).any()
+    assert (labels[ids == shin] == names.index("robot")).all()
+    assert (labels[ids == 0] == names.index("terrain")).all()
+    assert env.sensor.classify_geom(shin) == names.index("robot")
+    # self_class=None and a mapping without mjlab's terrain keyword: both warned about.
     cfg = rw_mjlab.SemanticLidarSensorCfg(
-        name="lidar", frame=ObjRef(type="body", name="robot"), pattern=GridPatternCfg()
+        **base, self_class=None, semantic_class_mapping=dict(DEFAULT_SEMANTIC_CLASS_MAPPING)
     )
     with pytest.warns(UserWarning) as caught:
         env = _Env(model, host, cfg)
@@ -336,22 +358,8 @@ def test_warnings_for_self_hits_and_unclassified_terrain():
     assert "/world/robot/leg/shin" in text and "see its own robot" in text
     assert "/world/terrain/terrain" in text and "mjlab_class_mapping" in text
     env.sense()
-    # The shin (group 0, not the parent body) is hit: what the warning is about.
-    shin = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "shin")
-    assert (env.sensor.data.geom_ids.numpy() == shin).any()
-    # With mjlab's terrain keyword the terrain is class 1 and the warning is gone.
-    mapped = rw_mjlab.SemanticLidarSensorCfg(
-        name="lidar",
-        frame=ObjRef(type="body", name="robot"),
-        pattern=GridPatternCfg(),
-        semantic_class_mapping=rw_mjlab.mjlab_class_mapping(),
-        include_geom_groups=(1,),
-    )
-    model.geom_group[0] = 1  # terrain in group 1, the shin (group 0) now excluded
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        env = _Env(model, host, mapped)
-    assert env.sensor.classify_geom(0) == 1
+    ids, labels = env.sensor.data.geom_ids.numpy(), env.sensor.data.semantic_labels.numpy()
+    assert (labels[(ids == shin) | (ids == 0)] == 0).all()
     assert (
         rw_mjlab.mjlab_class_mapping()["terrain"][:4] == DEFAULT_SEMANTIC_CLASS_MAPPING["terrain"]
     )
@@ -369,12 +377,34 @@ def test_warnings_for_self_hits_and_unclassified_terrain():
         ({"semantic_class_mapping": {"terrain": []}}, "empty keyword list"),
         ({"miss_distance": math.inf}, "miss_distance"),
         ({"ray_alignment": "roll"}, "ray_alignment"),
+        ({"include_geom_groups": (7,)}, "include_geom_groups"),
+        ({"self_class": ""}, "self_class"),
+        ({"debug_vis_max_points": -1}, "debug_vis_max_points"),
+        ({"refine_curved_hits": 1}, "refine_curved_hits"),
     ],
 )
-def test_config_is_validated(kwargs, message):
+def test_config_is_validated_in_build_after_any_change(kwargs, message):
+    """Construction never fails (mjlab changes configs after creating them); build() does,
+    whether the bad value was given at construction or set afterwards."""
     base = {"name": "lidar", "frame": ObjRef(type="body", name="trunk", entity="robot")}
+    given = rw_mjlab.SemanticLidarSensorCfg(**{**base, **kwargs})
     with pytest.raises(SensorError, match=message):
-        rw_mjlab.SemanticLidarSensorCfg(**{**base, **kwargs})
+        given.build()
+    later = rw_mjlab.SemanticLidarSensorCfg(**base)
+    later.build()  # the defaults are valid
+    for key, value in kwargs.items():
+        setattr(later, key, value)
+    with pytest.raises(SensorError, match=message):
+        later.build()
+
+
+def test_a_config_that_is_not_an_mjlab_sensor_config_is_named():
+    core = SemanticLidarCfg(prim_path="trunk")
+    with pytest.raises(SensorError, match="not an mjlab sensor config"):
+        rw_mjlab.resolve(core)
+    # Put into mjlab's scene.sensors by mistake, the core config says what to use.
+    with pytest.raises(SensorError, match="robotwright.sensors.mjlab.SemanticLidarSensorCfg"):
+        core.build()
 
 
 def test_observation_terms_refuse_other_sensors():
@@ -439,7 +469,7 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
         if dirs_prev is not None:
             assert not np.allclose(dirs, dirs_prev)
         dirs_prev = dirs
-        q = data.quat_w.numpy().astype(np.float64)
+        q = data.sensor_quat_w.numpy().astype(np.float64)
         for e in range(env.num_envs):
             rot = np.empty(9)
             mujoco.mju_quat2Mat(rot, q[e] / np.linalg.norm(q[e]))
@@ -449,9 +479,11 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
         hit = data.hit_mask.numpy()
         seen |= set(np.unique(data.semantic_labels.numpy()[hit]).tolist())
         dist = data.distances.numpy()
-        assert (dist >= 0).all() and (dist <= example.MAX_DISTANCE).all()
-        assert (dist[~hit] == example.MAX_DISTANCE).all()
-        assert np.isnan(data.hit_pos_w.numpy()[~hit]).all()
+        assert (dist[hit] >= 0).all() and (dist <= example.MAX_DISTANCE).all()
+        assert (dist[~hit] == -1.0).all()
+        np.testing.assert_array_equal(
+            data.hit_pos_w.numpy()[~hit], data.ray_origins_w.numpy()[~hit]
+        )
         expect = data.ray_origins_w.numpy() + dirs * dist[..., None]
         np.testing.assert_allclose(data.hit_pos_w.numpy()[hit], expect[hit], atol=1e-4)
     assert frames == list(range(frames[0], frames[0] + 12))
@@ -485,7 +517,7 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
     for _ in range(frames[-1] + 1):
         ref.update()
     assert ref.data.frame == frames[-1]
-    np.testing.assert_allclose(data.pos_w.numpy(), ref.data.pos_w, atol=1e-4)
+    np.testing.assert_allclose(data.sensor_pos_w.numpy(), ref.data.pos_w, atol=1e-4)
     _compare_with_core(data, ref)
     env.close()
 

@@ -233,6 +233,15 @@ class SemanticLidarCfg(LidarCfg):
             }
         check_class_mapping(self.semantic_class_mapping, f"{name}.semantic_class_mapping")
 
+    def build(self) -> None:
+        """Refuse to be built as an mjlab sensor: mjlab's ``scene.sensors`` calls ``build()``."""
+        from robotwright.errors import SensorError
+
+        raise SensorError(
+            f"{type(self).__name__} is the core sensor's config, not an mjlab sensor config: "
+            "in mjlab's scene.sensors use robotwright.sensors.mjlab.SemanticLidarSensorCfg"
+        )
+
 
 #: The name of class id 0 (a miss, or a geom no class names): no class may take it.
 UNKNOWN_CLASS = "unknown"

@@ -17,7 +17,11 @@ from mjlab.sensor.builtin_sensor import ObjRef
 from mjlab.sensor.raycast_sensor import RayCastSensorCfg
 
 from robotwright.errors import SensorError
-from robotwright.sensors.config import DEFAULT_SEMANTIC_CLASS_MAPPING, SemanticLidarCfg
+from robotwright.sensors.config import (
+    DEFAULT_SEMANTIC_CLASS_MAPPING,
+    UNKNOWN_CLASS,
+    SemanticLidarCfg,
+)
 from robotwright.sensors.patterns import GridPatternCfg, LivoxPatternCfg, PatternCfg
 
 if TYPE_CHECKING:
@@ -193,8 +197,15 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
     vis = cfg.debug_vis_max_points
     if not isinstance(vis, int) or isinstance(vis, bool) or not 0 <= vis <= 1_000_000:
         raise SensorError(f"{name}.debug_vis_max_points: expected an integer in [0, 1000000]")
-    if cfg.self_class is not None and (not isinstance(cfg.self_class, str) or not cfg.self_class):
-        raise SensorError(f"{name}.self_class: expected None or a non-empty class name")
+    if cfg.self_class is not None and (
+        not isinstance(cfg.self_class, str)
+        or not cfg.self_class
+        or cfg.self_class.lower() == UNKNOWN_CLASS
+    ):
+        raise SensorError(
+            f"{name}.self_class: expected None or a non-empty class name other than "
+            f"{UNKNOWN_CLASS!r}, got {cfg.self_class!r}"
+        )
     mapping = (
         mjlab_class_mapping() if cfg.semantic_class_mapping is None else cfg.semantic_class_mapping
     )
