@@ -181,3 +181,26 @@ def test_search_writes_winners_view_can_open(tmp_path, capsys):
     assert main(argv) == 2
     assert main([*argv, "--overwrite", "--no-picture"]) == 0
     assert not (out / "best_1" / "on_carrier.png").exists()
+
+
+def test_display_pose_is_the_pictures_pose(grammar):
+    from robotwright.grammar.draw import display_pose
+
+    for d in some_designs(grammar):
+        limb = build(grammar, d)
+        np.testing.assert_array_equal(P.display_pose(limb), display_pose(limb))
+
+
+def test_physics_search_same_on_processes_and_in_one(grammar):
+    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+
+    from robotwright.grammar.search import random_search
+
+    objs, cons = [Payload(samples=8), Energy(duration=0.5)], [NoCarrierCollision(samples=4)]
+    kw = dict(budget=4, max_links=2, seed=5)
+    with ThreadPoolExecutor(1) as one, ProcessPoolExecutor(2) as two:
+        a = random_search(grammar, objs, cons, executor=one, **kw)
+        b = random_search(grammar, objs, cons, executor=two, **kw)
+    assert [(e.design.hash(), e.values, e.violations) for e in a.evaluations] == [
+        (e.design.hash(), e.values, e.violations) for e in b.evaluations
+    ]
