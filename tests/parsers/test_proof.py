@@ -537,3 +537,14 @@ def test_export_urdf_proof(tmp_path: Path, monkeypatch, capsys) -> None:
     assert main(["export", str(hrdf_dir), "-o", str(out), "--strict"]) == 2
     err = capsys.readouterr().err
     assert "dof_damping" in err and "Traceback" not in err and not out.exists()
+
+
+def test_hrdf_folder_to_urdf_is_proved(tmp_path: Path, monkeypatch) -> None:
+    convert(_write(tmp_path, PLAIN), tmp_path / "robot")
+    assert not [m for m in convert(tmp_path / "robot", tmp_path / "a.urdf") if "proof:" in m]
+    _lose_urdf_damping(monkeypatch)
+    lost = [m for m in convert(tmp_path / "robot", tmp_path / "b.urdf") if "proof:" in m]
+    assert len(lost) == 1 and "dof_damping" in lost[0] and "'shoulder'" in lost[0], lost
+    with pytest.raises(ConversionError, match="dof_damping"):
+        convert(tmp_path / "robot", tmp_path / "c.urdf", strict=True)
+    assert not (tmp_path / "c.urdf").exists()

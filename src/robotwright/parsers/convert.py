@@ -161,14 +161,20 @@ def _proof(
 
     kind = file_kind(src_p, existing=True)
     if kind == "hrdf":
-        return []  # the output is the folder's own export: nothing else to compare with
-    path, opts = src_p, options
-    if is_xacro(src_p):
-        path, opts = xacro_as_urdf(src_p, options)
-    work = opts.get("work_dir")
-    found = prove(
-        path, kind, hrdf, out_kind, notes, options=opts, work_dir=Path(work) if work else None
-    )
+        if out_kind != "urdf":
+            return []  # the output is the folder's own export: nothing else to compare with
+        # A URDF holds less than the folder: MuJoCo's import of it against its MJCF.
+        from robotwright.parsers.proof_urdf import prove_urdf_output
+
+        found = prove_urdf_output(hrdf, str(src_p), notes)
+    else:
+        path, opts = src_p, options
+        if is_xacro(src_p):
+            path, opts = xacro_as_urdf(src_p, options)
+        work = opts.get("work_dir")
+        found = prove(
+            path, kind, hrdf, out_kind, notes, options=opts, work_dir=Path(work) if work else None
+        )
     if strict and found:
         raise ConversionError(
             found,
