@@ -1,17 +1,23 @@
-"""Every command shown in README.md and docs/*.md runs as written.
+"""Every command shown in README.md and docs/*.md runs as written, all of them in order.
 
 A user runs them from the project folder after the first set-up command
-(``python -m pip install . && robotwright demo``), so each document's commands run in
-order in a fresh folder holding the project's ``src/`` and the demo's output. Commands
-are the ``$ `` lines of ``console`` blocks and the lines of ``bash`` blocks (the set-up
-commands themselves excepted); syntax synopses with placeholders live in ``text``
-blocks. Output lines a document shows under a command must be what the command prints
-(timings and ``...`` excepted).
+(``python -m pip install . && robotwright demo``), README first, then each page of
+``docs/``: the test runs every command of every document in that order in one fresh
+folder holding a copy of the project's ``src/`` and the demo's output, and checks each
+one succeeds. So a command never collides with an earlier one's output (each writes its
+own output names, all under ``out/``, which ``.gitignore`` holds), prints at most one
+line on stderr (the notes' summary), and the commands leave nothing else behind (no
+stray file in the checkout, no ``MUJOCO_LOG.TXT``). Commands are the ``$ `` lines of
+``console`` blocks and the lines of ``bash`` blocks (the set-up commands themselves
+excepted); syntax synopses with placeholders live in ``text`` blocks. Output lines a
+document shows under a command must be what the command prints (timings and ``...``
+excepted).
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import re
 import shlex
@@ -54,18 +60,36 @@ def commands(document: Path) -> list[tuple[str, list[str]]]:
     return found
 
 
+#: What the documented commands may add to the folder they run in: their outputs, all
+#: under ``out/`` (the set-up's ``robotwright_demo/`` is there before them).
+OUTPUTS = {"out"}
+
+
+def _snapshot(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` (relative path -> SHA-256 of its bytes)."""
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and "__pycache__" not in p.parts
+    }
+
+
 @pytest.fixture(scope="module")
-def demo_output(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The folder the first set-up command leaves (``robotwright demo``), without the
-    pictures step (rendering is slow and no documented command reads its output)."""
-    out = tmp_path_factory.mktemp("setup") / "robotwright_demo"
+def fresh_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A fresh folder as a new user has it after the set-up: a copy of the project's
+    ``src/`` and the output of ``robotwright demo`` (without its pictures step: rendering
+    is slow and no documented command reads its output)."""
+    folder = tmp_path_factory.mktemp("fresh")
+    shutil.copytree(
+        ROOT / "src", folder / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info")
+    )
     steps = [s for s in demo.STEPS if s[1].__name__ != "step_pictures"]
     original, demo.STEPS = demo.STEPS, steps
     try:
-        demo.run_demo(out)
+        demo.run_demo(folder / "robotwright_demo")
     finally:
         demo.STEPS = original
-    return out
+    return folder
 
 
 def test_documents_show_commands() -> None:
@@ -73,33 +97,54 @@ def test_documents_show_commands() -> None:
     assert shown["README.md"] >= 8 and sum(shown.values()) >= 25, shown
 
 
-@pytest.mark.parametrize("document", DOCUMENTS, ids=lambda d: d.name)
-def test_every_command_runs_as_written(
-    document: Path, demo_output: Path, tmp_path: Path, monkeypatch, capsys
+def _run_command(document: Path, command: str, shown: list[str], capsys) -> list[str]:
+    """Run one documented command; the problems found (empty when it ran as written)."""
+    where = f"{document.name}: `{command}`"
+    words = shlex.split(command, comments=True)
+    if words[0] != "robotwright":
+        return [f"{where}: not a robotwright command"]
+    redirect = None
+    if ">" in words:
+        words, redirect = words[: words.index(">")], words[words.index(">") + 1]
+    if words[1] in INTERACTIVE:
+        return []
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        code = main(words[1:])
+    err = capsys.readouterr().err
+    if code != 0:
+        return [f"{where} exited {code}:\n{err}"]
+    problems = []
+    if len(err.splitlines()) > 1:
+        problems.append(f"{where} printed more than one line on stderr:\n{err}")
+    if redirect:
+        Path(redirect).write_text(stdout.getvalue(), encoding="utf-8")
+        if Path(redirect).stat().st_size == 0:
+            problems.append(f"{where} printed nothing into {redirect}")
+    printed = stdout.getvalue().splitlines()
+    problems += [
+        f"{where} did not print: {line}"
+        for line in shown
+        if not _TIMING.search(line) and line not in printed
+    ]
+    return problems
+
+
+def test_every_command_runs_in_order_in_one_fresh_folder(
+    fresh_folder: Path, monkeypatch, capsys
 ) -> None:
-    listed = commands(document)
-    if not listed:
-        pytest.skip(f"{document.name} shows no command")
-    (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
-    shutil.copytree(demo_output, tmp_path / "robotwright_demo")
-    monkeypatch.chdir(tmp_path)
-    for command, shown in listed:
-        words = shlex.split(command, comments=True)
-        assert words[0] == "robotwright", f"{document.name}: not a robotwright command: {command}"
-        redirect = None
-        if ">" in words:
-            words, redirect = words[: words.index(">")], words[words.index(">") + 1]
-        if words[1] in INTERACTIVE:
-            continue
-        stdout = io.StringIO()
-        with contextlib.redirect_stdout(stdout):
-            code = main(words[1:])
-        err = capsys.readouterr().err
-        assert code == 0, f"{document.name}: `{command}` exited {code}:\n{err}"
-        if redirect:
-            Path(redirect).write_text(stdout.getvalue(), encoding="utf-8")
-            assert Path(redirect).stat().st_size > 0
-        printed = stdout.getvalue().splitlines()
-        for line in shown:
-            if not _TIMING.search(line):
-                assert line in printed, f"{document.name}: `{command}` did not print: {line}"
+    """README's commands, then each page's, in one folder: every one exits 0 (none
+    refuses to replace an earlier one's output), and only ``out/`` is added."""
+    monkeypatch.chdir(fresh_folder)
+    before = _snapshot(fresh_folder)
+    entries = {p.name for p in fresh_folder.iterdir()}
+    problems: list[str] = []
+    for document in DOCUMENTS:
+        for command, shown in commands(document):
+            problems += _run_command(document, command, shown, capsys)
+    assert not problems, "\n".join(problems)
+    added = {p.name for p in fresh_folder.iterdir()} - entries
+    assert added <= OUTPUTS, f"the commands left files outside out/: {sorted(added - OUTPUTS)}"
+    after = _snapshot(fresh_folder)
+    changed = [name for name, digest in before.items() if after.get(name) != digest]
+    assert not changed, f"the commands changed the project's or the demo's files: {changed}"

@@ -3,9 +3,7 @@
 
 Each robot is described below with primitive geoms and per-geom masses; MuJoCo computes
 the body masses, centres of mass and principal inertias from those geoms
-(``inertiafromgeom``), and the result is saved as an HRDF folder. The robots hold only
-values every output format keeps (no actuator ``peak_velocity``: MJCF has no field for it),
-so exporting, viewing or rendering them prints no conversion notes. Run from the repo root:
+(``inertiafromgeom``), and the result is saved as an HRDF folder. Run from the repo root:
 
     python tools/make_bundled_robots.py
 """
@@ -303,7 +301,7 @@ def humanoid() -> HRDF:
             continue
         jname = b.joint[0]
         key = jname.removeprefix("left_").removeprefix("right_").removesuffix("_joint")
-        actuators.append(Actuator(joint=jname, peak_torque=torque[key]))
+        actuators.append(Actuator(joint=jname, peak_torque=torque[key], peak_velocity=20.0))
     sensors = [
         Sensor(name=f"{side}_foot_touch", type="touch", objtype="site", objname=f"{side}_sole")
         for side in ("left", "right")
@@ -393,6 +391,7 @@ def arm() -> HRDF:
             name=b.joint[0].removesuffix("_joint") + "_servo",
             type="position",
             peak_torque=peak[b.joint[0]],
+            peak_velocity=3.0,
             p_gain=200.0 if peak[b.joint[0]] > 20 else 50.0,
             d_gain=20.0 if peak[b.joint[0]] > 20 else 5.0,
             ctrl_range=b.joint[3],

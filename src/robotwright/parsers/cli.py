@@ -227,8 +227,9 @@ class _InfoRecords(logging.Handler):
 def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
     """Run a command with the parsers' log kept from the console (their warnings reach the
     user as the command's notes), restoring it after, so that a program calling
-    ``main()`` keeps its own logging. What an option made (``--actuators``) is reported
-    on stderr: one line, each with ``-v``."""
+    ``main()`` keeps its own logging. What an option made (``--actuators``) is part of
+    what was written: one line on stdout after ``wrote ...`` (stderr keeps one line, the
+    notes' summary), each on stderr with ``-v``."""
 
     @functools.wraps(func)
     def wrapper(args: argparse.Namespace) -> int:
@@ -250,8 +251,7 @@ def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
                         print(f"made: {line}", file=sys.stderr)
                 print(
                     f"{len(made.lines)} actuator(s) made by --actuators"
-                    + ("" if getattr(args, "verbose", False) else " (-v lists each)"),
-                    file=sys.stderr,
+                    + ("" if getattr(args, "verbose", False) else " (-v lists each)")
                 )
 
     return wrapper
