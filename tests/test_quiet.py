@@ -65,3 +65,62 @@ def test_bad_input_still_exits_2_with_a_closed_pipe(tmp_path: Path) -> None:
     done = _closed_reader(["info", str(tmp_path / "missing")])
     assert done.returncode == 2
     assert done.stderr.startswith("error: ")
+
+
+_COMPOSITE_EXAMPLE = """
+from robotwright.generators import MJCFGeneratorComposite, MJCFHumanoidGenerator, Placement
+
+scene = MJCFGeneratorComposite(
+    {
+        "h": MJCFHumanoidGenerator.from_robot_name("mini_humanoid"),
+        "arm": MJCFHumanoidGenerator.from_robot_name("arm6"),
+    },
+    placements={"arm": Placement(parent="h", frame="back_mount")},
+)
+model = scene.to_model()
+print(model.nbody)
+"""
+
+
+def test_readme_composite_example_shows_one_line_per_warning() -> None:
+    """The README's Python composite example: Python shows each robot's losses as one
+    line (head and counts), not one line per value."""
+    done = subprocess.run(
+        [sys.executable, "-W", "default", "-c", _COMPOSITE_EXAMPLE],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    shown = [line for line in done.stderr.splitlines() if "ConversionWarning" in line]
+    assert len(shown) == 2
+    assert "20 value(s) not written: 20 actuator.csv peak_velocity" in shown[0]
+    assert "6 value(s) not written: 6 actuator.csv peak_velocity" in shown[1]
+    # The display lines and the source line Python shows under each, nothing else.
+    assert len(done.stderr.splitlines()) == 4
+    assert int(done.stdout) > 20
+
+
+def test_conversion_warning_keeps_every_value_for_programs() -> None:
+    """str() of the same warning lists every value, one line each."""
+    import warnings
+
+    from robotwright.errors import ConversionWarning
+    from robotwright.generators import MJCFHumanoidGenerator
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        MJCFHumanoidGenerator.from_robot_name("mini_humanoid").generate()
+    (w,) = [w for w in caught if issubclass(w.category, ConversionWarning)]
+    text = str(w.message)
+    assert len(text.splitlines()) == 21
+    assert all(f"row {i}: column 'peak_velocity'" in text for i in range(20))
+    assert f"{w.message}".count("\n") == 0
+    assert f"{w.message}".endswith("str(warning) lists each")
+
+
+def test_a_warning_without_a_list_is_shown_as_it_is() -> None:
+    from robotwright.errors import ConversionWarning
+
+    w = ConversionWarning("robot 'x': one thing\nover two lines")
+    assert f"{w}" == str(w)

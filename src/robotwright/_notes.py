@@ -17,7 +17,16 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["Note", "collect_notes", "is_ours", "name_list", "notes_of", "summary_line"]
+__all__ = [
+    "Note",
+    "collect_notes",
+    "is_ours",
+    "kind_counts",
+    "name_list",
+    "notes_of",
+    "one_line",
+    "summary_line",
+]
 
 _PACKAGE_DIR = str(Path(__file__).resolve().parent)
 
@@ -116,10 +125,25 @@ def collect_notes() -> Iterator[CaughtNotes]:
 def summary_line(notes: Sequence[Note], where: str | None = None) -> str:
     """``N conversion note(s) (...): 22 joint.csv armature, 11 simple_geom.csv, ...; WHERE``
     (``where``: the file holding the full list, or how to print it)."""
-    counts = Counter(n.kind for n in notes)
-    kinds = ", ".join(f"{c} {k}" for k, c in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])))
     tail = f"; {where}" if where else ""
     return (
         f"{len(notes)} conversion note(s) (values or elements not kept or approximated): "
-        f"{kinds}{tail}"
+        f"{kind_counts(notes)}{tail}"
     )
+
+
+def kind_counts(notes: Sequence[Note]) -> str:
+    """``"22 joint.csv armature, 11 simple_geom.csv"``: how many notes of each kind, the
+    most frequent first."""
+    counts = Counter(n.kind for n in notes)
+    return ", ".join(f"{c} {k}" for k, c in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])))
+
+
+def one_line(message: str) -> str:
+    """A warning that lists values (``head:\n  - a\n  - b``) as one line: its head and
+    how many values of each kind (``robot 'arm6' to MJCF: 6 value(s) not written: 6
+    actuator.csv peak_velocity``); a message without a list as it is."""
+    head, sep, _ = str(message).partition("\n  - ")
+    if not sep:
+        return str(message)
+    return f"{' '.join(head.split()).rstrip(':')}: {kind_counts(notes_of(message))}"

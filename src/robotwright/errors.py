@@ -122,4 +122,21 @@ class InputFileError(RobotwrightError, ValueError):
 
 
 class ConversionWarning(UserWarning):
-    """An element was dropped or approximated during a conversion (named in the message)."""
+    """An element was dropped or approximated during a conversion (named in the message).
+
+    A warning that lists many values (``robot 'arm6' to MJCF: 6 value(s) not written:``
+    then one ``"\n  - "`` line per value) is shown by Python's warnings display as one
+    line: its head and how many values of each kind, ending ``str(warning) lists each``.
+    ``str(warning)`` keeps every value (programs, the command line's ``-v``)."""
+
+    def __format__(self, spec: str) -> str:
+        # Python's warnings display writes the message with an f-string, which calls
+        # __format__: a call that loses 30 values prints one line, not 30. str() (what
+        # programs and the command line read) is untouched.
+        from robotwright._notes import one_line
+
+        text = str(self)
+        short = one_line(text)
+        if spec or short == text:
+            return format(text, spec)
+        return f"{short}; str(warning) lists each"
