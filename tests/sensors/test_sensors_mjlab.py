@@ -335,7 +335,11 @@ def test_defaults_class_terrain_and_the_robot_and_warn_only_when_unlabelled():
     model = mujoco.MjModel.from_xml_string(SELF_SEEING_XML)
     host = random_envs(model, 1)
     shin = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "shin")
-    base = {"name": "lidar", "frame": ObjRef(type="body", name="robot"), "pattern": GridPatternCfg()}
+    base = {
+        "name": "lidar",
+        "frame": ObjRef(type="body", name="robot"),
+        "pattern": GridPatternCfg(),
+    }
     # Defaults: mjlab terrain is terrain, the robot's own (included) shin is "robot".
     with warnings.catch_warnings():
         warnings.simplefilter("error")

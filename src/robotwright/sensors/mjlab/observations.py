@@ -109,7 +109,9 @@ def lidar_point_cloud(
     per-ray terms (slot ``j`` is not a direction), so pair it with an encoder.
     """
     if not isinstance(max_points, int) or isinstance(max_points, bool) or max_points < 1:
-        raise SensorError(f"lidar_point_cloud: max_points must be an integer >= 1, got {max_points!r}")
+        raise SensorError(
+            f"lidar_point_cloud: max_points must be an integer >= 1, got {max_points!r}"
+        )
     if frame not in ("sensor", "base", "world"):
         raise SensorError(
             f"lidar_point_cloud: frame must be 'sensor', 'base' or 'world', got {frame!r}"
@@ -179,7 +181,9 @@ def lidar_range_image(
     """
     for what, v in (("width", width), ("height", height)):
         if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 4096:
-            raise SensorError(f"lidar_range_image: {what} must be an integer in [1, 4096], got {v!r}")
+            raise SensorError(
+                f"lidar_range_image: {what} must be an integer in [1, 4096], got {v!r}"
+            )
     s = _sensor(env, sensor_name)
     data = s.data
     e, n = data.hit_mask.shape

@@ -514,12 +514,17 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         points = _rows(data.hit_pos_w, env_ids)
         if frame == "sensor":
             rot = _rows(self._sensor_mat, env_ids)
-            points = torch.einsum("eji,enj->eni", rot, points - _rows(data.sensor_pos_w, env_ids)[:, None])
+            points = torch.einsum(
+                "eji,enj->eni", rot, points - _rows(data.sensor_pos_w, env_ids)[:, None]
+            )
         nan = torch.full((), float("nan"), device=points.device)
         return torch.where(_rows(data.hit_mask, env_ids)[..., None], points, nan)
 
     def classify_geom(self, geom_id: int) -> int:
         """Class id of a geom under this sensor's mapping (the robot's own class included)."""
-        if self.resolved.self_class_id and self.geom_semantic_class[geom_id] == self.resolved.self_class_id:
+        if (
+            self.resolved.self_class_id
+            and self.geom_semantic_class[geom_id] == self.resolved.self_class_id
+        ):
             return self.resolved.self_class_id
         return classify_path(self.geom_paths[geom_id], self.resolved.mapping)

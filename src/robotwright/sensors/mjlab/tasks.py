@@ -77,6 +77,8 @@ def _cracker_box_spec() -> mujoco.MjSpec:
 def semantic_lidar_go1_rough_env_cfg(play: bool = False) -> ManagerBasedRlEnvCfg:
     """mjlab's rough Go1 velocity task with obstacles and the semantic LiDAR ``"lidar"``."""
     cfg = unitree_go1_rough_env_cfg(play=play)
+    # The furniture and boxes touch the terrain too: room for their contacts per world.
+    cfg.sim.nconmax = max(cfg.sim.nconmax or 0, 35) + 150
     entities = {"furniture": EntityCfg(spec_fn=_furniture_spec)}
     yaw = {"yaw": (-3.14159, 3.14159)}
     cfg.events["reset_furniture"] = EventTermCfg(
