@@ -888,9 +888,13 @@ class Viewer:
             if np.abs(shift).max() > 0:
                 for client in self.server.get_clients().values():
                     cam = client.camera
+                    look_at = np.asarray(cam.look_at) + shift
                     with client.atomic():
+                        # viser moves the look-at point with the position (same view
+                        # direction); set it too where a version does not
                         cam.position = np.asarray(cam.position) + shift
-                        cam.look_at = np.asarray(cam.look_at) + shift
+                        if not np.allclose(cam.look_at, look_at):
+                            cam.look_at = look_at
 
     def _summary_markdown(self) -> str:
         m = self.model
