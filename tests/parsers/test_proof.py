@@ -319,6 +319,15 @@ def test_range_of_an_unlimited_joint_is_noted(tmp_path: Path) -> None:
     assert not [m for m in convert(_write(tmp_path, PLAIN), tmp_path / "o2") if "unlimited" in m]
 
 
+def test_range_of_a_free_joint_is_noted(tmp_path: Path) -> None:
+    xml = PLAIN.replace(
+        '<body name="base">', '<body name="base"><joint name="root" type="free" range="-2 2"/>'
+    )
+    messages = convert(_write(tmp_path, xml), tmp_path / "out")
+    assert any("unlimited joint" in m and '"root"' in m for m in messages), messages
+    assert not [m for m in messages if "proof:" in m], messages
+
+
 # -- real robots ------------------------------------------------------------------------------
 TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"
 CORPORA = {

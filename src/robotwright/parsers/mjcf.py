@@ -497,8 +497,9 @@ def _joints(
             # The free joint too: our MJCF and URDF then name it alike (URDF needs a name).
             name = joint_name(model, j)
             rep.warn(f"unnamed joint named '{name}'", where)
-        if jt != "free" and not model.jnt_limited[j] and np.any(model.jnt_range[j]):
-            # MuJoCo ignores the range of an unlimited joint: harmless, but said.
+        if not model.jnt_limited[j] and np.any(model.jnt_range[j]):
+            # MuJoCo ignores the range of an unlimited joint (a free joint's always):
+            # harmless, but said.
             rep.warn(
                 f"range {model.jnt_range[j].tolist()} of an unlimited joint dropped "
                 "(MuJoCo ignores it)",
