@@ -124,3 +124,46 @@ def test_a_warning_without_a_list_is_shown_as_it_is() -> None:
 
     w = ConversionWarning("robot 'x': one thing\nover two lines")
     assert f"{w}" == str(w)
+
+
+#: An OBJ whose faces name texture coordinates for some corners only: MuJoCo warns that
+#: it discards them (through its C warning handler, not an error).
+_PARTIAL_UV_OBJ = """v 0 0 0
+v 1 0 0
+v 0 1 0
+v 0 0 1
+vt 0 0
+vt 1 0
+f 1/1 2/2 3
+f 1/1 2/2 4
+f 1/1 3 4
+f 2 3 4
+"""
+_MESH_URDF = (
+    '<robot name="r"><link name="base"><inertial><mass value="1"/>'
+    '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+    '<visual><geometry><mesh filename="tri.obj"/></geometry></visual></link></robot>'
+)
+
+
+def test_mujoco_warnings_are_notes_of_the_one_summary_line(
+    tmp_path: Path, monkeypatch, capsys
+) -> None:
+    """MuJoCo's own warnings join the notes' summary line (each with -v) and leave no
+    MUJOCO_LOG.TXT in the working folder; MuJoCo's handler is put back after."""
+    import mujoco
+
+    (tmp_path / "tri.obj").write_text(_PARTIAL_UV_OBJ)
+    (tmp_path / "r.urdf").write_text(_MESH_URDF)
+    monkeypatch.chdir(tmp_path)
+    before = mujoco.get_mju_user_warning()
+    assert main(["export", "r.urdf", "-o", "r.xml"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "1 MuJoCo warning" in err[0] and "-v lists each" in err[0]
+    assert main(["export", "r.urdf", "-o", "r2.xml", "-v"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    listed = [line for line in err if line.startswith("note: MuJoCo: ")]
+    assert len(listed) == 1 and "tri.obj" in listed[0]
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+    assert mujoco.get_mju_user_warning() is before
+    assert mujoco.MjModel.from_xml_path("r.xml").nmesh == 1

@@ -20,7 +20,7 @@ from robotwright import __version__
 from robotwright._atomic import mesh_size_limit
 from robotwright._limits import keyframe_limit
 from robotwright._names import PrintableStream
-from robotwright._notes import CaughtNotes, collect_notes, summary_line
+from robotwright._notes import CaughtNotes, Note, collect_notes, summary_line
 from robotwright._npz import npz_limit
 from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
@@ -241,6 +241,16 @@ def _report_notes(caught: CaughtNotes, verbose: bool) -> None:
         print(summary_line(caught.notes, "-v lists each"), file=sys.stderr)
 
 
+def _mujoco_warnings(command: str) -> Any:
+    """MuJoCo's warnings gathered while a command that reads models runs (see
+    :mod:`robotwright._mujoco_log`); other commands do not import MuJoCo for it."""
+    if command not in _ASSET_COMMANDS and command not in ("demo", "grammar"):
+        return nullcontext([])
+    from robotwright._mujoco_log import gathered
+
+    return gathered()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; returns its exit code (2 for bad input, with a one-line error)."""
     out, err = sys.stdout, sys.stderr
@@ -295,8 +305,14 @@ def _run(args: argparse.Namespace) -> int:
             sources,
             copies,
             collect_notes() as caught,
+            _mujoco_warnings(args.command) as mujoco_warnings,
         ):
             code = int(args.func(args) or 0)
+        # MuJoCo's own warnings (a mesh's texture coordinates discarded, ...) are notes
+        # of the same summary line.
+        caught.notes += [
+            Note("MuJoCo warning", f"MuJoCo: {m}") for m in dict.fromkeys(mujoco_warnings)
+        ]
         # Commands that only show a model (view, render) write no conversion: the notes
         # of loading it say nothing about the picture, so they are listed with -v only.
         if not args.verbose and getattr(args, "shows_only", False):
