@@ -535,3 +535,83 @@ def test_go1_example_main_prints_a_summary_and_saves_the_picture(example, tmp_pa
     assert counts["unknown"] == 0
     assert all(counts[c] > 0 for c in DEFAULT_SEMANTIC_CLASS_MAPPING)
     assert summary["actor_obs"][1] > 2 * summary["rays"]
+
+
+def test_seed_getters_point_cloud_and_range_image(clutter_model):
+    model = _robot_in_group_3(clutter_model)
+    host = random_envs(model, 3, seed=4)
+    pattern = LivoxPatternCfg(num_rays=3000)
+    offset = {"offset_pos": (0.05, -0.02, 0.03), "offset_rot": (0.9659258, 0.0, 0.258819, 0.0)}
+    cfg = rw_mjlab.SemanticLidarSensorCfg(
+        name="lidar", frame=ObjRef(type="site", name="lidar"), pattern=pattern, **offset
+    )
+    env = _Env(model, host, cfg)
+    ref = SemanticLidarSensor(
+        SemanticLidarCfg(prim_path="lidar", pattern_cfg=pattern, return_mesh_ids=True, **offset),
+        model,
+        host,
+    )
+    env.sense()
+    ref.update()
+    s, data = env.sensor, env.sensor.data
+    hit = data.hit_mask
+    # The seed's getters, with env_ids; mesh_ids is geom_ids.
+    assert torch.equal(s.get_semantic_labels([2, 0]), data.semantic_labels[[2, 0]])
+    assert torch.equal(s.mesh_ids, data.geom_ids) and torch.equal(data.mesh_ids, data.geom_ids)
+    assert torch.equal(s.get_mesh_ids(torch.tensor([1])), data.geom_ids[1:2])
+    assert s.get_distances([1]).shape == (1, 3000)
+    same = (data.geom_ids.numpy() == ref.get_mesh_ids()) & hit.numpy()
+    for frame in ("world", "sensor"):
+        ours = s.get_pointcloud([0, 2], frame=frame).numpy()
+        theirs = ref.get_pointcloud([0, 2], frame=frame)
+        both = same[[0, 2]]
+        np.testing.assert_allclose(ours[both], theirs[both], atol=1e-4)
+        assert np.isnan(ours[~hit.numpy()[[0, 2]]]).all()
+    with pytest.raises(SensorError, match="frame must be"):
+        s.get_pointcloud(frame="base")
+    # Point cloud: a deterministic, evenly spaced sample of the hits, padded with zeros.
+    classes = len(s.class_names)
+    cloud = rw_mjlab.lidar_point_cloud(env, "lidar", max_points=512)
+    assert cloud.shape == (3, 512, 3 + classes)
+    assert torch.equal(cloud, rw_mjlab.lidar_point_cloud(env, "lidar", max_points=512))
+    sensor_points = s.get_pointcloud(frame="sensor")
+    for e in range(3):
+        idx = torch.nonzero(hit[e]).flatten()
+        take = idx[(torch.arange(512) * idx.numel()) // 512] if idx.numel() > 512 else idx
+        k = take.numel()
+        torch.testing.assert_close(cloud[e, :k, :3], sensor_points[e, take], atol=1e-5, rtol=0)
+        labels = cloud[e, :k, 3:].argmax(-1)
+        assert torch.equal(labels, data.semantic_labels[e, take].long())
+        assert (cloud[e, k:] == 0).all() and (cloud[e, :k, 3:].sum(-1) == 1).all()
+    big = rw_mjlab.lidar_point_cloud(env, "lidar", max_points=3000, frame="world")
+    counts = (big[..., 3:].sum(-1) > 0).sum(-1)
+    assert torch.equal(counts, hit.sum(-1))  # fewer hits than slots: all of them, padded
+    k = int(counts[0])
+    torch.testing.assert_close(big[0, :k, :3], data.hit_pos_w[0][hit[0]], atol=0, rtol=0)
+    # Range image: every ray's cell from its sensor-frame direction.
+    image = rw_mjlab.lidar_range_image(env, "lidar", width=16, height=4)
+    assert image.shape == (3, 1 + classes, 4, 16)
+    assert torch.equal(
+        rw_mjlab.lidar_range_image(env, "lidar", 16, 4, flatten=True), image.reshape(3, -1)
+    )
+    frame = int(data.frame[0])
+    d = s.table.window(frame)[1]
+    az = np.arctan2(d[:, 1], d[:, 0])
+    el = np.arctan2(d[:, 2], np.hypot(d[:, 0], d[:, 1]))
+    all_d = s.table.directions
+    all_el = np.arctan2(all_d[:, 2], np.hypot(all_d[:, 0], all_d[:, 1]))
+    col = np.clip(np.floor((az + np.pi) / (2 * np.pi) * 16), 0, 15).astype(int)
+    row = np.clip(np.floor((all_el.max() - el) / (all_el.max() - all_el.min()) * 4), 0, 3)
+    row = row.astype(int)
+    dist, labels, h = data.distances.numpy(), data.semantic_labels.numpy(), hit.numpy()
+    for e in range(3):
+        for r in range(4):
+            for c in range(16):
+                in_cell = (row == r) & (col == c)
+                hits = in_cell & h[e]
+                near = dist[e][hits].min() / 40.0 if hits.any() else 1.0
+                assert abs(float(image[e, 0, r, c]) - near) < 1e-5
+                for k in range(classes):
+                    frac = (hits & (labels[e] == k)).sum() / max(in_cell.sum(), 1)
+                    assert abs(float(image[e, 1 + k, r, c]) - frac) < 1e-5
+    assert float(image[:, 0].min()) < 1.0
