@@ -24,6 +24,7 @@ from robotwright._notes import CaughtNotes, Note, collect_notes, summary_line
 from robotwright._npz import npz_limit
 from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
+from robotwright._progress import shown as progress_shown
 from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
 from robotwright.parsers.packages import given_packages
@@ -306,6 +307,7 @@ def _run(args: argparse.Namespace) -> int:
             copies,
             collect_notes() as caught,
             _mujoco_warnings(args.command) as mujoco_warnings,
+            progress_shown(),
         ):
             code = int(args.func(args) or 0)
         # MuJoCo's own warnings (a mesh's texture coordinates discarded, ...) are notes

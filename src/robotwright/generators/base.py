@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from robotwright._atomic import atomic_files, check_output_path, write_text_atomic
+from robotwright._progress import steps
 from robotwright.errors import GeneratorError
 from robotwright.generators.xmlfmt import to_xml_string
 
@@ -178,7 +179,8 @@ class GeneratorBase(ABC):
                 # All or nothing: the copies and the file are staged, then moved into place
                 # (the file last, so it never names a mesh that is not there yet).
                 with atomic_files(path.parent) as staged:
-                    for src, dst in self._mesh_copy.items():
+                    copies = self._mesh_copy.items()
+                    for src, dst in steps(copies, len(copies), "meshes copied"):
                         if src != dst:
                             staged.copy(src, dst.relative_to(path.parent))
                     staged.write_text(path.name, text)

@@ -10,6 +10,8 @@ from pathlib import Path
 
 from robotwright._atomic import atomic_dir, check_output_path
 from robotwright._outputs import add_overwrite_flag, check_overwrite
+from robotwright._progress import Progress
+from robotwright._progress import duration as _duration
 from robotwright.errors import GrammarError, InputFileError, Problem
 
 #: Largest ``--max-links`` the commands accept. Exact counting grows with the cube of
@@ -49,45 +51,6 @@ def _max_links(text: str) -> int:
 
 
 _MAX_LINKS_HELP = f"largest number of links in a design (0 to {MAX_LINKS})"
-
-
-def _duration(seconds: float) -> str:
-    """``42 s``, ``3.5 min``, ``2.1 h``, ``4.0 days``, ``1.2e+03 years``."""
-    for unit, size in (("years", 365.25 * 86400), ("days", 86400), ("h", 3600), ("min", 60)):
-        if seconds >= 2 * size:
-            value = seconds / size
-            return f"{value:.3g} {unit}" if value < 1e4 else f"{value:.2g} {unit}"
-    return f"{seconds:.0f} s"
-
-
-class Progress:
-    """Progress of ``total`` steps on stderr: at most one line every ``every`` seconds,
-    with the rate and the estimated time left."""
-
-    def __init__(self, total: int, what: str, every: float = 5.0) -> None:
-        self.total, self.what, self.every = total, what, every
-        self.t0 = time.perf_counter()
-        self._last = self.t0
-
-    def eta(self, done: int) -> float | None:
-        """Estimated seconds left after ``done`` steps (None before the first)."""
-        if done <= 0:
-            return None
-        elapsed = time.perf_counter() - self.t0
-        return elapsed / done * max(self.total - done, 0)
-
-    def update(self, done: int, extra: str = "") -> None:
-        now = time.perf_counter()
-        if now - self._last < self.every or done >= self.total:
-            return
-        self._last = now
-        left = self.eta(done)
-        eta = "" if left is None else f", about {_duration(left)} left"
-        print(
-            f"  {done}/{self.total} {self.what}{extra} ({_duration(now - self.t0)}{eta})",
-            file=sys.stderr,
-            flush=True,
-        )
 
 
 def _warn_long(estimate_s: float, what: str) -> None:

@@ -29,6 +29,7 @@ from robotwright._inputs import (
     read_text,
 )
 from robotwright._paths import resolve_inside, trusted_roots
+from robotwright._progress import steps
 from robotwright.errors import (
     HRDFError,
     InputFileError,
@@ -1070,7 +1071,8 @@ def write_hrdf_dir(hrdf: HRDF, path: str | Path, *, overwrite: bool = False) -> 
             if text is not None:
                 (tmp / f"{stem}.csv").write_text(text, encoding="utf-8")
         copied: set[str] = set()
-        for mesh, source in zip(hrdf.meshes, sources, strict=True):
+        pairs = zip(hrdf.meshes, sources, strict=True)
+        for mesh, source in steps(pairs, len(sources), "meshes copied"):
             rel = (
                 mesh.file
                 if mesh.file is not None

@@ -27,6 +27,7 @@ import numpy as np
 
 from robotwright._notes import name_list
 from robotwright._paths import trusted_asset_roots
+from robotwright._progress import steps
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import (
     HRDF,
@@ -726,7 +727,8 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     tree = _read_tree(root, path)
     links, joints, parent_of, children = tree.links, tree.joints, tree.parent_of, tree.children
     order, roots = tree.order, tree.roots
-    data = {n: reader.link_data(links[n]) for n in order}
+    # A robot of many links with large meshes takes a while: progress past 2 s.
+    data = {n: reader.link_data(links[n]) for n in steps(order, len(order), "links read")}
     if reader.unresolved:
         from robotwright.parsers.unresolved import group_unresolved
 

@@ -20,6 +20,7 @@ import mujoco
 import numpy as np
 
 from robotwright._atomic import write_bytes_atomic
+from robotwright._progress import steps
 from robotwright.render.core import (
     RenderError,
     RenderOptions,
@@ -158,7 +159,7 @@ def animate(
             [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
         )
     pictures = []
-    for q in states:
+    for q in steps(states, len(states), "frames drawn"):
         data.qpos[:] = q
         mujoco.mj_forward(model, data)
         pictures.append(render_model(model, data, opts, bounds=box))
