@@ -557,3 +557,19 @@ def test_hrdf_folder_to_urdf_is_proved(tmp_path: Path, monkeypatch) -> None:
     with pytest.raises(ConversionError, match="dof_damping"):
         convert(tmp_path / "robot", tmp_path / "c.urdf", strict=True)
     assert not (tmp_path / "c.urdf").exists()
+
+
+def test_dropped_massless_root_link_is_one_reported_absence(tmp_path: Path) -> None:
+    # The parser drops a massless root link (noted); MuJoCo's import keeps it: its
+    # absence is the difference, not the parent and root ids of every body below it.
+    urdf = URDF.replace(
+        '<link name="base">',
+        '<link name="footprint"/><joint name="fp" type="fixed"><parent link="footprint"/>'
+        '<child link="base"/><origin xyz="0 0 0.1"/></joint><link name="base">',
+    )
+    src = _write(tmp_path, urdf, "u.urdf")
+    reference = proof.source_model(src, "urdf", {})
+    assert reference is not None and reference.body("footprint").id > 0
+    messages = convert(src, tmp_path / "out")
+    assert any("footprint" in m and "proof:" not in m for m in messages), messages
+    assert not [m for m in messages if "proof:" in m], messages

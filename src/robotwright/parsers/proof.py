@@ -112,9 +112,9 @@ _EQ_FAMILY = {0: "body", 1: "body", 2: "jnt", 3: "tendon"}
 #: bookkeeping that follows from the compared fields (see the module docstring).
 _SKIP_SUFFIX = ("adr", "num", "treeid", "plugin", "dataid", "matid", "mocapid")
 _SKIP_FIELDS = {"body_bvhadr", "body_bvhnum", "actuator_actadr", "key_mpos", "key_mquat",
-                # the compiler's shortcuts for a body whose frames coincide: they follow
+                # the compiler's shortcuts for an object whose frames coincide: they follow
                 # from the compared frames (and the axis order of its principal moments)
-                "body_sameframe", "body_simple"}  # fmt: skip
+                "body_sameframe", "body_simple", "geom_sameframe", "site_sameframe"}  # fmt: skip
 #: drawing only (MuJoCo's physics never reads them): colours, visibility groups, shadows
 #: and the drawn width of a tendon; a material's colour becomes ``geom_rgba`` as written.
 _APPEARANCE = ("_rgba", "_group", "_castshadow", "_width")
@@ -304,8 +304,12 @@ def _match(src: _Side, res: _Side, fam: str, body_map: dict[int, int]) -> dict[i
     # By structure: unnamed objects with the other side's unnamed ones, in order (a named
     # one not found by its name is missing).
     rest = [i for i in rest if not src.names[fam][i]]
+    # (a name no source object has is the converter's own: MuJoCo's URDF import names
+    # no geom, the parsers name one from its <collision name>)
+    src_names = {src.names[fam][i] for i in s_idx}
     for j in r_idx:
-        if j not in taken and _unnamed(res.names[fam][j]):
+        name = res.names[fam][j]
+        if j not in taken and (_unnamed(name) or name not in src_names):
             pool.setdefault(_structure_key(res, fam, j, None), []).append(j)
     for i in rest:
         cands = pool.get(_structure_key(src, fam, i, body_map))
@@ -492,6 +496,11 @@ def compare_models(
                 a = _ids(a, maps[_ID_FIELDS[attr]])
             elif attr in _POLY_ID_FIELDS:
                 a, b = _poly_ids(source, result, attr, si, ri, a, b, maps)
+            if attr in _ID_FIELDS or attr in _POLY_ID_FIELDS:
+                # An id of an object the result lacks: that absence is the difference
+                # (reported as the missing object), not every id that points at it.
+                gone = (np.asarray(a).reshape(len(a), -1) == -2).any(axis=1)
+                b = np.where(gone.reshape((-1,) + (1,) * (np.ndim(b) - 1)), a, b)
             if a.shape[1:] != b.shape[1:]:
                 diffs += [
                     _diff(
