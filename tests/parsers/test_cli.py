@@ -94,17 +94,18 @@ def test_convert_urdf_only_option_on_mjcf_source_is_named(probe: Path, tmp_path:
     assert "Traceback" not in err and not out.exists()
 
 
+# Our words only: what expat or defusedxml add after them is theirs to change.
 @pytest.mark.parametrize(
     ("name", "content", "expected"),
     [
         ("missing.urdf", None, "missing.urdf: file not found: expected a .urdf or .xml file"),
         ("model.txt", "x", "model.txt: expected a .urdf, .xacro or .xml (MJCF) file"),
-        ("empty.xml", "", "empty.xml: not well-formed XML: no element found"),
+        ("empty.xml", "", "empty.xml: not well-formed XML"),
         ("cut.urdf", "<robot name='r'><link name='a'>", "cut.urdf: not well-formed XML"),
         (
             "bomb.xml",
             '<!DOCTYPE m [<!ENTITY a "aa"><!ENTITY b "&a;&a;">]><mujoco model="&b;"/>',
-            "bomb.xml: unsafe XML refused (EntitiesForbidden)",
+            "bomb.xml: unsafe XML refused",
         ),
     ],
 )
