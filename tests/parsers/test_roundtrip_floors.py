@@ -142,3 +142,33 @@ def test_urdf_dummy_link_masses_allowed(tmp_path: Path) -> None:
     rows = {r.check: r for r in report.rows}
     assert any(k.startswith("URDF:") for k in rows), report.table()
     assert report.ok, report.table()
+
+
+def test_urdf_refused_like_the_source_is_not_a_failure(tmp_path: Path) -> None:
+    # A zero principal moment: MuJoCo refuses the source's full inertia (eigenvalues must
+    # be positive), the parser keeps it with a note, our MJCF compiles; MuJoCo refuses our
+    # URDF for the source's reason: nothing to compare there, not a failure of ours.
+    # (a tip welded to the link gives the moving body what MuJoCo needs, as in
+    # example-robot-data's finger_edu)
+    tip = (
+        '<link name="tip"><inertial><mass value="0.01"/><inertia ixx="1e-6" iyy="1e-6" '
+        'izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="t" '
+        'type="fixed"><parent link="arm"/><child link="tip"/><origin xyz="0 0 0.1"/></joint>'
+    )
+    src = tmp_path / "flat.urdf"
+    src.write_text(_urdf(1.2e-4, 1.2e-4, 0.0).replace("</robot>", tip + "</robot>"))
+    report = rt.roundtrip(src, configs=2)
+    assert report.reference.startswith("yourdfpy (MuJoCo refuses"), report.table()
+    (row,) = [r for r in report.rows if r.check == "URDF: our URDF loads in MuJoCo"]
+    assert row.ok and not row.applicable, report.table()
+    assert report.ok and report.input_error is None, report.table()
+    assert any("non-physical inertia" in w for w in report.warnings), report.warnings
+
+
+@pytest.mark.realdata
+def test_corpus_finger_edu_urdf_refused_like_the_source(capsys: pytest.CaptureFixture) -> None:
+    path = ERD / "finger_edu_description/robots/finger_edu.urdf"
+    if not path.is_file():
+        pytest.skip(f"example-robot-data absent: {path}")
+    assert main(["roundtrip", str(path), "--configs", "2"]) == 0
+    assert "n/a  URDF: our URDF loads in MuJoCo" in capsys.readouterr().out
