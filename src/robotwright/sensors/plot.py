@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -24,6 +25,8 @@ CLASS_COLORS: tuple[str, ...] = (
     "#17becf",
     "#e377c2",
 )
+#: Characters per line of a legend label (two columns fit the 13-inch-wide figure).
+_LEGEND_CHARS = 70
 
 
 def class_color(cls_id: int) -> str:
@@ -137,12 +140,15 @@ def plot_scan(
         ax.grid(True, alpha=0.3)
 
     # Legend markers drawn at a readable size (the scatter dots themselves are tiny).
+    # A class's keywords can be a long list (the default mapping's are): its label is
+    # wrapped, so the legend's columns stay within the figure's width.
     handles = []
     for cls_id, cls_name in enumerate(class_names):
         words = list((class_keywords or {}).get(cls_name, ()))
         what = f"{cls_name}: {', '.join(words)}" if words else cls_name
         if cls_id == 0:
             what = f"{cls_name} (no keyword matched)"
+        what = textwrap.fill(f"{what} ({counts[cls_id]} pts)", _LEGEND_CHARS)
         handles.append(
             Line2D(
                 [],
@@ -151,22 +157,27 @@ def plot_scan(
                 marker="o",
                 ms=7,
                 color=class_color(cls_id),
-                label=f"{what} ({counts[cls_id]} pts)",
+                label=what,
             )
         )
     if sensor_pos is not None:
         handles.append(Line2D([], [], ls="", marker="x", ms=9, mew=2, color="k", label="sensor"))
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 3), frameon=False)
+    legend = fig.legend(
+        handles=handles, loc="lower center", ncol=min(len(handles), 2), frameon=False
+    )
     heading = title or f"LiDAR scan: {len(points)} points"
     if upside_down(sensor_quat):
         heading += "\nnote: the sensor is mounted upside down (its z axis points down)"
     fig.suptitle(heading)
-    rows = (len(handles) + 2) // 3
-    fig.tight_layout(rect=(0, 0.06 * rows + 0.03, 1, 0.97))
+    # The views get what the legend leaves: its height measured once drawn.
+    fig.canvas.draw()
+    below = legend.get_window_extent().height / fig.bbox.height
+    fig.tight_layout(rect=(0, min(below + 0.02, 0.6), 1, 0.97))
     path = Path(path)
     try:
         with atomic_open(path, "wb") as fh:
-            fig.savefig(fh, format="png", dpi=110)
+            # "tight": the saved picture holds every drawn text, the whole legend too.
+            fig.savefig(fh, format="png", dpi=110, bbox_inches="tight", pad_inches=0.15)
     finally:
         plt.close(fig)
     return path
