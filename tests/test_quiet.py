@@ -167,3 +167,33 @@ def test_mujoco_warnings_are_notes_of_the_one_summary_line(
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
     assert mujoco.get_mju_user_warning() is before
     assert mujoco.MjModel.from_xml_path("r.xml").nmesh == 1
+
+
+def test_view_of_a_bundled_robot_prints_at_most_one_note_line(tmp_path: Path) -> None:
+    """view only shows the robot: no conversion notes without -v, and what the page
+    cannot draw in one line. Waits for the address line (readiness), not for a time."""
+    import signal
+
+    with (tmp_path / "stderr.txt").open("w+") as errors:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "robotwright", "view", "mini_humanoid", "--port", "0"],
+            stdout=subprocess.PIPE,
+            stderr=errors,
+            text=True,
+        )
+        try:
+            assert proc.stdout is not None
+            for line in proc.stdout:
+                if "Ctrl-C" in line:
+                    break
+            proc.send_signal(signal.SIGINT)
+            proc.communicate(timeout=600)  # a hang guard only
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+        errors.seek(0)
+        err = errors.read()
+    assert proc.returncode == 0, err
+    assert "conversion note" not in err and "peak_velocity" not in err
+    assert len(err.splitlines()) <= 1, err

@@ -115,13 +115,14 @@ def _run(args: argparse.Namespace) -> int:
     # the command line's usual form, rather than when the command ends.
     for line in scene.warnings:  # the model shown differs from the robot: always said
         print(f"warning: {line}", file=sys.stderr)
+    # The viewer only shows the model, as render does: what a conversion would not keep
+    # is listed with -v only.
+    verbose = bool(getattr(args, "verbose", False))
     notes = [n for message in scene.notes for n in notes_of(message)]
-    if notes and getattr(args, "verbose", False):
+    if notes and verbose:
         for n in notes:
             print(f"note: {n.text}", file=sys.stderr)
-    if notes:
-        hint = "listed above" if getattr(args, "verbose", False) else "-v lists each"
-        print(summary_line(notes, hint), file=sys.stderr)
+        print(summary_line(notes, "listed above"), file=sys.stderr)
     options = {} if args.groups is None else {"geom_groups": args.groups}
     config = ViewerConfig(
         host=args.host,
@@ -141,12 +142,13 @@ def _run(args: argparse.Namespace) -> int:
         f"{scene.title}: {m.nbody - 1} bodies, {m.njnt} joints, {viewer.geom_count} geoms shown"
         + (f", {len(scene.scan.points)} scan points" if scene.scan is not None else "")
     )
+    # What the page cannot draw as MuJoCo would: one line (each with -v).
     lines = [*viewer.notes, *viewer.skipped]
-    shown = lines if getattr(args, "verbose", False) else lines[:5]
-    for line in shown:
-        print(f"note: {line}", file=sys.stderr)
-    if len(shown) < len(lines):
-        print(f"note: ... {len(lines) - len(shown)} more (-v lists each)", file=sys.stderr)
+    if verbose or len(lines) == 1:
+        for line in lines:
+            print(f"note: {line}", file=sys.stderr)
+    elif lines:
+        print(f"note: {lines[0]} (and {len(lines) - 1} more; -v lists each)", file=sys.stderr)
     try:
         # Inside the try: a Ctrl-C right after the address is printed still stops cleanly.
         print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
