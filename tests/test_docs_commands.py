@@ -27,7 +27,7 @@ from pathlib import Path
 import pytest
 
 from robotwright import demo
-from robotwright.cli import main
+from robotwright.cli import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
@@ -110,6 +110,10 @@ def _run_command(document: Path, command: str, shown: list[str], capsys) -> list
     if ">" in words:
         words, redirect = words[: words.index(">")], words[words.index(">") + 1]
     if words[1] in INTERACTIVE:
+        try:
+            build_parser().parse_args(words[1:])
+        except SystemExit:
+            return [f"{where}: its arguments do not parse:\n{capsys.readouterr().err}"]
         return []
     stdout = io.StringIO()
     with contextlib.redirect_stdout(stdout):
