@@ -573,3 +573,20 @@ def test_dropped_massless_root_link_is_one_reported_absence(tmp_path: Path) -> N
     messages = convert(src, tmp_path / "out")
     assert any("footprint" in m and "proof:" not in m for m in messages), messages
     assert not [m for m in messages if "proof:" in m], messages
+
+
+def test_source_compile_reused_only_for_the_same_file(tmp_path: Path) -> None:
+    from robotwright.parsers.mjcf import parse_mjcf
+
+    src = _write(tmp_path, PLAIN)
+    parse_mjcf(src)
+    first = proof.source_model(src, "mjcf", {})
+    # Taken once: the next proof compiles the file again.
+    second = proof.source_model(src, "mjcf", {})
+    assert first is not None and second is not None and first is not second
+    assert proof.compare_models(first, second) == []
+    # A file changed after the parse is compiled as it is now.
+    parse_mjcf(src)
+    src.write_text(PLAIN.replace('mass="1"', 'mass="2.5"'))  # (another size too)
+    now = proof.source_model(src, "mjcf", {})
+    assert now is not None and now.body("base").mass[0] == 2.5

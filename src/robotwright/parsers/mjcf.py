@@ -14,6 +14,7 @@ contact pairs and excludes, keyframes) or is reported as a warning naming it.
 
 from __future__ import annotations
 
+import functools
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
@@ -165,9 +166,34 @@ _TRN_ATTR = {
     int(mujoco.mjtTrn.mjTRN_SITE): ("site", mujoco.mjtObj.mjOBJ_SITE),
     int(mujoco.mjtTrn.mjTRN_BODY): ("body", mujoco.mjtObj.mjOBJ_BODY),
 }
-_DYN = {0: "none", 1: "integrator", 2: "filter", 3: "filterexact", 4: "muscle", 5: "user"}
-_GAIN = {0: "fixed", 1: "affine", 2: "muscle", 3: "user"}
-_BIAS = {0: "none", 1: "affine", 2: "muscle", 3: "user"}
+
+
+def _keywords(enum: type, prefix: str) -> dict[int, str]:
+    """MJCF keywords of a MuJoCo enum (``mjDYN_FILTEREXACT`` -> ``filterexact``), from the
+    installed MuJoCo: 4.x numbers them differently from 3.x (``dcmotor`` before ``user``)."""
+    return {int(v): k[len(prefix) :].lower() for k, v in enum.__members__.items()}
+
+
+_DYN = _keywords(mujoco.mjtDyn, "mjDYN_")
+_GAIN = _keywords(mujoco.mjtGain, "mjGAIN_")
+_BIAS = _keywords(mujoco.mjtBias, "mjBIAS_")
+#: MuJoCo 4's declared control input (``actuator_ctrlspec``) -> the ``<general input>``
+#: keyword; absent in 3.x. Other values (a DC motor's voltage) follow from the gain type.
+_HAS_CTRLSPEC = hasattr(mujoco.MjModel, "actuator_ctrlspec")
+_INPUT = {1: "pos", 2: "vel", 32: "pressure"}
+
+
+@functools.cache
+def _table_ctrlspec() -> dict[str, int]:
+    """The ``actuator_ctrlspec`` each HRDF actuator type compiles to once written back
+    (``<motor>``, ``<position>``, ``<velocity>``), as the installed MuJoCo sets it."""
+    xml = (
+        "<mujoco><worldbody><body><joint name='j'/><geom size='1'/></body></worldbody>"
+        "<actuator><motor joint='j'/><position joint='j' kp='1'/><velocity joint='j' kv='1'/>"
+        "</actuator></mujoco>"
+    )
+    spec = mujoco.MjModel.from_xml_string(xml).actuator_ctrlspec
+    return {"motor": int(spec[0]), "position": int(spec[1]), "velocity": int(spec[2])}
 
 
 def _actuator_record(model: mujoco.MjModel, i: int) -> Actuator | None:
@@ -204,6 +230,10 @@ def _actuator_record(model: mujoco.MjModel, i: int) -> Actuator | None:
     ):
         kind, kv = "velocity", float(gain[0])
     if kind is None:
+        return None
+    # MuJoCo 4 declares the input a <position>/<velocity> takes (pos/vel); a <general>
+    # with the same gains declares none: the table's type would change it.
+    if _HAS_CTRLSPEC and int(model.actuator_ctrlspec[i]) != _table_ctrlspec()[kind]:
         return None
     return Actuator(
         joint=joint_name(model, int(model.actuator_trnid[i, 0])),
@@ -259,6 +289,8 @@ def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
     attrs["dyntype"] = _DYN[int(model.actuator_dyntype[i])]
     attrs["gaintype"] = _GAIN[int(model.actuator_gaintype[i])]
     attrs["biastype"] = _BIAS[int(model.actuator_biastype[i])]
+    if _HAS_CTRLSPEC and int(model.actuator_ctrlspec[i]) in _INPUT:
+        attrs["input"] = _INPUT[int(model.actuator_ctrlspec[i])]
     attrs["dynprm"] = _fmt(model.actuator_dynprm[i])
     attrs["gainprm"] = _fmt(model.actuator_gainprm[i])
     attrs["biasprm"] = _fmt(model.actuator_biasprm[i])
@@ -916,6 +948,10 @@ def parse_mjcf(
         if too_many is not None:
             raise InputFileError(path, too_many)
         model = spec.compile()
+        # The proof of the conversion compares with this compile (one compile saved).
+        from robotwright.parsers.proof import remember_parsed
+
+        remember_parsed(path, spec, model)
     except UnsafePathError as exc:
         problem = Problem(exc.file or str(path), exc.reason, element=exc.element)
         raise ConversionError([problem]) from exc

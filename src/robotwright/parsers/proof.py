@@ -773,9 +773,15 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
 
     try:
         if kind == "mjcf":
-            spec = mujoco.MjSpec.from_file(str(path))
-            model = spec.compile()
-            _SOURCE_MESHES[id(model)] = _mesh_files(spec)
+            parsed = _take_parsed(path)
+            if parsed is not None:
+                model, folder, meshdir, files = parsed
+            else:
+                spec = mujoco.MjSpec.from_file(str(path))
+                model = spec.compile()
+                folder, meshdir = spec.modelfiledir or "", spec.compiler.meshdir or ""
+                files = [m.file for m in spec.meshes]
+            _SOURCE_MESHES[id(model)] = _mesh_files(folder, meshdir, files)
             return model
         compiler = {
             k: options[k]
@@ -809,20 +815,50 @@ def _file_key(path: str | Path) -> tuple[int, str] | None:
 _SOURCE_MESHES: dict[int, tuple[str, str, dict[tuple[int, str], str]]] = {}
 
 
-def _mesh_files(spec: mujoco.MjSpec) -> tuple[str, str, dict[tuple[int, str], str]]:
+def _mesh_files(
+    folder: str, meshdir: str, files: Iterable[str]
+) -> tuple[str, str, dict[tuple[int, str], str]]:
     """The folders and mesh file names of an MJCF as MuJoCo read them: its model folder,
     its mesh folder, and per file content (size, SHA-256) the name as written."""
     import os
 
-    folder, meshdir = spec.modelfiledir or "", spec.compiler.meshdir or ""
     base = Path(folder or ".") / meshdir
     names: dict[tuple[int, str], str] = {}
-    for mesh in spec.meshes:
-        if mesh.file and not os.path.isabs(mesh.file):
-            key = _file_key(base / mesh.file)
+    for file in files:
+        if file and not os.path.isabs(file):
+            key = _file_key(base / file)
             if key is not None:
-                names.setdefault(key, mesh.file)
+                names.setdefault(key, file)
     return folder, meshdir, names
+
+
+#: the last MJCF the parser compiled: (resolved path, size and mtime) -> its model, model
+#: folder, mesh folder and mesh file names; taken by :func:`source_model` (one compile
+#: of the source saved). At most one is kept.
+_PARSED: dict[tuple[str, int, int], tuple[mujoco.MjModel, str, str, list[str]]] = {}
+
+
+def _stat_key(path: str | Path) -> tuple[str, int, int] | None:
+    try:
+        st = Path(path).stat()
+        return str(Path(path).resolve()), st.st_size, st.st_mtime_ns
+    except OSError:
+        return None
+
+
+def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel) -> None:
+    """Keep ``model``, the parser's compile of the MJCF file ``path`` from ``spec``
+    (compiled, not changed since), for the proof of the conversion that follows."""
+    _PARSED.clear()
+    key = _stat_key(path)
+    if key is not None:
+        files = [m.file for m in spec.meshes]
+        _PARSED[key] = (model, spec.modelfiledir or "", spec.compiler.meshdir or "", files)
+
+
+def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, str, str, list[str]] | None:
+    key = _stat_key(path)
+    return _PARSED.pop(key, None) if key is not None else None
 
 
 def _compile_with_same_files(
