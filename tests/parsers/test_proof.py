@@ -590,3 +590,32 @@ def test_source_compile_reused_only_for_the_same_file(tmp_path: Path) -> None:
     src.write_text(PLAIN.replace('mass="1"', 'mass="2.5"'))  # (another size too)
     now = proof.source_model(src, "mjcf", {})
     assert now is not None and now.body("base").mass[0] == 2.5
+
+
+def _with_tip(mass: str, inertia: str) -> str:
+    return URDF.replace(
+        '<link name="tip"/>',
+        f'<link name="tip"><inertial><origin xyz="0 0 0.05"/><mass value="{mass}"/>'
+        f'<inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" '
+        'iyz="0"/></inertial></link>',
+    )
+
+
+def test_urdf_merge_compared_with_mujocos_fused_import(tmp_path: Path) -> None:
+    src = _write(tmp_path, _with_tip("0.2", "0.001"), "u.urdf")
+    reference = proof.source_model(src, "urdf", {"fixed_joints": "merge"})
+    assert reference is not None
+    # MuJoCo fused the tip into the arm and kept the fixed base a body.
+    names = {reference.body(i).name for i in range(reference.nbody)}
+    assert "tip" not in names and {"base", "arm"} <= names
+    messages = convert(src, tmp_path / "out", fixed_joints="merge")
+    assert not [m for m in messages if "proof:" in m], messages
+
+
+def test_urdf_merge_of_a_massless_link_with_inertia_is_reported(tmp_path: Path) -> None:
+    # MuJoCo's fusion leaves out the inertia of a link without mass; the parser keeps
+    # it: the proof says so instead of either being silent.
+    src = _write(tmp_path, _with_tip("0", "0.001"), "u.urdf")
+    messages = convert(src, tmp_path / "out", fixed_joints="merge")
+    lost = [m for m in messages if "proof:" in m]
+    assert len(lost) == 1 and "body_inertia" in lost[0] and "'arm'" in lost[0], messages

@@ -794,7 +794,8 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
             inertia_from_geoms=options.get("inertia_from_geoms", "auto"),
             **compiler,
         )
-        return compile_urdf(text, options.get("density"))
+        fuse = options.get("fixed_joints", "keep") == "merge"
+        return compile_urdf(text, options.get("density"), fuse_static=fuse)
     except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
         return None
 
@@ -987,9 +988,9 @@ def prove(
 
         found = prove_urdf_output(hrdf, str(source), notes)
         out_kind = "mjcf"
-    if kind == "urdf" and options.get("fixed_joints", "keep") != "keep":
-        # MuJoCo's import keeps every link a body here (fusing static bodies would fuse
-        # the fixed base into the world): links merged on request have no counterpart.
+    if kind == "urdf" and options.get("fixed_joints", "keep") == "site":
+        # Massless leaf links become sites, others stay bodies: MuJoCo's import has no
+        # such choice to compare with (it keeps every link, or fuses every fixed one).
         return found
     src = source_model(source, kind, options)
     if src is None:

@@ -519,8 +519,15 @@ def urdf_for_mujoco(
     return ET.tostring(root, encoding="unicode")
 
 
-def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
+def compile_urdf(
+    text: str, density: float | None = None, *, fuse_static: bool = False
+) -> mujoco.MjModel:
     """MuJoCo's import of a URDF text (as :func:`urdf_for_mujoco` writes it), compiled.
+
+    ``fuse_static``: links on fixed joints fused into their parents by MuJoCo
+    (``fusestatic``, the import's default), the root link kept a body (MuJoCo would fuse
+    a fixed base into the world): the reference of ``fixed_joints="merge"``. It adds one
+    ``framepos`` sensor per top-level body (what keeps it; sensors are not a URDF's).
 
     ``density``: kg/m^3 given to the collision geoms (MuJoCo's import gives them its
     default, 1000; a URDF cannot say otherwise), for the links without ``<inertial>``.
@@ -541,6 +548,7 @@ def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
         and mujoco_urdf_imports_mimic()
         and mujoco_urdf_keeps_mesh_files_apart()
         and density is None
+        and not fuse_static
     ):
         return mujoco.MjModel.from_xml_string(text)
     root = DET.fromstring(text)
@@ -550,6 +558,17 @@ def compile_urdf(text: str, density: float | None = None) -> mujoco.MjModel:
         if assets:
             text = ET.tostring(root, encoding="unicode")
     spec = mujoco.MjSpec.from_string(text, assets=assets or None)
+    if fuse_static:
+        spec.compiler.fusestatic = True
+        # A body a sensor refers to is not fused: the root stays the robot's base.
+        top = spec.worldbody.first_body()
+        while top is not None:
+            spec.add_sensor(
+                type=mujoco.mjtSensor.mjSENS_FRAMEPOS,
+                objtype=mujoco.mjtObj.mjOBJ_XBODY,
+                objname=top.name,
+            )
+            top = spec.worldbody.next_body(top)
     if density is not None:
         for geom in spec.geoms:
             if geom.density > 0:  # collision geoms; the import gives visual ones 0
