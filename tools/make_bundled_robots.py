@@ -17,6 +17,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from robotwright._outputs import MARKER
 from robotwright.hrdf import (
     HRDF,
     Actuator,
@@ -418,6 +419,9 @@ def arm() -> HRDF:
 def main() -> None:
     for robot in (humanoid(), arm()):
         path = robot.save(OUT / robot.name, overwrite=True)
+        # The mark every saved output folder gets is for a user's outputs; the bundled
+        # robots are part of the package, so nothing is left in the checkout beside them.
+        (path / MARKER).unlink(missing_ok=True)
         print(f"wrote {path}: {robot.summary()}")
 
 
