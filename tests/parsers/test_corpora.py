@@ -43,8 +43,6 @@ CONFIGS = 20
 EXPECTED_FAILURES: dict[str, str] = {
     "pybullet/differential/diff_ring.urdf": "mesh paths are relative to pybullet_data (its "
     "search path), not to the URDF's folder: differential/differential/*.stl do not exist",
-    "pybullet/humanoid/humanoid.urdf": "pybullet's non-standard 'spherical' joints: our MJCF "
-    "is exact (ball joints), our URDF writes standard URDF, a ball as three revolute joints",
 }
 
 

@@ -71,15 +71,6 @@ EXPECTED_REFUSALS: dict[str, tuple[str, ...]] = {
         "no such file",
     ),
 }
-_CTRLSPEC = (
-    "silent: MuJoCo 4's actuator_ctrlspec of the <general> actuators (biastype affine) is 0 "
-    "in the source and 1 after conversion, with no note (found by the proof)"
-)
-_HAS_CTRLSPEC = hasattr(mujoco.MjModel, "actuator_ctrlspec")
-_BALL = (
-    "ball joints: our MJCF is exact, our URDF (no ball joint in URDF) writes each as three "
-    "revolute joints, so the URDF form's forward kinematics differ"
-)
 #: "corpus/relative path" -> why it converts but not exactly (strict xfail: fixing it
 #: makes the test fail until the entry goes).
 EXPECTED_FAILURES: dict[str, str] = {
@@ -91,18 +82,6 @@ EXPECTED_FAILURES: dict[str, str] = {
     "robot (dropped with a note)",
     "genesis-world/xml/franka_sim/franka_panda_teleop.xml": "scene: a weld equality ties "
     "the arm to the vive_controller mocap body outside the robot (dropped with a note)",
-    "genesis-world/xml/franka_emika_panda/panda.xml": _CTRLSPEC,
-    "genesis-world/xml/franka_emika_panda/panda_free_base.xml": _CTRLSPEC
-    + "; the free joint's range (from a class default; MuJoCo ignores a free joint's "
-    "range) is dropped without a note",
-    "genesis-world/xml/franka_emika_panda/panda_no_tendon.xml": _CTRLSPEC,
-    "genesis-world/xml/franka_emika_panda/panda_nohand.xml": _CTRLSPEC,
-    "genesis-world/xml/franka_emika_panda/panda_non_overlap.xml": _CTRLSPEC,
-    "genesis-world/xml/franka_emika_panda/scene.xml": _CTRLSPEC,
-    "genesis-world/xml/franka_emika_panda/scene_no_tendon.xml": _CTRLSPEC,
-    "genesis-world/xml/one_ball_joint.xml": _BALL,
-    "genesis-world/xml/rope_ball.xml": _BALL,
-    "genesis-world/xml/three_joint_link.xml": _BALL,
 }
 
 
@@ -128,8 +107,7 @@ def _params() -> list:
             key = f"{corpus}/{rel}"
             marks = []
             reason = EXPECTED_FAILURES.get(key)
-            # MuJoCo 3.11 has no actuator_ctrlspec: nothing there to differ.
-            if reason is not None and (reason != _CTRLSPEC or _HAS_CTRLSPEC):
+            if reason is not None:
                 marks.append(pytest.mark.xfail(reason=reason, strict=True))
             out.append(pytest.param(corpus, rel, marks=marks, id=key))
     return out

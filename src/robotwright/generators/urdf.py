@@ -107,21 +107,27 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
     After ``generate``/``export``, two maps tell readers of the file which links are not
     bodies of the robot: :attr:`dummy_links` (link name -> the body whose joints it
     splits, including anchor links) and :attr:`frame_links` (site/IMU name -> its link
-    name; differs from the site name only where it was renamed). Both are empty until
-    a tree is generated and are dropped with it.
+    name; differs from the site name only where it was renamed). A third tells which
+    joints stand for a ball joint: :attr:`split_joints` (ball joint name -> its revolute
+    joints about the body's x, y and z axes, parent side first, so that a rotation ``R``
+    of the ball is ``Rx(a) Ry(b) Rz(c)``). All are empty until a tree is generated and
+    are dropped with it.
     """
 
     dummy_links: dict[str, str]
     frame_links: dict[str, str]
+    split_joints: dict[str, tuple[str, str, str]]
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.dummy_links = {}
         self.frame_links = {}
+        self.split_joints = {}
 
     def _destroy(self) -> None:
         self.dummy_links = {}
         self.frame_links = {}
+        self.split_joints = {}
 
     def _robot_name(self) -> str:
         return self.hrdf.name if self.hrdf is not None else "robot"
@@ -178,6 +184,7 @@ class URDFHumanoidGenerator(HRDFMixin, URDFGeneratorBase):
         writer.write(root)
         self.dummy_links = dict(writer.dummy_links)
         self.frame_links = {k: writer.p(v) for k, v in writer.frame_links.items()}
+        self.split_joints = dict(writer.split_joints)
         _report(hrdf, "URDF", losses, strict)
 
 
@@ -207,6 +214,8 @@ class _RobotWriter:
         self.frame_links: dict[str, str] = {}
         #: dummy link name (prefixed) -> the body whose joints it splits.
         self.dummy_links: dict[str, str] = {}
+        #: ball joint name (prefixed) -> its x, y, z revolute joints (prefixed).
+        self.split_joints: dict[str, tuple[str, str, str]] = {}
 
     def p(self, name: str) -> str:
         return prefixed(self.prefix, name)
@@ -459,22 +468,25 @@ class _RobotWriter:
         for j in own:
             name = j.name or ""
             if j.type == "ball":
+                rng = (-j.range[1], j.range[1]) if j.range is not None else None
+                split = [self._fresh(f"{name}_{a}", self.joint_names) for a in "xyz"]
+                for jname, axis in zip(split, ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))):
+                    out.append((j, jname, "revolute" if rng else "continuous", axis, rng))
+                self.split_joints[self.p(name)] = (
+                    self.p(split[0]),
+                    self.p(split[1]),
+                    self.p(split[2]),
+                )
                 self.losses.append(
                     Problem(
                         "joint.csv",
-                        f"ball joint '{name}': URDF has none; written as revolute joints "
-                        f"'{name}_x', '{name}_y', '{name}_z' (each limited to the cone angle)",
+                        f"ball joint '{name}': URDF has none; written as "
+                        + ("revolute" if rng else "continuous")
+                        + f" joints '{split[0]}', '{split[1]}', '{split[2]}' about the body's "
+                        "x, y and z axes" + (" (each limited to the cone angle)" if rng else ""),
                         column="type",
                     )
                 )
-                rng = (-j.range[1], j.range[1]) if j.range is not None else None
-                for axis_name, axis in (
-                    ("x", (1.0, 0.0, 0.0)),
-                    ("y", (0.0, 1.0, 0.0)),
-                    ("z", (0.0, 0.0, 1.0)),
-                ):
-                    jname = self._fresh(f"{name}_{axis_name}", self.joint_names)
-                    out.append((j, jname, "revolute" if rng else "continuous", axis, rng))
             elif j.type == "slide":
                 out.append((j, name, "prismatic", j.axis, j.range))
             else:

@@ -32,6 +32,7 @@ from robotwright.errors import ConversionError, InputFileError, Problem
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
+    JointInfo,
     RobotView,
     compile_urdf,
     mimic_map,
@@ -686,18 +687,64 @@ class OurURDF:
     text: str
     dummy_links: dict[str, str]
     frame_links: dict[str, str]
+    #: ball joint -> the x, y, z revolute joints our URDF writes for it.
+    split_joints: dict[str, tuple[str, str, str]] = field(default_factory=dict)
 
     def view(self, model: mujoco.MjModel) -> RobotView:
         """View of ``model`` (this URDF compiled) without the links the URDF form adds:
         dummy links (their 1e-9 kg each stays in the total mass) and site links renamed
-        because a body has the site's name (the reference's FK of that name is the body)."""
+        because a body has the site's name (the reference's FK of that name is the body).
+        A ball joint is one joint of the view again: its FK takes the ball's quaternion
+        and sets the three revolute joints that stand for it to the same rotation."""
         view = view_from_model(model)
         drop = set(self.dummy_links)
         drop |= {link for site, link in self.frame_links.items() if link != site}
         view.bodies = [b for b in view.bodies if b not in drop]
         view.inertia_world = {k: v for k, v in view.inertia_world.items() if k not in drop}
         view.mass = {k: v for k, v in view.mass.items() if k not in drop or k in self.dummy_links}
+        if self.split_joints:
+            _join_split_balls(view, self.split_joints)
         return view
+
+
+def xyz_angles(quat: np.ndarray) -> tuple[float, float, float]:
+    """Angles ``(a, b, c)`` (rad) with ``Rx(a) Ry(b) Rz(c)`` the rotation of the unit
+    quaternion ``quat`` (w, x, y, z): a rotation about x, then about the new y, then
+    about the newest z, as the revolute joints standing for a ball joint turn."""
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, np.asarray(quat, dtype=float))
+    r = mat.reshape(3, 3)
+    b = float(np.arctan2(r[0, 2], np.hypot(r[0, 0], r[0, 1])))
+    a = float(np.arctan2(-r[1, 2], r[2, 2]))
+    c = float(np.arctan2(-r[0, 1], r[0, 0]))
+    return a, b, c
+
+
+def _join_split_balls(view: RobotView, split: dict[str, tuple[str, str, str]]) -> None:
+    """Turn the revolute joints standing for each ball joint back into that ball joint
+    of ``view`` (joints and FK)."""
+    joints = {j.name: j for j in view.joints}
+    parts = {n for names in split.values() for n in names}
+    balls = {ball: names for ball, names in split.items() if all(n in joints for n in names)}
+    kept = []
+    for j in view.joints:
+        ball = next((b for b, names in balls.items() if j.name == names[0]), None)
+        if ball is not None:
+            last = joints[balls[ball][2]]
+            kept.append(JointInfo(ball, "ball", last.body, np.zeros(3), None))
+        elif j.name not in parts:
+            kept.append(j)
+    view.joints = kept
+    inner = view.fk
+
+    def fk(q: dict[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        q = dict(q)
+        for ball, names in balls.items():
+            if ball in q:
+                q.update(zip(names, xyz_angles(q.pop(ball)), strict=True))
+        return inner(q)  # type: ignore[operator]
+
+    view.fk = fk
 
 
 def our_urdf(hrdf: HRDF) -> OurURDF:
@@ -713,7 +760,7 @@ def our_urdf(hrdf: HRDF) -> OurURDF:
         root = gen.generate(relative_mesh_path=False)
     # The generated tree as is: the same document export writes, less its indentation.
     text = urdf_for_mujoco(Path(f"{hrdf.name}.urdf"), root=root)
-    return OurURDF(text, dict(gen.dummy_links), dict(gen.frame_links))
+    return OurURDF(text, dict(gen.dummy_links), dict(gen.frame_links), dict(gen.split_joints))
 
 
 def our_urdf_model(hrdf: HRDF) -> mujoco.MjModel:
