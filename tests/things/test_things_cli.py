@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 
 from robotwright.cli import main
@@ -62,3 +64,31 @@ def test_cli_bad_inputs_and_outputs_are_clear_errors(tmp_path, capsys):
         "robot.xml",
     ]
     assert [p.name for p in (tmp_path / "hrdf").iterdir()] == ["x"]
+
+
+def test_urdf_with_meshes_to_mjcf_and_hrdf(tmp_path: Path, capsys) -> None:
+    """A URDF's meshes are staged while it is parsed; they are still there when the
+    Things output is written (the staging folder lived only as long as the parsed robot,
+    which was gone before the export: 'asset file ... does not exist')."""
+    import struct
+
+    tri = [(0, 0, 0), (0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1)]
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    stl = bytearray(b"\0" * 80 + struct.pack("<I", len(faces)))
+    for f in faces:
+        stl += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *tri[i]) for i in f)
+        stl += b"\0\0"
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "m.stl").write_bytes(bytes(stl))
+    urdf = tmp_path / "src" / "r.urdf"
+    urdf.write_text(
+        '<robot name="r"><link name="base"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '<visual><geometry><mesh filename="m.stl"/></geometry></visual></link></robot>'
+    )
+    out = tmp_path / "out" / "r.xml"
+    assert main(["things", str(urdf), str(out)]) == 0, capsys.readouterr().err
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1
+    folder = tmp_path / "out" / "r_hrdf"
+    assert main(["things", str(urdf), str(folder)]) == 0, capsys.readouterr().err
+    assert len(list(folder.rglob("*.stl"))) == 1

@@ -48,7 +48,10 @@ def _run(args: argparse.Namespace) -> int:
         # Things read MJCF themselves: every element they model is kept.
         world = World.from_xml_path(resolved.path, strict=args.strict)
     else:  # a robot name, an HRDF folder, a URDF or xacro: through HRDF
-        world = hrdf_to_world(load_robot(args.source, strict=args.strict), strict=args.strict)
+        # Held until the output is written: a parsed URDF's meshes live in a staging
+        # folder that goes away with the robot (its temp_assets).
+        robot = load_robot(args.source, strict=args.strict)
+        world = hrdf_to_world(robot, strict=args.strict)
     if to_xml:
         written = world.export(output)
     else:
