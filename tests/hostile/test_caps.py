@@ -546,6 +546,18 @@ def test_max_keyframes_flag_lowers_and_raises_the_limit(tmp_path, capsys):
     assert (out / "extra.xml").read_text(encoding="utf-8").count("<key ") == 10_001
 
 
+def test_python_keyframe_limit_lowers_and_raises_the_limit(tmp_path):
+    import robotwright
+    from robotwright.errors import RobotwrightError
+    from robotwright.parsers import mjcf_to_hrdf
+
+    src = _keyframe_mjcf(tmp_path / "k.xml", 3)
+    with robotwright.keyframe_limit(2), pytest.raises(RobotwrightError, match="3 keyframes"):
+        mjcf_to_hrdf(src)
+    with robotwright.keyframe_limit(3):
+        assert "<key " in mjcf_to_hrdf(src).mjcf_extra
+
+
 @pytest.mark.parametrize("keys", [3, 50])
 def test_hrdf_extra_xml_keyframes_are_capped(tmp_path, capsys, keys):
     robot = tmp_path / "arm6"
