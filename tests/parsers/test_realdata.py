@@ -32,7 +32,7 @@ MASSLESS = (
 )
 EXPECTED_FAILURES: dict[str, str] = {
     "alex_description/urdf/alex_nub_hands.urdf": "nub.obj holds 4 objects and MuJoCo reads the first only, an open 29-face shell whose volume it refuses, in the source and in our MJCF (passes with join_obj_objects, see test_split_obj_robot_passes_with_join_obj_objects)",
-    "alex_description/urdf/alex_psyonic_hands.urdf": "mimic joints name a joint ('index_q1') that does not exist; the mimic is dropped, yourdfpy still couples them",
+    "alex_description/urdf/alex_psyonic_hands.urdf": "non-physical inertias (A + B < C on four links) that HRDF refuses: the round trip is refused as bad input; its mimic joints also name a joint ('index_q1') that does not exist (dropped with a note; yourdfpy still couples them)",
     "human_description/robots/human.urdf": MASSLESS,
     "icub_description/robots/icub.urdf": MASSLESS,
     "icub_description/robots/icub_reduced.urdf": MASSLESS,
