@@ -222,5 +222,27 @@ def test_render_prints_no_notes_line_unless_verbose(tmp_path, capsys) -> None:
     assert main(["render", str(urdf), "-o", str(out), "--size", "160x120"]) == 0
     assert out.is_file()
     assert "conversion note" not in capsys.readouterr().err
-    assert main(["render", str(urdf), "-o", str(out), "--size", "160x120", "--overwrite", "-v"]) == 0
+    assert (
+        main(["render", str(urdf), "-o", str(out), "--size", "160x120", "--overwrite", "-v"]) == 0
+    )
     assert "conversion note" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "geom",
+    [
+        '<geom type="box" size="0.1 0.1 0.1" mass="-1"/>',
+        '<geom type="box" size="0.1 0.1 0.1" density="-5"/>',
+        '<geom type="sphere" size="0.1" fromto="0 0 0 0 0 0"/>',
+        '<geom type="mesh" mesh="nothing"/>',
+    ],
+)
+def test_a_model_mujoco_refuses_is_one_error_line(tmp_path: Path, capsys, geom: str) -> None:
+    # MuJoCo's own message names the element on a second line; the user gets one line.
+    src = tmp_path / "bad.xml"
+    src.write_text(f'<mujoco><worldbody><body name="b"><joint/>{geom}</body></worldbody></mujoco>')
+    out = tmp_path / "out.xml"
+    assert main(["convert", str(src), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1, err
+    assert str(src) in err and not out.exists()

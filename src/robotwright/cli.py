@@ -26,7 +26,7 @@ from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
 from robotwright._progress import shown as progress_shown
 from robotwright._suggest import did_you_mean
-from robotwright.errors import RobotwrightError
+from robotwright.errors import ProblemsError, RobotwrightError
 from robotwright.parsers.packages import given_packages
 from robotwright.sources import given_source_options, source_options
 
@@ -287,6 +287,20 @@ def _closed_pipe(out: Any) -> int:
     return 0
 
 
+def _one_line(text: str) -> str:
+    """``text`` on one line: MuJoCo's messages carry the element and line on a second."""
+    return " ".join(line.strip() for line in text.splitlines() if line.strip())
+
+
+def _error_text(exc: RobotwrightError) -> str:
+    """The message of a refusal: one line, or for several problems one line each under
+    a heading line."""
+    if isinstance(exc, ProblemsError) and len(exc.problems) > 1:
+        head, _, _ = str(exc).partition("\n")
+        return "\n".join([head, *(f"  - {_one_line(str(p))}" for p in exc.problems)])
+    return _one_line(str(exc))
+
+
 def _run(args: argparse.Namespace) -> int:
     try:
         roots = getattr(args, "asset_roots", None) or []
@@ -322,7 +336,7 @@ def _run(args: argparse.Namespace) -> int:
         _report_notes(caught, bool(args.verbose))
         return code
     except RobotwrightError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {_error_text(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         # Ctrl-C on long work (grammar enumeration, search): a line, not a traceback.

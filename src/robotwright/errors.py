@@ -46,6 +46,10 @@ class ProblemsError(RobotwrightError):
     def __init__(self, problems: list[Problem], summary: str | None = None) -> None:
         self.problems = list(problems)
         errors = [p for p in self.problems if p.severity == "error"]
+        if len(self.problems) == 1 and summary is None:
+            # One problem already names its file, element and field: one line.
+            super().__init__(str(self.problems[0]))
+            return
         head = summary or f"{len(errors)} problem(s) found"
         body = "\n".join(f"  - {p}" for p in self.problems)
         super().__init__(f"{head}:\n{body}" if body else head)
