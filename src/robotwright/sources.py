@@ -93,7 +93,8 @@ def _float_arg(what: str, *, positive: bool) -> Any:
     return parse
 
 
-def _xacro_arg(text: str) -> tuple[str, str]:
+def parse_xacro_arg(text: str) -> tuple[str, str]:
+    """``NAME:=VALUE`` (xacro's own syntax) of ``--xacro-arg``, as ``(NAME, VALUE)``."""
     name, sep, value = text.partition(":=")
     if not sep or not name.strip():
         raise argparse.ArgumentTypeError(f"{text!r}: expected NAME:=VALUE")
@@ -149,7 +150,7 @@ def add_source_options(p: argparse.ArgumentParser) -> None:
     add(
         "--xacro-arg",
         action="append",
-        type=_xacro_arg,
+        type=parse_xacro_arg,
         metavar="NAME:=VALUE",
         help=".xacro: value of $(arg NAME) (repeatable)",
     )

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import ConversionWarning
+from robotwright.sources import parse_xacro_arg
 
 
 def _options(args: argparse.Namespace) -> dict:
@@ -65,14 +66,6 @@ def _density(text: str) -> float:
         raise argparse.ArgumentTypeError(f"{text!r}: expected a finite number > 0") from None
 
 
-def _xacro_arg(text: str) -> tuple[str, str]:
-    """``name:=value`` (xacro's own syntax) of ``--xacro-arg``."""
-    name, sep, value = text.partition(":=")
-    if not sep or not name.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: expected NAME:=VALUE")
-    return name.strip(), value
-
-
 def _source_args(p: argparse.ArgumentParser) -> None:
     """Options of the parsers (URDF/MJCF source -> HRDF), shared by convert and roundtrip."""
     p.add_argument(
@@ -100,7 +93,7 @@ def _source_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--xacro-arg",
         action="append",
-        type=_xacro_arg,
+        type=parse_xacro_arg,
         metavar="NAME:=VALUE",
         help=".xacro sources: value of $(arg NAME) (repeat for several)",
     )
