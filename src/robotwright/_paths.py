@@ -49,15 +49,24 @@ PathLike = str | os.PathLike[str]
 _TRUSTED: ContextVar[tuple[Path, ...]] = ContextVar("robotwright_trusted_roots", default=())
 
 
-def _root(folder: PathLike) -> Path:
-    path = Path(folder).expanduser()
+def resolve_folder(folder: PathLike, label: str) -> Path:
+    """``folder`` (``~`` expanded) resolved, symbolic links followed.
+
+    Raises:
+        UnsafePathError: it cannot be resolved (a link loop) or is not an existing
+            folder; the message starts with ``label`` (how the caller names the folder).
+    """
     try:
-        resolved = path.resolve()
+        resolved = Path(folder).expanduser().resolve()
     except (OSError, RuntimeError) as exc:
-        raise UnsafePathError(f"{folder}: trusted asset root cannot be resolved: {exc}") from None
+        raise UnsafePathError(f"{label} cannot be resolved: {exc}") from None
     if not resolved.is_dir():
-        raise UnsafePathError(f"{folder}: trusted asset root is not a folder")
+        raise UnsafePathError(f"{label} is not a folder")
     return resolved
+
+
+def _root(folder: PathLike) -> Path:
+    return resolve_folder(folder, f"{folder}: trusted asset root")
 
 
 @contextmanager

@@ -46,7 +46,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from robotwright._assets import check_asset_file
-from robotwright._paths import resolve_inside
+from robotwright._paths import resolve_folder, resolve_inside
 from robotwright.errors import InputFileError, UnsafePathError
 
 _NAME_RE = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
@@ -69,14 +69,7 @@ def given_packages(packages: Mapping[str, str | os.PathLike[str]]) -> Iterator[d
     added = []
     for name, folder in packages.items():
         check_package_name(name)
-        path = Path(folder).expanduser()
-        try:
-            resolved = path.resolve()
-        except (OSError, RuntimeError) as exc:
-            raise UnsafePathError(f"package '{name}': {folder} cannot be resolved: {exc}") from None
-        if not resolved.is_dir():
-            raise UnsafePathError(f"package '{name}': {folder} is not a folder")
-        added.append((name, resolved))
+        added.append((name, resolve_folder(folder, f"package '{name}': {folder}")))
     token = _GIVEN.set(tuple(added) + _GIVEN.get())
     try:
         yield dict(reversed(_GIVEN.get()))
