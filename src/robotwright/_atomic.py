@@ -40,6 +40,7 @@ from contextvars import ContextVar
 from pathlib import Path
 from typing import IO, Any
 
+from robotwright._limits import limit_for_block, megabytes
 from robotwright.errors import InputFileError, OutputPathError
 
 __all__ = [
@@ -81,13 +82,8 @@ def mesh_size_limit(mb: float | None) -> Iterator[None]:
         with robotwright.mesh_size_limit(2000):  # a 1.5 GB scan mesh
             robot = HRDF.from_dir("big_robot")
     """
-    if mb is not None and not mb > 0:
-        raise ValueError(f"mesh size limit must be a positive number of MB, got {mb}")
-    token = _MESH_LIMIT.set(round(mb * 10**6) if mb is not None else _MESH_LIMIT.get())
-    try:
+    with limit_for_block(_MESH_LIMIT, megabytes(mb, "mesh size limit")):
         yield
-    finally:
-        _MESH_LIMIT.reset(token)
 
 
 def _too_big(src: object, limit: int) -> InputFileError:

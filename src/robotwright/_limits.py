@@ -13,9 +13,13 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import math
 from collections.abc import Iterator
+from typing import TypeVar
 
 __all__ = ["MAX_KEYFRAMES", "keyframe_limit", "keyframes_problem"]
+
+_T = TypeVar("_T")
 
 #: Most keyframes a model may hold (real robots ship fewer than 100).
 MAX_KEYFRAMES = 10_000
@@ -26,19 +30,43 @@ _LIMIT: contextvars.ContextVar[int] = contextvars.ContextVar(
 
 
 @contextlib.contextmanager
-def keyframe_limit(max_keyframes: int | None) -> Iterator[None]:
-    """Within the block, models may hold up to ``max_keyframes`` keyframes (``None``:
-    the default, :data:`MAX_KEYFRAMES`)."""
-    if max_keyframes is None:
+def limit_for_block(var: contextvars.ContextVar[_T], value: _T | None) -> Iterator[None]:
+    """Within the block, the limit held by context variable ``var`` is ``value``
+    (``None``: left as it is); the caller has checked ``value``."""
+    if value is None:
         yield
         return
-    if isinstance(max_keyframes, bool) or not isinstance(max_keyframes, int) or max_keyframes < 0:
-        raise ValueError(f"max_keyframes: expected an integer >= 0, got {max_keyframes!r}")
-    token = _LIMIT.set(max_keyframes)
+    token = var.set(value)
     try:
         yield
     finally:
-        _LIMIT.reset(token)
+        var.reset(token)
+
+
+def megabytes(mb: float | None, what: str) -> int | None:
+    """A limit of ``mb`` megabytes (10**6 bytes) in bytes (``None`` stays ``None``).
+
+    Raises:
+        ValueError: ``mb`` is not a positive finite number; the message names the
+            limit as ``what``.
+    """
+    if mb is None:
+        return None
+    if not 0 < mb < math.inf:
+        raise ValueError(f"{what} must be a positive number of MB, got {mb}")
+    return round(mb * 10**6)
+
+
+@contextlib.contextmanager
+def keyframe_limit(max_keyframes: int | None) -> Iterator[None]:
+    """Within the block, models may hold up to ``max_keyframes`` keyframes (``None``:
+    the default, :data:`MAX_KEYFRAMES`)."""
+    if max_keyframes is not None and (
+        isinstance(max_keyframes, bool) or not isinstance(max_keyframes, int) or max_keyframes < 0
+    ):
+        raise ValueError(f"max_keyframes: expected an integer >= 0, got {max_keyframes!r}")
+    with limit_for_block(_LIMIT, max_keyframes):
+        yield
 
 
 def keyframes_problem(count: int) -> str | None:

@@ -22,6 +22,7 @@ from collections.abc import Collection, Iterator
 from typing import TYPE_CHECKING
 
 from robotwright._inputs import _open_regular
+from robotwright._limits import limit_for_block, megabytes
 from robotwright.errors import InputFileError
 
 if TYPE_CHECKING:
@@ -40,13 +41,8 @@ _LIMIT: contextvars.ContextVar[int] = contextvars.ContextVar("npz_limit", defaul
 def npz_limit(mb: float | None) -> Iterator[None]:
     """Within the block, :func:`load_npz` accepts arrays of up to ``mb`` megabytes
     (10**6 bytes) in total once loaded (``None``: the default, :data:`MAX_NPZ_BYTES`)."""
-    if mb is not None and not 0 < mb < math.inf:
-        raise ValueError(f"scan size limit must be a positive number of MB, got {mb}")
-    token = _LIMIT.set(int(mb * 10**6) if mb is not None else _LIMIT.get())
-    try:
+    with limit_for_block(_LIMIT, megabytes(mb, "scan size limit")):
         yield
-    finally:
-        _LIMIT.reset(token)
 
 
 # What reading one damaged, encrypted or oddly compressed entry can raise.

@@ -28,6 +28,7 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
+from robotwright._limits import limit_for_block
 from robotwright.errors import SensorError
 from robotwright.sensors._names import PATTERN_NAMES
 
@@ -138,16 +139,12 @@ _RAY_LIMIT: contextvars.ContextVar[int] = contextvars.ContextVar(
 def ray_limit(max_rays: int | None) -> Iterator[None]:
     """Within the block, patterns may cast up to ``max_rays`` rays per frame (``None``:
     the default, :data:`MAX_RAYS_PER_FRAME`)."""
-    if max_rays is None:
-        yield
-        return
-    if isinstance(max_rays, bool) or not isinstance(max_rays, int) or max_rays < 1:
+    if max_rays is not None and (
+        isinstance(max_rays, bool) or not isinstance(max_rays, int) or max_rays < 1
+    ):
         raise SensorError(f"max_rays: expected an integer >= 1, got {max_rays!r}")
-    token = _RAY_LIMIT.set(max_rays)
-    try:
+    with limit_for_block(_RAY_LIMIT, max_rays):
         yield
-    finally:
-        _RAY_LIMIT.reset(token)
 
 
 def _check_ray_count(count: float, cls: str, what: str = "rays per frame") -> None:
