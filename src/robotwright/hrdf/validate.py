@@ -64,6 +64,17 @@ def _duplicates(names: Iterable[str | None]) -> set[str]:
     return {n for n, c in counts.items() if c > 1}
 
 
+def _reversed_range(
+    table: str, column: str, bounds: Sequence[float] | None, row: int
+) -> list[Problem]:
+    """The problem of a ``column`` range whose lower bound is above its upper one
+    (MuJoCo refuses it), on its ``<column>0`` cell; none for a sound or absent range."""
+    if bounds is not None and bounds[0] > bounds[1]:
+        message = f"{column} lower {bounds[0]} > upper {bounds[1]}"
+        return [Problem(table, message, row=row, column=f"{column}0")]
+    return []
+
+
 def _check_tree(hrdf: HRDF) -> list[Problem]:
     out: list[Problem] = []
     n = len(hrdf.bodies)
@@ -302,15 +313,7 @@ def _check_joints(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
             norm = math.sqrt(sum(v * v for v in j.axis))
             if norm < AXIS_NORM_MIN:
                 out.append(Problem("joint.csv", f"axis {j.axis} is zero", row=row, column="axis0"))
-        if j.range is not None and j.range[0] > j.range[1]:
-            out.append(
-                Problem(
-                    "joint.csv",
-                    f"range lower {j.range[0]} > upper {j.range[1]}",
-                    row=row,
-                    column="range0",
-                )
-            )
+        out += _reversed_range("joint.csv", "range", j.range, row)
         for col in (
             "armature",
             "viscous_friction",
@@ -369,16 +372,7 @@ def _check_actuators(hrdf: HRDF) -> list[Problem]:
                 )
             )
         for col in ("ctrl_range", "force_range"):
-            r = getattr(a, col)
-            if r is not None and r[0] > r[1]:
-                out.append(
-                    Problem(
-                        "actuator.csv",
-                        f"{col} lower {r[0]} > upper {r[1]}",
-                        row=i,
-                        column=f"{col}0",
-                    )
-                )
+            out += _reversed_range("actuator.csv", col, getattr(a, col), i)
         if a.type == "position" and a.p_gain is None:
             out.append(
                 Problem(
@@ -803,16 +797,7 @@ def _check_physics_fields(hrdf: HRDF) -> list[Problem]:
 
     out: list[Problem] = []
     for row, j in enumerate(table_rows(hrdf, "joint")):
-        rng = j.actuatorfrcrange
-        if rng is not None and rng[0] > rng[1]:
-            out.append(
-                Problem(
-                    "joint.csv",
-                    f"actuatorfrcrange lower {rng[0]} > upper {rng[1]}",
-                    row=row,
-                    column="actuatorfrcrange0",
-                )
-            )
+        out += _reversed_range("joint.csv", "actuatorfrcrange", j.actuatorfrcrange, row)
         if j.actuatorgravcomp not in (0, 1):
             out.append(
                 Problem(
