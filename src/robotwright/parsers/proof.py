@@ -862,6 +862,18 @@ def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, str, str, list[str]]
     return _PARSED.pop(key, None) if key is not None else None
 
 
+def _mesh_sources(hrdf: HRDF) -> list[Path]:
+    """The files the HRDF's meshes are read from, for :func:`_compile_with_same_files`;
+    a mesh whose file cannot be found is left out (the compile that needs it fails)."""
+    originals = []
+    for m in hrdf.meshes:
+        try:
+            originals.append(hrdf.mesh_source(m))
+        except Exception:  # noqa: BLE001 - an unreadable mesh fails the compile
+            continue
+    return originals
+
+
 def _compile_with_same_files(
     xml: str,
     originals: Iterable[Path],
@@ -936,12 +948,7 @@ def result_model(
         if out_kind == "urdf":
             model = our_urdf_model(hrdf)
         else:
-            originals = []
-            for m in hrdf.meshes:
-                try:
-                    originals.append(hrdf.mesh_source(m))
-                except Exception:  # noqa: BLE001 - an unreadable mesh fails the compile
-                    continue
+            originals = _mesh_sources(hrdf)
             if out_kind == "mjcf":
                 model = _compile_with_same_files(
                     our_mjcf_text(hrdf), originals, discard_visual, files

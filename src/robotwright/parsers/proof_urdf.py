@@ -189,7 +189,12 @@ def prove_urdf_output(hrdf, file: str, notes: Iterable[str] = ()) -> list:
 
     from robotwright.errors import Problem
     from robotwright.generators import URDFHumanoidGenerator
-    from robotwright.parsers.proof import _compile_with_same_files, as_problems, uncovered
+    from robotwright.parsers.proof import (
+        _compile_with_same_files,
+        _mesh_sources,
+        as_problems,
+        uncovered,
+    )
     from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
     from robotwright.parsers.roundtrip import our_mjcf_text
 
@@ -205,12 +210,7 @@ def prove_urdf_output(hrdf, file: str, notes: Iterable[str] = ()) -> list:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         return [Problem(file, f"proof: MuJoCo does not import the URDF: {first}",
                         severity="warning")]  # fmt: skip
-    originals = []
-    for m in hrdf.meshes:
-        try:
-            originals.append(hrdf.mesh_source(m))
-        except Exception:  # noqa: BLE001 - an unreadable mesh fails the compile
-            continue
+    originals = _mesh_sources(hrdf)
     mjcf = _compile_with_same_files(our_mjcf_text(hrdf), originals, discard_visual=True)
     # A writer reports its losses in one note of many lines: each line is one report.
     lines = [line for n in [*notes, *(str(w.message) for w in caught)] for line in n.splitlines()]
