@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag
@@ -36,24 +37,23 @@ def _groups(text: str) -> tuple[int, ...]:
     return tuple(sorted({int(p) for p in parts}))
 
 
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (0 < value <= 60):  # NaN fails too
-        raise argparse.ArgumentTypeError(f"'{text}': expected seconds in (0, 60]")
-    return value
+def _up_to_60(what: str) -> Callable[[str], float]:
+    """An option's type: a number in (0, 60], named ``what`` in the error."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        if not (0 < value <= 60):  # NaN fails too
+            raise argparse.ArgumentTypeError(f"'{text}': expected {what} in (0, 60]")
+        return value
+
+    return parse
 
 
-def _fps(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (0 < value <= 60):
-        raise argparse.ArgumentTypeError(f"'{text}': expected frames per second in (0, 60]")
-    return value
+_seconds = _up_to_60("seconds")
+_fps = _up_to_60("frames per second")
 
 
 def default_output(source: str, suffix: str) -> Path:
