@@ -275,40 +275,44 @@ class Payload:
 
 
 @dataclass(frozen=True)
-class Track:
+class _TrackingRun:
+    """The settings of one tracking run (:func:`robotwright.grammar.physics.track`),
+    which :class:`Track` and :class:`Energy` both measure."""
+
+    duration: float = 2.0
+    scale: float = 0.15
+    carrier: Carrier = Carrier()
+
+    def __post_init__(self) -> None:
+        check_settings(type(self).__name__, duration=self.duration, scale=self.scale)
+
+    def _run(self, ctx: EvalContext) -> TrackResult:
+        return ctx.tracking(self.carrier, self.duration, self.scale)
+
+
+@dataclass(frozen=True)
+class Track(_TrackingRun):
     """RMS distance (m) between the first tool point and a circle-then-line reference
     in front of the limb over ``duration`` s, under PD + gravity compensation within
     the peak torques (:func:`robotwright.grammar.physics.track`); smaller is better."""
 
-    duration: float = 2.0
-    scale: float = 0.15
-    carrier: Carrier = Carrier()
     name: str = "track"
     maximize: bool = False
 
-    def __post_init__(self) -> None:
-        check_settings("Track", duration=self.duration, scale=self.scale)
-
     def __call__(self, ctx: EvalContext) -> float:
-        return ctx.tracking(self.carrier, self.duration, self.scale).error
+        return self._run(ctx).error
 
 
 @dataclass(frozen=True)
-class Energy:
+class Energy(_TrackingRun):
     """Mean mechanical power (W), ``sum |tau_i dq_i|`` averaged over the steps of the
     same run as :class:`Track`; smaller is better."""
 
-    duration: float = 2.0
-    scale: float = 0.15
-    carrier: Carrier = Carrier()
     name: str = "energy"
     maximize: bool = False
 
-    def __post_init__(self) -> None:
-        check_settings("Energy", duration=self.duration, scale=self.scale)
-
     def __call__(self, ctx: EvalContext) -> float:
-        return ctx.tracking(self.carrier, self.duration, self.scale).power
+        return self._run(ctx).power
 
 
 @dataclass(frozen=True)
