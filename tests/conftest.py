@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import zlib
 from pathlib import Path
 
 import pytest
@@ -17,6 +18,89 @@ HURODES_FIXTURES = Path(
     os.environ.get("ROBOTWRIGHT_HURODES_FIXTURES") or TESTDATA / "hurodes-fixtures"
 )
 FETCH_HINT = "run python tools/fetch_test_data.py"
+
+#: Runs a sample of the corpus tests (``@pytest.mark.corpus``): 1 file in N of each
+#: corpus, plus every file the test lists as an expected failure or refusal. .ci/run's
+#: MuJoCo 3.11 stage sets it; the first stage runs every file.
+CORPUS_SAMPLE_ENV = "ROBOTWRIGHT_CORPUS_SAMPLE"
+
+
+def corpus_sample_size(value: str | None) -> int:
+    """N of ``$ROBOTWRIGHT_CORPUS_SAMPLE`` (unset or empty: 1, every file)."""
+    if value is None or not value.strip():
+        return 1
+    try:
+        size = int(value)
+    except ValueError:
+        size = 0
+    if size < 1:
+        raise pytest.UsageError(
+            f"{CORPUS_SAMPLE_ENV}: expected an integer >= 1 (run 1 corpus file in N), got {value!r}"
+        )
+    return size
+
+
+def corpus_sample(items: list[pytest.Item], size: int) -> list[pytest.Item]:
+    """The corpus test items a sample of 1 in ``size`` leaves out.
+
+    Per test function and corpus (its ``corpus`` parameter), in collection order, every
+    ``size``-th file is kept, starting at an offset taken from the function's name so
+    that two tests of the same corpus check different files. Kept always: a case with
+    an ``xfail`` mark, or whose id is in the marker's ``always`` (expected refusals).
+    """
+    groups: dict[tuple, list[pytest.Item]] = {}
+    for item in items:
+        mark = item.get_closest_marker("corpus")
+        if mark is None:
+            continue
+        params = getattr(getattr(item, "callspec", None), "params", {})
+        key = (str(item.path), getattr(item, "originalname", item.name), params.get("corpus"))
+        groups.setdefault(key, []).append(item)
+    left_out = []
+    for (_, name, _), members in groups.items():
+        offset = zlib.crc32(name.encode()) % size
+        for index, item in enumerate(members):
+            always = item.get_closest_marker("corpus").kwargs.get("always", ())
+            case_id = getattr(getattr(item, "callspec", None), "id", "")
+            if index % size == offset or case_id in always or item.get_closest_marker("xfail"):
+                continue
+            left_out.append(item)
+    return left_out
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    size = corpus_sample_size(os.environ.get(CORPUS_SAMPLE_ENV))
+    if size == 1:
+        return
+    reason = (
+        f"corpus sample ({CORPUS_SAMPLE_ENV}={size}: 1 file in {size} of each corpus runs "
+        "here); every corpus file runs in .ci/run's first stage (newest versions)"
+    )
+    left_out = corpus_sample(items, size)
+    for item in left_out:
+        item.add_marker(pytest.mark.skip(reason=reason))
+    total = sum(1 for item in items if item.get_closest_marker("corpus"))
+    config.stash[_SAMPLE_KEY] = (size, total - len(left_out), total)
+
+
+_SAMPLE_KEY = pytest.StashKey[tuple]()
+
+
+def pytest_report_header(config: pytest.Config) -> str | None:
+    size = corpus_sample_size(os.environ.get(CORPUS_SAMPLE_ENV))
+    if size == 1:
+        return None
+    return f"{CORPUS_SAMPLE_ENV}={size}: a sample of the corpus tests runs (see tests/conftest.py)"
+
+
+def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
+    sample = config.stash.get(_SAMPLE_KEY, None)
+    if sample is not None:
+        size, kept, total = sample
+        terminalreporter.write_line(
+            f"corpus sample ({CORPUS_SAMPLE_ENV}={size}): {kept} of {total} corpus cases run, "
+            f"{total - kept} skipped (they run in .ci/run's first stage)"
+        )
 
 
 def _need(path: Path, why: str) -> Path:

@@ -114,6 +114,7 @@ def _every_body_inertia(ref: mujoco.MjModel, ours: mujoco.MjModel, root: str | N
     return bad
 
 
+@pytest.mark.corpus
 @pytest.mark.parametrize(("corpus", "rel"), _params())
 def test_corpus_file_roundtrips(corpus: str, rel: str) -> None:
     root = CORPORA[corpus]

@@ -197,6 +197,7 @@ def check_file(corpus: str, rel: str, work: Path) -> tuple[str, str]:
     return "exact", ""
 
 
+@pytest.mark.corpus(always=tuple(EXPECTED_REFUSALS))
 @pytest.mark.parametrize(("corpus", "rel"), _params())
 def test_corpus_file_physics_complete(corpus: str, rel: str, tmp_path: Path) -> None:
     outcome, detail = check_file(corpus, rel, tmp_path)

@@ -355,6 +355,7 @@ def _corpus_params() -> list:
 
 
 @pytest.mark.realdata
+@pytest.mark.corpus
 @pytest.mark.parametrize(("corpus", "rel"), _corpus_params())
 def test_corpus_proof_has_no_unreported_difference(corpus: str, rel: str, tmp_path: Path) -> None:
     root = CORPORA[corpus]

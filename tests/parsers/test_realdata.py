@@ -58,6 +58,7 @@ def _corpus() -> list:
     return params
 
 
+@pytest.mark.corpus
 @pytest.mark.parametrize("rel", _corpus())
 def test_example_robot_data_roundtrip(rel: str) -> None:
     report = roundtrip(ERD / rel, configs=CORPUS_CONFIGS, fixed_joints="merge")
