@@ -177,10 +177,17 @@ def _keywords(enum: type, prefix: str) -> dict[int, str]:
 _DYN = _keywords(mujoco.mjtDyn, "mjDYN_")
 _GAIN = _keywords(mujoco.mjtGain, "mjGAIN_")
 _BIAS = _keywords(mujoco.mjtBias, "mjBIAS_")
-#: MuJoCo 4's declared control input (``actuator_ctrlspec``) -> the ``<general input>``
-#: keyword; absent in 3.x. Other values (a DC motor's voltage) follow from the gain type.
+#: ``actuator_ctrlspec`` (3.11 has it too, but only for an so3 actuator's chart).
 _HAS_CTRLSPEC = hasattr(mujoco.MjModel, "actuator_ctrlspec")
-_INPUT = {1: "pos", 2: "vel", 32: "pressure"}
+#: MuJoCo 4's declared control input (``actuator_ctrlspec``, ``mjtCtrlInput``) -> the
+#: ``<general input>`` keyword; empty where the installed MuJoCo declares none (3.11's
+#: ``input`` takes only an so3 chart). Other values (a DC motor's voltage) follow from
+#: the gain type.
+_INPUT = {
+    int(v): k[len("mjINPUT_") :].lower()
+    for k, v in getattr(getattr(mujoco, "mjtCtrlInput", None), "__members__", {}).items()
+    if k in ("mjINPUT_POS", "mjINPUT_VEL", "mjINPUT_PRESSURE")
+}
 
 
 @functools.cache
