@@ -22,7 +22,7 @@ from robotwright.hrdf.model import HRDF, Body, Joint
 from robotwright.hrdf.validate import check_model as validate
 from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_from_model
-from robotwright.parsers.roundtrip import our_mjcf_model, roundtrip
+from robotwright.parsers.roundtrip import compare_extras, our_mjcf_model, roundtrip
 from robotwright.parsers.xmlsafe import parse_xml
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
@@ -405,3 +405,52 @@ def test_world_sites_dropped_with_reason_when_the_root_moves(tmp_path: Path) -> 
     result = mjcf_to_hrdf_with_warnings(path, root_body="thorax")
     lost = [w for w in _warnings(result) if "but the robot's root moves" in w]
     assert len(lost) == 2
+
+
+WELDED_TO_THE_WORLD = """<mujoco model="welded">
+  <worldbody>
+    <body name="base" pos="0 0 1">
+      <geom type="box" size=".1 .1 .1" mass="2"/>
+      <body name="l1">
+        <joint name="j1" axis="0 1 0" range="-1 1"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -.3" size=".03" mass=".5"/>
+        <body name="l2" pos="0 0 -.3">
+          <joint name="j2" axis="0 1 0" range="-1 1"/>
+          <geom type="capsule" fromto="0 0 0 0 0 -.3" size=".03" mass=".5"/>
+        </body>
+      </body>
+    </body>
+    <body name="box" pos="1 0 .1">
+      <freejoint/>
+      <geom type="box" size=".05 .05 .05" mass=".2"/>
+    </body>
+  </worldbody>
+  <equality>
+    <weld body1="l2" body2="box"/>
+    <joint joint1="j2" joint2="j1" polycoef="0.1 0.5 0 0 0"/>
+  </equality>
+</mujoco>
+"""
+
+
+def test_round_trip_of_a_robot_taken_out_of_a_world_compares_its_own_equalities(
+    tmp_path: Path,
+) -> None:
+    """root_body='base': the weld to the box (outside the robot) is dropped with a note
+    naming it, and the round trip compares the robot's own equality (the joint coupling),
+    not the world's count."""
+    path = tmp_path / "welded.xml"
+    path.write_text(WELDED_TO_THE_WORLD)
+    result = mjcf_to_hrdf_with_warnings(path, root_body="base")
+    assert any("equality dropped" in w and "'box'" in w for w in _warnings(result))
+    report = roundtrip(path, configs=5, root_body="base", urdf=False)
+    assert report.ok, report.table()
+    (row,) = [r for r in report.rows if r.check.endswith("equality/tendon/contact/keyframe")]
+    assert row.value.startswith("eq 1,"), report.table()
+    # What is compared is the coupling itself: a changed multiplier is a failed row.
+    ref = view_from_model(mujoco.MjModel.from_xml_path(str(path)), root="base")
+    ours = our_mjcf_model(result.hrdf)
+    assert compare_extras(ref, view_from_model(ours), 1e-9).ok
+    ours.eq_data[0, 1] = 0.7
+    bad = compare_extras(ref, view_from_model(ours), 1e-9)
+    assert not bad.ok and "equality constraints differ" in bad.note

@@ -34,6 +34,7 @@ from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
     JointInfo,
     RobotView,
+    body_name,
     compile_urdf,
     mimic_map,
     urdf_for_mujoco,
@@ -485,20 +486,51 @@ def compare_geoms(ref: RobotView, ours: RobotView, tol: float, collision_only: b
     )
 
 
+def _equalities_in(view: RobotView) -> list[int]:
+    """Indices of the view's model's equality constraints whose bodies, joints and sites
+    are all on the robot's bodies (or the world); a tendon coupling counts as on it."""
+    m = view.model
+    keep = set(view.bodies)
+    body_of = {
+        mujoco.mjtObj.mjOBJ_BODY: lambda i: i,
+        mujoco.mjtObj.mjOBJ_XBODY: lambda i: i,
+        mujoco.mjtObj.mjOBJ_JOINT: lambda i: int(m.jnt_bodyid[i]),
+        mujoco.mjtObj.mjOBJ_SITE: lambda i: int(m.site_bodyid[i]),
+    }
+    rows = []
+    for i in range(m.neq):
+        ot = int(m.eq_objtype[i])
+        if ot == 0:  # MuJoCo leaves it unset for joint/tendon couplings
+            ot = {2: mujoco.mjtObj.mjOBJ_JOINT, 3: mujoco.mjtObj.mjOBJ_TENDON}.get(
+                int(m.eq_type[i]), mujoco.mjtObj.mjOBJ_BODY
+            )
+        to_body = body_of.get(ot)
+        ids = [int(m.eq_obj1id[i]), int(m.eq_obj2id[i])]
+        bodies = [] if to_body is None else [to_body(k) for k in ids if k >= 0]
+        if all(b == 0 or body_name(m, b) in keep for b in bodies):
+            rows.append(i)
+    return rows
+
+
 def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
     """Equality constraints, tendons, contact excludes/pairs and keyframes of the compiled
     models: counts, equality data, tendon lengths at the zero pose, keyframe vectors."""
     m1, m2 = ref.model, ours.model
     problems = []
+    # A robot taken out of a larger world (root_body) keeps only its own equalities: the
+    # parsers drop the others with a note naming them.
+    ref_eqs = _equalities_in(ref)
+    counts1 = {"neq": len(ref_eqs)}
     for attr in ("neq", "ntendon", "nexclude", "npair", "nkey"):
-        if getattr(m1, attr) != getattr(m2, attr):
-            problems.append(f"{attr} {getattr(m1, attr)}/{getattr(m2, attr)}")
+        n1 = counts1.get(attr, getattr(m1, attr))
+        if n1 != getattr(m2, attr):
+            problems.append(f"{attr} {n1}/{getattr(m2, attr)}")
     if not problems:
-        if m1.neq:
+        if ref_eqs:
             # Matched by (type, object names): importers order equalities differently.
-            def eqs(m: mujoco.MjModel) -> dict:
+            def eqs(m: mujoco.MjModel, rows: list[int]) -> dict:
                 out = {}
-                for i in range(m.neq):
+                for i in rows:
                     ot = int(m.eq_objtype[i])
                     if ot == 0:  # MuJoCo leaves it unset for joint/tendon couplings
                         ot = {2: mujoco.mjtObj.mjOBJ_JOINT, 3: mujoco.mjtObj.mjOBJ_TENDON}.get(
@@ -512,7 +544,7 @@ def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
                     out[key] = m.eq_data[i]
                 return out
 
-            e1, e2 = eqs(m1), eqs(m2)
+            e1, e2 = eqs(m1, ref_eqs), eqs(m2, list(range(m2.neq)))
             if set(e1) != set(e2) or any(
                 np.abs(e1[k] - e2[k]).max() > tol * max(1.0, np.abs(e1[k]).max()) for k in e1
             ):
@@ -572,8 +604,8 @@ def compare_extras(ref: RobotView, ours: RobotView, tol: float) -> Row:
         names = lambda m, pairs: [(m.body(x).name, m.body(y).name) for x, y in pairs]  # noqa: E731
         if sorted(names(m1, sig(m1))) != sorted(names(m2, sig(m2))):
             problems.append("contact excludes differ")
-    summary = f"eq {m1.neq}, tendons {m1.ntendon}, excludes {m1.nexclude}, pairs {m1.npair}, keys {m1.nkey}"
-    counts = (m1.neq, m1.ntendon, m1.nexclude, m1.npair, m1.nkey)
+    summary = f"eq {len(ref_eqs)}, tendons {m1.ntendon}, excludes {m1.nexclude}, pairs {m1.npair}, keys {m1.nkey}"
+    counts = (len(ref_eqs), m1.ntendon, m1.nexclude, m1.npair, m1.nkey)
     return Row(
         "equality/tendon/contact/keyframe",
         summary,
