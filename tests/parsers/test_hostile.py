@@ -10,6 +10,7 @@ import re
 import threading
 from pathlib import Path
 
+import mujoco
 import pytest
 import trimesh
 
@@ -298,6 +299,46 @@ def test_urdf_numbers_must_be_finite(tmp_path, capsys, field, value, expected) -
     with pytest.raises(ConversionError, match=re.escape(expected)):
         urdf_to_hrdf(path)
     out = tmp_path / "out"
+    assert main(["convert", str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "r.urdf" in err and not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "expected"),
+    [
+        ("mass", "2.5e-310", "mass '2.5e-310': expected a finite number (MuJoCo"),
+        ("ixx", "1e-320", "inertia: expected finite numbers ixx..izz (MuJoCo"),
+        ("xyz", "0 5e-324 0", "<origin xyz> = '0 5e-324 0': expected 3 finite numbers (MuJoCo"),
+        ("box", "1 2.2e-308 1", "<box size> = '1 2.2e-308 1': expected 3 finite numbers (MuJoCo"),
+        ("lower", "-1e-310", "<limit lower='-1e-310'>: expected a finite number (MuJoCo"),
+    ],
+)
+def test_urdf_subnormal_numbers_as_the_installed_mujoco_reads_them(
+    tmp_path, capsys, field, value, expected
+) -> None:
+    """A subnormal number (nonzero, below 2.2250738585072014e-308 in magnitude): where
+    MuJoCo's XML reader takes it (4.x), the URDF converts and keeps it; where it refuses
+    it (3.11: "number is too large"), the parser refuses it too, naming the element and
+    why, instead of an HRDF no MJCF of this MuJoCo can hold."""
+    path = tmp_path / "r.urdf"
+    path.write_text(f'<robot name="r">{_LINK.format(**{**_SANE, field: value})}</robot>')
+    try:
+        mujoco.MjModel.from_xml_string(
+            '<mujoco><worldbody><geom size="0.1" pos="1e-310 0 0"/></worldbody></mujoco>'
+        )
+        reads = True
+    except ValueError:
+        reads = False
+    out = tmp_path / "out"
+    if reads:
+        hrdf = urdf_to_hrdf(path)
+        if field == "lower":
+            assert hrdf.joints[0].range[0] == float(value)
+        assert main(["convert", str(path), "-o", str(out)]) == 0
+        return
+    with pytest.raises(ConversionError, match=re.escape(expected)):
+        urdf_to_hrdf(path)
     assert main(["convert", str(path), "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert expected in err and "r.urdf" in err and not out.exists()

@@ -240,7 +240,8 @@ _PROBE_TENSOR = np.array([[0.02, 0.001, -0.002], [0.001, 0.03, 0.0015], [-0.002,
 
 
 # MuJoCo 3.11 differs from 4.x in four ways that matter to a URDF reference (the four
-# probes below). Each is detected by what the installed MuJoCo does (a probe, run once),
+# probes below; a fifth, whether the XML reader takes subnormal numbers, is the URDF
+# parser's). Each is detected by what the installed MuJoCo does (a probe, run once),
 # not by its version number: the workaround is applied only where MuJoCo needs it, so
 # that on a MuJoCo that gets these right the reference stays MuJoCo's own, independent
 # of our parser's code.
@@ -301,6 +302,35 @@ def mujoco_urdf_imports_mimic() -> bool:
         + "</robot>"
     )
     return mujoco.MjModel.from_xml_string(urdf).neq == 1
+
+
+@functools.cache
+def mujoco_urdf_clamps_effort() -> bool:
+    """Whether MuJoCo's URDF import makes ``<limit effort>`` the joint's actuator force
+    range (``actfrcrange`` +-effort; 3.11 and 4.x do)."""
+    urdf = (
+        '<robot name="probe"><mujoco><compiler fusestatic="false"/></mujoco>'
+        '<link name="a"/><link name="b"><inertial><mass value="1"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="-1" upper="1" effort="3" velocity="1"/></joint></robot>'
+    )
+    model = mujoco.MjModel.from_xml_string(urdf)
+    return bool(model.jnt_actfrclimited[0]) and model.jnt_actfrcrange[0].tolist() == [-3.0, 3.0]
+
+
+@functools.cache
+def mujoco_xml_reads_subnormals() -> bool:
+    """Whether MuJoCo's XML reader takes a subnormal number (nonzero, below
+    ``sys.float_info.min`` in magnitude). MuJoCo 3.11 refuses one ("number is too
+    large"); 4.x reads it."""
+    try:
+        mujoco.MjModel.from_xml_string(
+            '<mujoco><worldbody><geom size="0.1" pos="1e-310 0 0"/></worldbody></mujoco>'
+        )
+    except ValueError:
+        return False
+    return True
 
 
 def _tetrahedron_stl(size: float = 1.0) -> bytes:
@@ -560,12 +590,14 @@ def compile_urdf(
     spec = mujoco.MjSpec.from_string(text, assets=assets or None)
     if fuse_static:
         spec.compiler.fusestatic = True
-        # A body a sensor refers to is not fused: the root stays the robot's base.
+        # A body a sensor refers to is not fused: the root stays the robot's base. (A
+        # body's frame, mjOBJ_XBODY, keeps it on 4.x only: MuJoCo 3.11 fuses it and then
+        # finds no body of that name; its inertial frame, mjOBJ_BODY, keeps it on both.)
         top = spec.worldbody.first_body()
         while top is not None:
             spec.add_sensor(
                 type=mujoco.mjtSensor.mjSENS_FRAMEPOS,
-                objtype=mujoco.mjtObj.mjOBJ_XBODY,
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
                 objname=top.name,
             )
             top = spec.worldbody.next_body(top)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import xml.etree.ElementTree as ET
 from collections import Counter
 from collections.abc import Mapping
@@ -147,25 +148,56 @@ class URDFOptions:
                 raise ValueError(f"{name}={value!r}: expected None or >= 0")
 
 
+class _Unreadable(ValueError):
+    """A finite number the installed MuJoCo's XML reader refuses (its message says why)."""
+
+
 def _finite(text: str) -> float:
     """A URDF number, finite as an HRDF holds it ("1e400", "inf" and "nan" are refused;
-    MuJoCo's reader refuses the first and takes the others). Raises ValueError."""
+    MuJoCo's reader refuses the first and takes the others). A subnormal number (nonzero,
+    below ``sys.float_info.min`` in magnitude) is refused where the installed MuJoCo's
+    XML reader refuses it (3.11 does; found by a probe): an HRDF is written and read back
+    as MJCF. Raises ValueError (:class:`_Unreadable` for the latter)."""
     value = float(text)
     if not math.isfinite(value):
         raise ValueError(f"{text!r} is not a finite number")
+    if value != 0 and abs(value) < sys.float_info.min:
+        from robotwright.parsers.reference import mujoco_xml_reads_subnormals
+
+        if not mujoco_xml_reads_subnormals():
+            import mujoco
+
+            raise _Unreadable(
+                f"MuJoCo {mujoco.__version__} reads no nonzero number smaller than "
+                f"{sys.float_info.min!r} in magnitude"
+            )
     return value
 
 
-def _floats(text: str | None, n: int, default: tuple[float, ...], what: str, rep) -> np.ndarray:
+def _why(exc: ValueError) -> str:
+    """`` (the reason)`` for a number MuJoCo cannot read, else nothing."""
+    return f" ({exc})" if isinstance(exc, _Unreadable) else ""
+
+
+def _floats(
+    text: str | None, n: int, default: tuple[float, ...], where: str, what: str, rep
+) -> np.ndarray:
+    """``n`` finite numbers of attribute ``what`` (e.g. ``<box size>``) of element ``where``;
+    ``default`` when absent. Raises ConversionError naming both."""
     if text is None:
         return np.array(default, dtype=float)
+    why = ""
     try:
         values = [_finite(v) for v in text.split()]
-    except ValueError:
-        values = []
+    except ValueError as exc:
+        values, why = [], _why(exc)
     if len(values) != n:
         raise ConversionError(
-            [Problem(rep.file, f"{what} = {text!r}: expected {n} finite numbers")],
+            [
+                Problem(
+                    rep.file, f"{what} = {text!r}: expected {n} finite numbers{why}", element=where
+                )
+            ],
         )
     return np.array(values, dtype=float)
 
@@ -186,8 +218,8 @@ class _Pose:
 def _origin(elem: ET.Element | None, rep: Reporter, where: str) -> _Pose:
     if elem is None:
         return _Pose()
-    xyz = _floats(elem.get("xyz"), 3, (0, 0, 0), f"{where} <origin xyz>", rep)
-    rpy = _floats(elem.get("rpy"), 3, (0, 0, 0), f"{where} <origin rpy>", rep)
+    xyz = _floats(elem.get("xyz"), 3, (0, 0, 0), where, "<origin xyz>", rep)
+    rpy = _floats(elem.get("rpy"), 3, (0, 0, 0), where, "<origin rpy>", rep)
     return _Pose(xyz, inr.quat_to_mat(inr.rpy_to_quat(rpy)))
 
 
@@ -222,7 +254,7 @@ def _link_inertial(link: ET.Element, rep: Reporter) -> tuple[float, np.ndarray, 
         try:
             mass = _finite(mass_el.get("value", "0"))
         except ValueError as exc:
-            problem = f"mass {mass_el.get('value')!r}: expected a finite number"
+            problem = f"mass {mass_el.get('value')!r}: expected a finite number{_why(exc)}"
             raise ConversionError([Problem(rep.file, problem, element=where)]) from exc
     i_el = inertial.find("inertia")
     tensor = np.zeros((3, 3))
@@ -230,9 +262,8 @@ def _link_inertial(link: ET.Element, rep: Reporter) -> tuple[float, np.ndarray, 
         try:
             v = {k: _finite(i_el.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
         except ValueError as exc:
-            raise ConversionError(
-                [Problem(rep.file, "inertia: expected finite numbers ixx..izz", element=where)]
-            ) from exc
+            problem = f"inertia: expected finite numbers ixx..izz{_why(exc)}"
+            raise ConversionError([Problem(rep.file, problem, element=where)]) from exc
         local = np.array(
             [
                 [v["ixx"], v["ixy"], v["ixz"]],
@@ -265,7 +296,7 @@ class _URDFReader:
             self.rep.warn("material texture dropped (HRDF geoms carry a colour only)", where)
         if color is not None:
             rgba = _floats(
-                color.get("rgba"), 4, (0.5, 0.5, 0.5, 1), f"{where} <color rgba>", self.rep
+                color.get("rgba"), 4, (0.5, 0.5, 0.5, 1), where, "<color rgba>", self.rep
             )
             return tuple(float(x) for x in np.clip(rgba, 0.0, 1.0))
         name = elem.get("name")
@@ -305,11 +336,11 @@ class _URDFReader:
             try:
                 return _finite(shape.get(attr, ""))
             except ValueError as exc:
-                problem = f"<{tag} {attr}>: expected a finite number"
+                problem = f"<{tag} {attr}>: expected a finite number{_why(exc)}"
                 raise ConversionError([Problem(self.rep.file, problem, element=where)]) from exc
 
         if tag == "box":
-            size = _floats(shape.get("size"), 3, (0, 0, 0), f"{where} <box size>", self.rep)
+            size = _floats(shape.get("size"), 3, (0, 0, 0), where, "<box size>", self.rep)
             fields.update(type="box", size=_t(size / 2.0))
         elif tag == "sphere":
             fields.update(type="sphere", size=(num("radius"), 0.0, 0.0))
@@ -320,7 +351,7 @@ class _URDFReader:
             if not uri:
                 self.rep.warn("mesh without filename dropped", where)
                 return None
-            scale = _t(_floats(shape.get("scale"), 3, (1, 1, 1), f"{where} <mesh scale>", self.rep))
+            scale = _t(_floats(shape.get("scale"), 3, (1, 1, 1), where, "<mesh scale>", self.rep))
             try:
                 path = resolve_uri(uri, self.path, self.opt.package_map, self.opt.mesh_root)
                 if any(v < 0 for v in scale):
@@ -551,7 +582,7 @@ def _num(elem: ET.Element | None, attr: str, default: float, where: str, rep: Re
             [
                 Problem(
                     rep.file,
-                    f"<{elem.tag} {attr}={elem.get(attr)!r}>: expected a finite number",
+                    f"<{elem.tag} {attr}={elem.get(attr)!r}>: expected a finite number" + _why(exc),
                     element=where,
                 )
             ]
@@ -567,7 +598,7 @@ def _joint_record(
     jtype = j.get("type")
     axis_el = j.find("axis")
     axis = _floats(
-        axis_el.get("xyz") if axis_el is not None else None, 3, (1, 0, 0), f"{where} <axis>", rep
+        axis_el.get("xyz") if axis_el is not None else None, 3, (1, 0, 0), where, "<axis xyz>", rep
     )
     if np.linalg.norm(axis) < 1e-12:
         raise ConversionError([Problem(rep.file, "axis is zero", element=where)])
@@ -600,7 +631,7 @@ def _joint_record(
     effort = _num(limit, "effort", 0.0, where, rep)
     velocity = _num(limit, "velocity", 0.0, where, rep)
     if effort and jtype != "spherical":
-        # MuJoCo 4's URDF importer clamps the joint's actuator force to +-|effort|.
+        # MuJoCo's URDF importer (3.11, 4.x) clamps the joint's actuator force to +-|effort|.
         joint = replace(joint, actuatorfrcrange=(-abs(effort), abs(effort)))
     actuator = None
     if opt.actuators == "motor" and effort > 0 and jtype != "spherical":
@@ -885,12 +916,14 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
             + name_list(dropped_limits)
         )
     clamped = [j.name for j in hrdf_joints if j.actuatorfrcrange is not None]
-    import mujoco  # the running version decides what its own URDF import does
+    from robotwright.parsers.reference import mujoco_urdf_clamps_effort
 
-    if clamped and int(mujoco.__version__.split(".")[0]) < 4:
+    if clamped and not mujoco_urdf_clamps_effort():
+        import mujoco  # the running version decides what its own URDF import does
+
         rep.warn(
             f"actuatorfrcrange +-effort set on {len(clamped)} joint(s) from <limit effort>, "
-            f"as MuJoCo 4's URDF import does; MuJoCo {mujoco.__version__}'s URDF import "
+            f"as MuJoCo 3.11's and 4's URDF imports do; MuJoCo {mujoco.__version__}'s import "
             "leaves them unclamped: " + name_list(clamped)
         )
 
