@@ -620,6 +620,9 @@ def compile_urdf(
     # every tensor in the link frame and the reader's iquat is not the tensor's frame;
     # otherwise the tensor is given in the frame iquat.
     in_link_frame = not mujoco_urdf_keeps_inertial_rotation()
+    # MuJoCo's own verdict first: a tensor it refuses ("inertia must have positive
+    # eigenvalues") stays refused; the diagonalisation below only makes its axes exact.
+    spec.compile()
     for body in spec.bodies:
         f = np.asarray(body.fullinertia, dtype=float)
         if not body.explicitinertial or np.isnan(f[0]):
