@@ -491,9 +491,10 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
         expect = data.ray_origins_w.numpy() + dirs * dist[..., None]
         np.testing.assert_allclose(data.hit_pos_w.numpy()[hit], expect[hit], atol=1e-4)
     assert frames == list(range(frames[0], frames[0] + 12))
-    # Every class of the default mapping appears among the hits (and nothing unknown).
-    assert tuple(DEFAULT_SEMANTIC_CLASS_MAPPING) == sensor.class_names[1:]
-    assert seen == set(range(1, len(sensor.class_names)))
+    # Every class of the default mapping appears among the hits (and nothing unknown);
+    # the robot's own class is last, never hit: its geoms are in groups the rays skip.
+    assert sensor.class_names == ("unknown", *DEFAULT_SEMANTIC_CLASS_MAPPING, "robot")
+    assert seen == set(range(1, len(DEFAULT_SEMANTIC_CLASS_MAPPING) + 1))
     hit_names = {sensor.geom_paths[g] for g in np.unique(data.geom_ids.numpy()) if g >= 0}
     assert "/world/terrain/terrain" in hit_names
     # The seed's stacked observation is the actor's last term, exactly.
