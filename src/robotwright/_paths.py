@@ -28,6 +28,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 from robotwright._assets import check_asset_file, check_declared_sizes
@@ -246,6 +247,10 @@ def check_mjcf_includes(
                     ) from None
                 pending.append((child, str(path), depth + 1))
                 continue
+            if el.tag == "hfield" and not el.get("file"):
+                # MuJoCo's XML reader allocates the declared samples as it reads the
+                # element (3.6 GB for 30,000 x 30,000): refuse an oversized one before.
+                _check_declared_hfield(el, where)
             if el.tag in ("mesh", "hfield", "skin", "texture"):
                 continue  # read at compile time: see check_mjcf_spec
             for attr, value in el.attrib.items():
@@ -261,6 +266,17 @@ def check_mjcf_includes(
                         except UnsafePathError as exc:
                             raise UnsafePathError(exc.reason, file=where, element=elem) from None
                         _check_size(found, where, elem)
+
+
+def _check_declared_hfield(el: Any, source: str) -> None:
+    """:func:`robotwright._assets.check_declared_sizes` on an ``<hfield nrow ncol>``
+    element of the XML (the same limit and message as on the parsed model)."""
+    try:
+        nrow, ncol = int(el.get("nrow") or 0), int(el.get("ncol") or 0)
+    except ValueError:
+        return  # not a number: MuJoCo's reader refuses it
+    hfield = SimpleNamespace(file="", nrow=nrow, ncol=ncol, name=el.get("name") or "")
+    check_declared_sizes(SimpleNamespace(hfields=[hfield], textures=[]), source=source)
 
 
 def check_mjcf_spec(
