@@ -622,7 +622,8 @@ def compile_urdf(
     in_link_frame = not mujoco_urdf_keeps_inertial_rotation()
     # MuJoCo's own verdict first: a tensor it refuses ("inertia must have positive
     # eigenvalues") stays refused; the diagonalisation below only makes its axes exact.
-    spec.compile()
+    # On a copy: compiling with fusestatic removes the fused bodies from the spec.
+    spec.copy().compile()
     for body in spec.bodies:
         f = np.asarray(body.fullinertia, dtype=float)
         if not body.explicitinertial or np.isnan(f[0]):
