@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -11,7 +12,13 @@ _HEAVY = ("mujoco", "numpy", "trimesh", "viser", "PIL")
 
 
 def _run(code: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    """``code`` in a fresh interpreter without MUJOCO_GL: where it is set, import
+    robotwright imports MuJoCo at once, by design (robotwright._mujoco_gl); importing
+    mjlab, as other tests do, sets it to egl in this process."""
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env
+    )
 
 
 def test_import_robotwright_imports_no_heavy_dependency() -> None:
