@@ -273,3 +273,29 @@ def test_nested_composite_and_outer_prefix():
 def test_different_simulator_settings_warn(synth_urdf_safe):
     with pytest.warns(ConversionWarning, match=r"robots \['s'\] have simulator settings"):
         MJCFGeneratorComposite({"arm": _gen("arm6"), "s": _gen(synth_urdf_safe)}).export()
+
+
+@pytest.mark.parametrize(
+    ("key", "first", "second"),
+    [("option", ("impratio", 10.0), ("impratio", 3.0)), ("flag", ("contact", "disable"), None)],
+)
+def test_scene_names_robots_whose_other_option_values_differ(key, first, second) -> None:
+    # A scene has one <option>: it takes the first robot's, and a robot whose option
+    # attributes or flags differ is named, never dropped silently.
+    a, b = HRDF.from_robot_name("arm6"), HRDF.from_robot_name("arm6")
+    getattr(a.meta.simulator_config, key)[first[0]] = first[1]
+    if second is not None:
+        getattr(b.meta.simulator_config, key)[second[0]] = second[1]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scene = MJCFGeneratorComposite(
+            {"a": MJCFHumanoidGenerator.from_hrdf(a), "b": MJCFHumanoidGenerator.from_hrdf(b)},
+            placements={"b": Placement((1.0, 0.0, 0.0), 0.0)},
+        )
+        model = scene.to_model()
+    named = [str(w.message) for w in caught if "simulator settings different" in str(w.message)]
+    assert len(named) == 1 and "['b']" in named[0]
+    if key == "option":
+        assert model.opt.impratio == 10.0
+    else:
+        assert model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT

@@ -251,14 +251,16 @@ class MJCFGeneratorComposite(MJCFGeneratorBase):
 
     def _robots_simulator_config(self) -> SimulatorConfig | None:
         """The first robot's simulator settings; a warning names robots whose option
-        values (timestep, gravity, integrator) differ, since a scene has one of each."""
+        values (timestep, gravity, integrator, every other ``<option>`` attribute and
+        ``<flag>``) differ, since a scene has one of each."""
         configs = [(k, g.simulator_config) for k, g in self.generators.items()]
         chosen = next(((k, c) for k, c in configs if c is not None), None)
         if chosen is None:
             return None
 
         def option(c: SimulatorConfig) -> tuple[object, ...]:
-            return (c.timestep, tuple(c.gravity or ()), c.integrator)
+            others = tuple(sorted((k, str(v)) for k, v in c.option.items()))
+            return (c.timestep, tuple(c.gravity or ()), c.integrator, others, c.flag)
 
         differ = [k for k, c in configs if c is not None and option(c) != option(chosen[1])]
         if differ:
