@@ -1047,8 +1047,8 @@ def _roundtrip_on(
         # MuJoCo refusing our URDF for the reason it refuses the source (a non-physical
         # inertia the parser noted and kept) is the source's fault: nothing to compare.
         first = str(exc).splitlines()[0] if str(exc) else ""
-        as_source = bool(first) and ref.kind.startswith("yourdfpy (MuJoCo refuses") and (
-            first in ref.kind
+        as_source = (
+            bool(first) and ref.kind.startswith("yourdfpy (MuJoCo refuses") and (first in ref.kind)
         )
         report.rows.append(
             Row(
