@@ -307,3 +307,27 @@ def test_generator_maps_are_reset_per_tree(tmp_path: Path) -> None:
         "r_free_ball": ("r_free_ball_x", "r_free_ball_y", "r_free_ball_z"),
         "r_cone": ("r_cone_x", "r_cone_y", "r_cone_z"),
     }
+
+
+@pytest.mark.skipif(
+    not hasattr(mujoco.mjtGain, "mjGAIN_SO3"),
+    reason=f"MuJoCo {mujoco.__version__} has no so3 actuators (a MuJoCo 4 feature)",
+)
+def test_so3_actuator_counts_actuators_not_controls(tmp_path: Path, capsys) -> None:
+    # An so3 actuator takes three controls: the converter iterates actuators, not
+    # controls (it raised IndexError), and names the actuator it cannot keep.
+    from robotwright.cli import main
+
+    src = tmp_path / "so3.xml"
+    src.write_text(
+        '<mujoco><worldbody><body name="b"><joint name="ball" type="ball"/>'
+        '<geom size="0.1" mass="1"/></body></worldbody><actuator><general name="a" '
+        'joint="ball" gaintype="so3" biastype="so3" gainprm="10" biasprm="0 -10 -1"/>'
+        "</actuator></mujoco>"
+    )
+    assert mujoco.MjModel.from_xml_path(str(src)).nu == 3
+    out = tmp_path / "out.xml"
+    assert main(["convert", str(src), "-o", str(out), "-v"]) == 0
+    err = capsys.readouterr().err
+    assert '<actuator name="a">' in err and "Traceback" not in err
+    assert mujoco.MjModel.from_xml_path(str(out)).nbody == 2

@@ -24,6 +24,7 @@ import mujoco
 import numpy as np
 
 from robotwright._limits import keyframes_problem
+from robotwright._mjmodel import actuator_count
 from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
@@ -321,7 +322,7 @@ def _actuators(
     table: list[Actuator] = []
     carried: list[ET.Element] = []
     kept: list[int] = []
-    for i in range(model.nu):
+    for i in range(actuator_count(model)):
         name = model.actuator(i).name
         where = f'<actuator name="{name}">' if name else f"actuator #{i}"
         target = _actuator_target(model, i)
@@ -363,7 +364,7 @@ def _keyframes(
         adr, num = int(model.actuator_actadr[i]), int(model.actuator_actnum[i])
         if adr >= 0:
             act_idx += range(adr, adr + num)
-    if len(qpos_idx) != model.nq or len(actuators) != model.nu:
+    if len(qpos_idx) != model.nq or len(actuators) != actuator_count(model):
         rep.warn("keyframes restricted to the robot's joints and actuators (the rest dropped)")
     section = ET.Element("keyframe")
     for k in range(model.nkey):
@@ -435,7 +436,7 @@ def _named_bodies(model: mujoco.MjModel) -> set[int]:
             out.add(int(model.sensor_objid[s]))
         if model.sensor_reftype[s] in body_types:
             out.add(int(model.sensor_refid[s]))
-    for a in range(model.nu):
+    for a in range(actuator_count(model)):
         if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_BODY:
             out.add(int(model.actuator_trnid[a, 0]))
     for e in range(model.neq):
@@ -759,7 +760,7 @@ def _routing_sites(model: mujoco.MjModel) -> set[int]:
             side = int(model.wrap_prm[w])
             if side >= 0:
                 out.add(side)
-    for a in range(model.nu):
+    for a in range(actuator_count(model)):
         if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_SITE:
             out.update(int(x) for x in model.actuator_trnid[a] if x >= 0)
     return out

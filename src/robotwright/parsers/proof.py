@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from robotwright._mjmodel import actuator_count
 from robotwright.errors import Problem
 
 if TYPE_CHECKING:
@@ -47,6 +48,15 @@ if TYPE_CHECKING:
 
 RTOL = 1e-9
 ATOL = 1e-12
+
+
+def _family_count(model: mujoco.MjModel, fam: str) -> int:
+    """Objects of family ``fam`` in ``model`` (actuators, not controls: see
+    :func:`robotwright._mjmodel.actuator_count`)."""
+    if fam == "actuator":
+        return actuator_count(model)
+    return int(getattr(model, FAMILIES[fam][0]))
+
 
 #: family prefix -> (count attribute, MJCF element word used in notes).
 FAMILIES: dict[str, tuple[str, str]] = {
@@ -181,7 +191,7 @@ def fields(model: mujoco.MjModel) -> dict[str, list[str]]:
         value = getattr(model, attr, None)
         if not isinstance(value, np.ndarray) or value.ndim == 0:
             continue
-        count = int(getattr(model, FAMILIES[fam][0]))
+        count = _family_count(model, fam)
         if value.shape[0] != count:
             continue
         out[fam].append(attr)
@@ -207,15 +217,15 @@ class _Side:
         self.m = model
         self.keep = keep_bodies
         self.names: dict[str, list[str]] = {
-            fam: [_name(model, fam, i) for i in range(int(getattr(model, cnt)))]
-            for fam, (cnt, _) in FAMILIES.items()
+            fam: [_name(model, fam, i) for i in range(_family_count(model, fam))]
+            for fam in FAMILIES
             if fam != "dof"
         }
 
     def kept(self, fam: str) -> np.ndarray:
         """Indices of the objects of ``fam`` that belong to the robot."""
         m = self.m
-        n = int(getattr(m, FAMILIES[fam][0]))
+        n = _family_count(m, fam)
         owner = {"body": None, "jnt": m.jnt_bodyid, "dof": m.dof_bodyid, "geom": m.geom_bodyid,
                  "site": m.site_bodyid}.get(fam, "all")  # fmt: skip
         if isinstance(owner, str):

@@ -23,6 +23,7 @@ import defusedxml.ElementTree as DET
 import mujoco
 import numpy as np
 
+from robotwright._mjmodel import actuator_count
 from robotwright._rotations import quat_to_mat, rpy_to_quat
 from robotwright.errors import UnsafePathError
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
@@ -182,7 +183,7 @@ def _view_from_model(model: mujoco.MjModel, kind: str = "mujoco") -> RobotView:
         return out
 
     actuators = []
-    for i in range(model.nu):
+    for i in range(actuator_count(model)):
         jid = int(model.actuator_trnid[i, 0])
         actuators.append(
             {
