@@ -5,6 +5,8 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
+import mujoco
+import numpy as np
 import pytest
 import trimesh
 
@@ -125,3 +127,32 @@ def quiet_parsers():
     logger.setLevel(logging.ERROR)
     yield
     logger.setLevel(old)
+
+
+def _every_body_inertia(ref: mujoco.MjModel, ours: mujoco.MjModel, root: str | None) -> list[str]:
+    """Bodies whose mass, centre of mass or world inertia tensor differ (1e-9 relative),
+    massless ones included (the round-trip table skips bodies without mass)."""
+    from robotwright.parsers.reference import view_from_model
+
+    a, b = view_from_model(ref, root=root), view_from_model(ours)
+    bad = []
+    for name in a.bodies:
+        if name not in b.mass:
+            continue  # merged or turned into a site: the round-trip table covers it
+        scale = max(1.0, abs(a.mass[name]))
+        (ca, ia), (cb, ib) = a.inertia_world[name], b.inertia_world[name]
+        iscale = max(np.abs(ia).max(), np.abs(ib).max(), 1e-300)
+        if (
+            abs(a.mass[name] - b.mass[name]) > 1e-9 * scale
+            or np.abs(ia - ib).max() > 1e-9 * iscale
+            or (a.mass[name] > 0 and np.abs(ca - cb).max() > 1e-9)
+        ):
+            bad.append(f"{name}: mass {a.mass[name]}/{b.mass[name]}, inertia {ia.diagonal()}")
+    return bad
+
+
+@pytest.fixture
+def body_differences():
+    """``(ref, ours, root) -> list[str]``: the bodies whose mass, centre of mass or world
+    inertia tensor differ between two compiled models (the corpus tests' body check)."""
+    return _every_body_inertia

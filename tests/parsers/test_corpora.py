@@ -23,7 +23,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_from_model
+from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
 from robotwright.parsers.roundtrip import our_mjcf_model, parse_source, roundtrip
 
 pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
@@ -94,29 +94,9 @@ def _robot_root(model: mujoco.MjModel) -> str | None:
     return model.body(max(top, key=lambda i: (size[i], -i))).name
 
 
-def _every_body_inertia(ref: mujoco.MjModel, ours: mujoco.MjModel, root: str | None) -> list[str]:
-    """Bodies whose mass, centre of mass or world inertia tensor differ (1e-9 relative),
-    massless ones included (the round-trip table skips bodies without mass)."""
-    a, b = view_from_model(ref, root=root), view_from_model(ours)
-    bad = []
-    for name in a.bodies:
-        if name not in b.mass:
-            continue  # merged or turned into a site: the round-trip table covers it
-        scale = max(1.0, abs(a.mass[name]))
-        (ca, ia), (cb, ib) = a.inertia_world[name], b.inertia_world[name]
-        iscale = max(np.abs(ia).max(), np.abs(ib).max(), 1e-300)
-        if (
-            abs(a.mass[name] - b.mass[name]) > 1e-9 * scale
-            or np.abs(ia - ib).max() > 1e-9 * iscale
-            or (a.mass[name] > 0 and np.abs(ca - cb).max() > 1e-9)
-        ):
-            bad.append(f"{name}: mass {a.mass[name]}/{b.mass[name]}, inertia {ia.diagonal()}")
-    return bad
-
-
 @pytest.mark.corpus
 @pytest.mark.parametrize(("corpus", "rel"), _params())
-def test_corpus_file_roundtrips(corpus: str, rel: str) -> None:
+def test_corpus_file_roundtrips(corpus: str, rel: str, body_differences) -> None:
     root = CORPORA[corpus]
     path = root / rel
     source = _source_model(path)
@@ -129,7 +109,7 @@ def test_corpus_file_roundtrips(corpus: str, rel: str) -> None:
     report = roundtrip(path, configs=CONFIGS, reference="mujoco", **options)
     assert report.ok, report.table()
     hrdf = parse_source(path, **options).hrdf
-    bad = _every_body_inertia(source, our_mjcf_model(hrdf), robot)
+    bad = body_differences(source, our_mjcf_model(hrdf), robot)
     assert not bad, bad
 
 

@@ -37,7 +37,7 @@ import pytest
 
 from robotwright._paths import trusted_asset_roots
 from robotwright.errors import ConversionError, RobotwrightError, UnsafePathError
-from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_from_model
+from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
 from robotwright.parsers.roundtrip import our_mjcf_model, parse_source, roundtrip
 
 pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
@@ -129,27 +129,7 @@ def robot_root(model: mujoco.MjModel) -> str | None:
     return model.body(best).name or f"body_{best}"  # as the parsers name an unnamed body
 
 
-def body_differences(ref: mujoco.MjModel, ours: mujoco.MjModel, root: str | None) -> list[str]:
-    """Bodies whose mass, centre of mass or world inertia tensor differ (1e-9 relative),
-    massless ones included."""
-    a, b = view_from_model(ref, root=root), view_from_model(ours)
-    bad = []
-    for name in a.bodies:
-        if name not in b.mass:
-            continue  # merged or turned into a site: the round-trip table covers it
-        scale = max(1.0, abs(a.mass[name]))
-        (ca, ia), (cb, ib) = a.inertia_world[name], b.inertia_world[name]
-        iscale = max(np.abs(ia).max(), np.abs(ib).max(), 1e-300)
-        if (
-            abs(a.mass[name] - b.mass[name]) > 1e-9 * scale
-            or np.abs(ia - ib).max() > 1e-9 * iscale
-            or (a.mass[name] > 0 and np.abs(ca - cb).max() > 1e-9)
-        ):
-            bad.append(f"{name}: mass {a.mass[name]}/{b.mass[name]}, inertia {ia.diagonal()}")
-    return bad
-
-
-def check_file(corpus: str, rel: str, work: Path) -> tuple[str, str]:
+def check_file(corpus: str, rel: str, work: Path, body_differences) -> tuple[str, str]:
     """(outcome, detail) of one file: ``"not compilable"`` (MuJoCo's reason),
     ``"refused"`` (our error), ``"exact"``, or ``"differs"`` (what differs)."""
     from robotwright.parsers.proof import prove
@@ -195,8 +175,10 @@ def check_file(corpus: str, rel: str, work: Path) -> tuple[str, str]:
 
 @pytest.mark.corpus(always=tuple(EXPECTED_REFUSALS))
 @pytest.mark.parametrize(("corpus", "rel"), _params())
-def test_corpus_file_physics_complete(corpus: str, rel: str, tmp_path: Path) -> None:
-    outcome, detail = check_file(corpus, rel, tmp_path)
+def test_corpus_file_physics_complete(
+    corpus: str, rel: str, tmp_path: Path, body_differences
+) -> None:
+    outcome, detail = check_file(corpus, rel, tmp_path, body_differences)
     key = f"{corpus}/{rel}"
     if outcome == "not compilable":
         assert key not in EXPECTED_REFUSALS, "a refusal is listed for a file MuJoCo refuses"
