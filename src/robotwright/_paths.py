@@ -194,6 +194,7 @@ def check_mjcf_includes(
     model_dir: PathLike,
     root: PathLike,
     trusted: Sequence[Path] | None = None,
+    _depth: int = 0,
 ) -> None:
     """Check what MuJoCo's XML parser itself opens, before it runs: ``<include file>``
     (each included file is read safely, without entities, and checked the same way) and
@@ -213,8 +214,9 @@ def check_mjcf_includes(
     import defusedxml
     import defusedxml.ElementTree as SafeET
 
-    pending = [(tree, source, 0)]
+    pending = [(tree, source, _depth)]
     dirs = [""]
+    included: set[Path] = set()
     while pending:
         node, where, depth = pending.pop()
         dirs += _compiler_dirs(node)
@@ -234,6 +236,15 @@ def check_mjcf_includes(
                         file=where,
                         element=elem,
                     )
+                if path in included:
+                    # MuJoCo refuses a file included twice; expanding every occurrence
+                    # first would take exponential time on a fan-out of includes.
+                    raise UnsafePathError(
+                        f"'{path}' is included more than once; MuJoCo includes a file once",
+                        file=where,
+                        element=elem,
+                    )
+                included.add(path)
                 try:
                     # Regular file, size cap: a FIFO or /dev/zero include never blocks.
                     child = SafeET.fromstring(read_bytes(path, MAX_XML_BYTES))
@@ -266,6 +277,39 @@ def check_mjcf_includes(
                         except UnsafePathError as exc:
                             raise UnsafePathError(exc.reason, file=where, element=elem) from None
                         _check_size(found, where, elem)
+                        if el.tag == "model" and found.is_file():
+                            _check_sub_model(found, where, elem, root, trusted, depth)
+
+
+def _check_sub_model(
+    path: Path, where: str, elem: str, root: PathLike, trusted: Sequence[Path] | None, depth: int
+) -> None:
+    """An ``<asset><model file>`` sub-model is a model of its own: MuJoCo reads its
+    includes from its folder and its meshes and textures with its own ``<compiler
+    meshdir/texturedir/assetdir>``. Check them so, inside the same root."""
+    import defusedxml
+    import defusedxml.ElementTree as SafeET
+    import mujoco
+
+    if depth + 1 > MAX_INCLUDE_DEPTH:
+        raise UnsafePathError(
+            f"sub-models nest deeper than {MAX_INCLUDE_DEPTH} levels", file=where, element=elem
+        )
+    try:
+        tree = SafeET.fromstring(read_bytes(path, MAX_XML_BYTES))
+    except InputFileError as exc:
+        raise UnsafePathError(exc.reason, file=where, element=elem) from None
+    except (defusedxml.DefusedXmlException, SafeET.ParseError, OSError) as exc:
+        raise UnsafePathError(
+            f"the sub-model cannot be read as safe XML: {exc}", file=where, element=elem
+        ) from None
+    here = {"source": str(path), "model_dir": path.parent, "root": root, "trusted": trusted}
+    check_mjcf_includes(tree, **here, _depth=depth + 1)
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError:
+        return  # MuJoCo refuses the sub-model: it reads none of its assets
+    check_mjcf_spec(spec, **here)
 
 
 def _check_declared_hfield(el: Any, source: str) -> None:

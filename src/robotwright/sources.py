@@ -310,12 +310,51 @@ def load_robot_with_notes(
         RobotwrightError: what the readers raise (naming file, element and field), or an
             option that does not apply to the source's kind.
     """
-    from robotwright.hrdf.model import HRDF
+    from robotwright._confine import run_confined
 
     resolved = resolve_source(source)
     opts = {**_GIVEN.get(), **options}
     _check_applies(resolved, opts)
     roots = tuple(asset_roots)
+    work = opts.get("work_dir")
+    hrdf, notes, parsed = run_confined(
+        _read_source,
+        resolved,
+        strict,
+        roots,
+        opts,
+        roots=[*source_roots(resolved), *roots],
+        writable=[work] if work else [],
+        what=str(resolved.path),
+    )
+    if parsed:
+        from robotwright.parsers.proof import restore_parsed
+
+        restore_parsed(parsed)
+    return hrdf, notes
+
+
+def source_roots(resolved: ResolvedSource) -> list[Path]:
+    """The folders a source may read by itself (see docs/security.md): an HRDF folder,
+    an MJCF file's folder, a URDF or xacro file's ROS package or folder."""
+    if resolved.kind == "hrdf":
+        folders = [resolved.path]
+    elif resolved.kind == "mjcf":
+        folders = [resolved.path.resolve().parent]
+    else:
+        from robotwright.parsers.packages import robot_root
+
+        folders = [robot_root(resolved.path)]
+    return folders
+
+
+def _read_source(
+    resolved: ResolvedSource, strict: bool, roots: tuple, opts: dict[str, Any]
+) -> tuple[HRDF, list[str], Any]:
+    """The reading step of :func:`load_robot_with_notes` (run confined): the HRDF, the
+    notes, and the MJCF parser's compile of the file kept for the proof."""
+    from robotwright.hrdf.model import HRDF
+
     if resolved.kind == "hrdf":
         from robotwright.hrdf.io import HRDFWarning
 
@@ -326,15 +365,16 @@ def load_robot_with_notes(
         for w in caught:
             if not issubclass(w.category, HRDFWarning):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        return hrdf, notes
+        return hrdf, notes, None
     from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
+    from robotwright.parsers.proof import parsed_state
 
     parse = mjcf_to_hrdf_with_warnings if resolved.kind == "mjcf" else urdf_to_hrdf_with_warnings
     if roots:
-        opts["asset_roots"] = roots
+        opts = {**opts, "asset_roots": roots}
     with _quiet_parser_log():
         result = parse(resolved.path, strict=strict, **opts)
-    return result.hrdf, [str(w) for w in result.warnings]
+    return result.hrdf, [str(w) for w in result.warnings], parsed_state()
 
 
 def load_robot(

@@ -4,11 +4,16 @@
 logger; ``*_with_warnings`` return a :class:`ParseResult` (``hrdf, warnings = ...``).
 With ``strict=True`` any warning becomes one :class:`~robotwright.errors.ConversionError`
 listing all of them.
+
+The file and everything it names are read by a confined reader
+(:func:`robotwright._confine.run_confined`): a process that may read only the file's
+folder (a URDF's ROS package) and the folders the caller trusted.
 """
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import Any
 
 from robotwright.hrdf.model import HRDF
@@ -19,9 +24,12 @@ def urdf_to_hrdf_with_warnings(
     path: str | os.PathLike, *, strict: bool = False, **options: Any
 ) -> ParseResult:
     """Parse a URDF; ``options`` are the fields of :class:`~robotwright.parsers.URDFOptions`."""
+    from robotwright.parsers.packages import robot_root
     from robotwright.parsers.urdf import URDFOptions, parse_urdf
 
-    return parse_urdf(path, URDFOptions(**options), strict=strict)
+    opts = URDFOptions(**options)
+    root = robot_root(_path(path))
+    return _confined(parse_urdf, path, opts, strict, root, options)
 
 
 def urdf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any) -> HRDF:
@@ -35,9 +43,49 @@ def mjcf_to_hrdf_with_warnings(
     """Parse an MJCF; ``options`` are the fields of :class:`~robotwright.parsers.mjcf.MJCFOptions`."""
     from robotwright.parsers.mjcf import MJCFOptions, parse_mjcf
 
-    return parse_mjcf(path, MJCFOptions(**options), strict=strict)
+    opts = MJCFOptions(**options)
+    return _confined(parse_mjcf, path, opts, strict, _path(path).resolve().parent, options)
 
 
 def mjcf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any) -> HRDF:
     """Parse an MJCF into an HRDF (see :func:`mjcf_to_hrdf_with_warnings`)."""
     return mjcf_to_hrdf_with_warnings(path, strict=strict, **options).hrdf
+
+
+def _path(path: str | os.PathLike) -> Path:
+    return Path(os.fspath(path))
+
+
+def _confined(
+    parse: Any, path: str | os.PathLike, opts: Any, strict: bool, root: Path, options: dict
+) -> ParseResult:
+    """``parse(path, opts, strict=strict)`` in a confined reader that may read ``root``
+    and the folders ``options`` trusts, and write its ``work_dir``; the MJCF parser's
+    compile of the file comes back for the proof."""
+    from robotwright._confine import run_confined
+    from robotwright._mesh_reader import reading_root
+    from robotwright.parsers.proof import restore_parsed
+
+    roots = [root, *(options.get("asset_roots") or ())]
+    roots += list((options.get("package_map") or {}).values())
+    work = options.get("work_dir")
+    with reading_root(root):
+        result, parsed = run_confined(
+            _parse_and_keep,
+            parse,
+            path,
+            opts,
+            strict,
+            roots=roots,
+            writable=[work] if work else [],
+            what=os.fspath(path),
+        )
+    if parsed:
+        restore_parsed(parsed)
+    return result
+
+
+def _parse_and_keep(parse: Any, path: Any, opts: Any, strict: bool) -> tuple[ParseResult, dict]:
+    from robotwright.parsers.proof import parsed_state
+
+    return parse(path, opts, strict=strict), parsed_state()

@@ -225,9 +225,11 @@ def _repair_file(
 ) -> tuple[list[tuple[str, str]], list[tuple]]:
     """Repair one mesh file: the ``(mesh name, file)`` of each output geom, and the
     :class:`MeshRepair` fields (less the body) of each repair made (none: unchanged)."""
+    from robotwright._mesh_reader import load_mesh_file
+
     try:
         # process=True merges duplicate vertices (STL), so watertightness is known.
-        loaded = trimesh.load(source, force="mesh", process=True)
+        loaded = load_mesh_file(source, force="mesh", process=True)
     except Exception as exc:  # trimesh raises many types for unreadable files
         raise ConversionError(
             [Problem("mesh.csv", f"cannot read mesh '{geom.name}': {exc}")]

@@ -81,10 +81,33 @@ class TempFolder:
         self.path = Path(tempfile.mkdtemp(prefix=prefix))
         # The callback holds the path only, never self, so the object can be collected.
         self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.path), True)
+        self._holder: object | None = None
+
+    def __reduce__(self) -> tuple:
+        # Only a confined reader's answer carries a temporary folder (by path, adopted
+        # by the process that reads the answer); anywhere else two processes would each
+        # remove the same folder.
+        from robotwright._confine import in_confined_copy
+
+        if not in_confined_copy():
+            raise TypeError("a TempFolder cannot be pickled")
+        return (_adopt_temp_folder, (str(self.path),))
 
     def remove(self) -> None:
         """Remove the folder now."""
         self._finalizer()
+
+
+def _adopt_temp_folder(path: str) -> TempFolder:
+    """A :class:`TempFolder` made by a confined reader, now held here (see
+    :mod:`robotwright._confine`)."""
+    from robotwright._confine import adoption_holder
+
+    folder = TempFolder.__new__(TempFolder)
+    folder._holder = adoption_holder(path)
+    folder.path = Path(path)
+    folder._finalizer = weakref.finalize(folder, shutil.rmtree, path, True)
+    return folder
 
 
 @dataclass
@@ -268,8 +291,10 @@ def load_triangles(source: Path):
     nothing merged or cleaned)."""
     import trimesh
 
+    from robotwright._mesh_reader import load_mesh_file
+
     try:
-        loaded = trimesh.load(str(source), force="mesh", process=False)
+        loaded = load_mesh_file(source, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types; name the file and re-raise
         raise MeshConversionError(f"cannot read mesh {source}: {exc}") from exc
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:

@@ -19,13 +19,17 @@ folders are reachable only when the user names them: ``asset_roots`` /
 4. inside the root only: the root itself when its ``package.xml`` names ``NAME``, an
    ancestor of the URDF inside the root called ``NAME``, or a sub-folder ``NAME`` of
    such an ancestor (symbolic links followed: it must lie inside the root);
-5. the ROS layout without its ``package.xml``: a URDF in a folder ``urdf`` whose parent
-   folder is called ``NAME`` (``jvrc_description/urdf/jvrc1.urdf`` naming
-   ``package://jvrc_description/meshes/...``) gets that parent folder.
+5. the ROS layout without its ``package.xml`` in an installed Python package: a URDF
+   in a folder ``urdf`` whose parent folder is called ``NAME`` and lies in the Python
+   installation (``site-packages/jvrc_description/urdf/jvrc1.urdf`` naming
+   ``package://jvrc_description/meshes/...``, as pip installs it) gets that parent
+   folder.
 
 Steps 1 to 3 are the user's choice (arguments, command line, environment); step 4 never
 leaves the root, and step 5 only takes a folder that the URI names exactly, one level
-above the URDF's ``urdf`` folder.
+above the URDF's ``urdf`` folder, and only where the user installed it with pip: the
+same layout anywhere else (``~/urdf/robot.urdf`` naming ``package://NAME/...`` with
+the home folder called ``NAME``) reaches nothing above the URDF's folder.
 
 A resolved path must stay inside its package folder (``..`` may not climb out), and a
 relative or ``file://`` path must stay inside the root, symbolic links followed, unless
@@ -177,9 +181,35 @@ def _package_inside_root(name: str, urdf_path: Path) -> Path | None:
         if child.is_dir() and child.resolve().is_relative_to(root):
             return child
     folder = resolved.parent
-    if root == folder and folder.name == "urdf" and folder.parent.name == name:
+    if (
+        root == folder
+        and folder.name == "urdf"
+        and folder.parent.name == name
+        and _in_python_installation(folder.parent)
+    ):
         return folder.parent
     return None
+
+
+def _in_python_installation(folder: Path) -> bool:
+    """Whether ``folder`` is an installed Python package's: strictly inside a
+    site-packages folder of this interpreter (where pip installs), never a shared
+    folder itself."""
+    import site
+    import sysconfig
+
+    places = {sysconfig.get_paths().get(k) for k in ("purelib", "platlib")}
+    with contextlib.suppress(AttributeError):
+        places.update(site.getsitepackages())
+    with contextlib.suppress(AttributeError):
+        places.add(site.getusersitepackages())
+    for place in places:
+        if not place:
+            continue
+        base = Path(place).resolve()
+        if folder != base and folder.is_relative_to(base) and base not in _shared_folders():
+            return True
+    return False
 
 
 def robot_root(urdf_path: Path) -> Path:

@@ -778,21 +778,48 @@ def as_problems(
 def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
     """The source as MuJoCo compiles it on its own (MJCF: its file; URDF: MuJoCo's URDF
     import, as the round trip's reference), or None when MuJoCo refuses it (nothing to
-    prove against). The parser has checked the file's paths already."""
+    prove against). The parser has checked the file's paths already; MuJoCo reads the
+    file in a confined reader (:mod:`robotwright._confine`)."""
+    from robotwright._confine import run_confined
+    from robotwright.parsers.packages import robot_root
+
+    if kind == "mjcf":
+        parsed = _take_parsed(path)
+        if parsed is not None:
+            model, meshes = parsed
+            _SOURCE_MESHES[id(model)] = meshes
+            return model
+    root = Path(path).resolve().parent if kind == "mjcf" else robot_root(Path(path))
+    extra = [Path(p) for p in (options.get("package_map") or {}).values()]
+    extra += [Path(p) for p in options.get("asset_roots") or ()]
+    try:
+        compiled = run_confined(
+            _compile_source, Path(path), kind, options, roots=[root, *extra], what=str(path)
+        )
+    except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
+        return None
+    if compiled is None:
+        return None
+    model, meshes = compiled
+    if meshes is not None:
+        _SOURCE_MESHES[id(model)] = meshes
+    return model
+
+
+def _compile_source(
+    path: Path, kind: str, options: dict
+) -> tuple[mujoco.MjModel, tuple[str, str, dict] | None] | None:
+    """:func:`source_model`'s compile, run confined: the model and, for MJCF, its mesh
+    files (see :func:`_mesh_files`)."""
     from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
 
     try:
         if kind == "mjcf":
-            parsed = _take_parsed(path)
-            if parsed is not None:
-                model, folder, meshdir, files = parsed
-            else:
-                spec = mujoco.MjSpec.from_file(str(path))
-                model = spec.compile()
-                folder, meshdir = spec.modelfiledir or "", spec.compiler.meshdir or ""
-                files = [m.file for m in spec.meshes]
-            _SOURCE_MESHES[id(model)] = _mesh_files(folder, meshdir, files)
-            return model
+            spec = mujoco.MjSpec.from_file(str(path))
+            model = spec.compile()
+            files = [m.file for m in spec.meshes]
+            meshes = _mesh_files(spec.modelfiledir or "", spec.compiler.meshdir or "", files)
+            return model, meshes
         compiler = {
             k: options[k]
             for k in ("balance_inertia", "bound_mass", "bound_inertia")
@@ -805,7 +832,7 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
             **compiler,
         )
         fuse = options.get("fixed_joints", "keep") == "merge"
-        return compile_urdf(text, options.get("density"), fuse_static=fuse)
+        return compile_urdf(text, options.get("density"), fuse_static=fuse), None
     except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
         return None
 
@@ -843,10 +870,10 @@ def _mesh_files(
     return folder, meshdir, names
 
 
-#: the last MJCF the parser compiled: (resolved path, size and mtime) -> its model, model
-#: folder, mesh folder and mesh file names; taken by :func:`source_model` (one compile
-#: of the source saved). At most one is kept.
-_PARSED: dict[tuple[str, int, int], tuple[mujoco.MjModel, str, str, list[str]]] = {}
+#: the last MJCF the parser compiled: (resolved path, size and mtime) -> its model and
+#: mesh files (see :func:`_mesh_files`); taken by :func:`source_model` (one compile of the
+#: source saved). At most one is kept.
+_PARSED: dict[tuple[str, int, int], tuple[mujoco.MjModel, tuple[str, str, dict]]] = {}
 
 
 def _stat_key(path: str | Path) -> tuple[str, int, int] | None:
@@ -864,10 +891,22 @@ def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel
     key = _stat_key(path)
     if key is not None:
         files = [m.file for m in spec.meshes]
-        _PARSED[key] = (model, spec.modelfiledir or "", spec.compiler.meshdir or "", files)
+        meshes = _mesh_files(spec.modelfiledir or "", spec.compiler.meshdir or "", files)
+        _PARSED[key] = (model, meshes)
 
 
-def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, str, str, list[str]] | None:
+def parsed_state() -> dict:
+    """What :func:`remember_parsed` keeps, to carry it out of a confined reader."""
+    return dict(_PARSED)
+
+
+def restore_parsed(state: dict) -> None:
+    """Keep what :func:`parsed_state` gave in a confined reader, here."""
+    _PARSED.clear()
+    _PARSED.update(state)
+
+
+def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, tuple[str, str, dict]] | None:
     key = _stat_key(path)
     return _PARSED.pop(key, None) if key is not None else None
 

@@ -846,11 +846,19 @@ def _yourdfpy_instead(path: Path, compiler: dict[str, Any], exc: ValueError) -> 
 def reference_loader(path: Path, reference: str = "auto", **options: Any) -> ReferenceLoader:
     """The reference of ``path`` (see :func:`reference_view`), prepared to be loaded."""
     _check_reference(reference)
+    from robotwright._confine import run_confined
+    from robotwright.parsers.packages import robot_root
+
+    trusted = [*(options.get("asset_roots") or ()), *(options.get("package_map") or {}).values()]
     if source_kind(path) == "mjcf":
         root = options.get("root_body")
-        return ReferenceLoader(
-            lambda: view_from_model(mujoco.MjModel.from_xml_path(str(path)), root=root)
-        )
+        roots = [Path(path).resolve().parent, *trusted]
+
+        def load_mjcf() -> RobotView:
+            model = run_confined(_model_from_path, str(path), roots=roots, what=str(path))
+            return view_from_model(model, root=root)
+
+        return ReferenceLoader(load_mjcf)
     compiler = {
         k: options[k] for k in ("balance_inertia", "bound_mass", "bound_inertia") if k in options
     }
@@ -874,7 +882,18 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
             raise
         return ReferenceLoader(functools.partial(fallback, exc))  # yourdfpy's from the start
     density = options.get("density")  # of links without <inertial>, as the parser's
-    return ReferenceLoader(lambda: view_from_model(compile_urdf(text, density), "mujoco"), fallback)
+    roots = [robot_root(Path(path)), *trusted]
+
+    def load_urdf() -> RobotView:
+        model = run_confined(compile_urdf, text, density, roots=roots, what=str(path))
+        return view_from_model(model, "mujoco")
+
+    return ReferenceLoader(load_urdf, fallback)
+
+
+def _model_from_path(path: str) -> mujoco.MjModel:
+    """MuJoCo's compile of the MJCF file ``path`` (run confined)."""
+    return mujoco.MjModel.from_xml_path(path)
 
 
 def reference_view(path: Path, reference: str = "auto", **options: Any) -> RobotView:

@@ -131,7 +131,7 @@ def expand_xacro(
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     try:
         done = subprocess.run(
-            [sys.executable, "-m", "robotwright.parsers.xacro"],
+            isolated_python_command("robotwright.parsers.xacro", "_worker"),
             input=json.dumps(request),
             capture_output=True,
             text=True,
@@ -159,6 +159,22 @@ def expand_xacro(
         raise ConversionError([Problem(f, m) for f, m in reply["problems"]])
     packages = {k: Path(v) for k, v in reply["packages"].items()}
     return reply["text"], packages, reply["messages"]
+
+
+def isolated_python_command(module: str, function: str) -> list[str]:
+    """The command that runs ``module.function()`` in a new interpreter started isolated
+    (``-I``: neither the working folder nor ``PYTHONPATH`` nor the user's site folder
+    on ``sys.path``, no ``PYTHON*`` variables), with robotwright's own installation
+    folder first: a robot folder that ships ``xacro.py`` or ``yaml.py`` and is the
+    working folder is never imported from."""
+    import sys
+
+    home = Path(__file__).resolve().parents[2]  # the folder holding robotwright/
+    bootstrap = (
+        f"import sys; sys.path.insert(0, {str(home)!r}); "
+        f"from {module} import {function}; {function}()"
+    )
+    return [sys.executable, "-I", "-c", bootstrap]
 
 
 def _worker() -> None:

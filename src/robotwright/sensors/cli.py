@@ -111,6 +111,15 @@ def load_scene(path: Path) -> mujoco.MjModel:
         SensorError: the scene is unreadable, not MJCF, or refused by MuJoCo.
         UnsafePathError: a file it names leaves its folder or is not a regular file.
     """
+    from robotwright._confine import run_confined
+    from robotwright._paths import trusted_roots
+
+    roots = [path.resolve().parent, *trusted_roots(())]
+    return run_confined(_load_scene_here, path, roots=roots, what=str(path))
+
+
+def _load_scene_here(path: Path) -> mujoco.MjModel:
+    """:func:`load_scene`'s reading step (run confined)."""
     from robotwright._paths import checked_mjcf_spec
     from robotwright.parsers.xmlsafe import parse_xml
 

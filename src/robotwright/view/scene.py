@@ -214,7 +214,15 @@ def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
 def _compile_mjcf(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjModel:
     """Compile an MJCF file with MuJoCo after the project's safety checks: no XML
     entities, and every file it names (includes, meshes, textures) inside its folder or
-    a trusted one."""
+    a trusted one; MuJoCo reads it in a confined reader (:mod:`robotwright._confine`)."""
+    from robotwright._confine import run_confined
+    from robotwright._paths import trusted_roots
+
+    roots = [path.resolve().parent, *trusted_roots(asset_roots)]
+    return run_confined(_compile_mjcf_here, path, asset_roots, roots=roots, what=str(path))
+
+
+def _compile_mjcf_here(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjModel:
     from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
     from robotwright.errors import ConversionError, UnsafePathError
     from robotwright.parsers.xmlsafe import parse_xml

@@ -1,0 +1,356 @@
+"""Confined reading: untrusted robot files are read by a process that cannot reach
+anything else.
+
+The path checks of :mod:`robotwright._paths` are the first line: they give the good
+error messages. But MuJoCo, trimesh and xacro open files by themselves (a sub-model's
+own ``meshdir``, a glTF buffer, an OBJ's material library), and each way they find a
+file that the checks did not foresee would be a way out. :func:`run_confined` runs a
+reading step in a forked copy of this process that the kernel confines with Landlock
+(:mod:`robotwright._landlock`) before the step starts: it may read only
+
+- the roots the step is given (the robot's folder or ROS package),
+- the folders the user named (``--asset-root``, ``--package``, ``package_map``,
+  ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``),
+- the Python installation and the shared libraries it loads,
+
+writes nothing anywhere and opens no TCP connection. The step's result, its warnings,
+MuJoCo's warnings and its exception travel back through a pipe (pickled: the parent
+unpickles only what its own forked copy wrote). A copy of a running process starts in
+about a millisecond, so confinement costs little beyond the transfer of the result.
+
+Where the kernel has no Landlock (older than 5.13, macOS) or ``fork`` is missing
+(Windows), the step runs in this process under the checks alone; :func:`confinement`
+says which, and the command line says it once with ``-v``. ``ROBOTWRIGHT_CONFINE=off``
+turns confinement off (for debugging a reader); any other value keeps it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import pickle
+import signal
+import sys
+import sysconfig
+import warnings
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any, TypeVar
+
+from robotwright._landlock import LandlockError, abi_version, restrict_self
+from robotwright.errors import RobotwrightError
+
+__all__ = ["ConfinementError", "confinement", "readable_roots", "run_confined"]
+
+T = TypeVar("T")
+
+#: Shared-library folders a reader may still load from (a lazily imported extension's
+#: dependencies), and the loader's cache. Never the user's files: ``/etc`` and ``/home``
+#: stay closed except ``ld.so.cache``.
+SYSTEM_LIBRARY_PATHS = (
+    "/lib",
+    "/lib64",
+    "/usr/lib",
+    "/usr/lib64",
+    "/usr/local/lib",
+    "/etc/ld.so.cache",
+    "/dev/null",
+    "/dev/urandom",
+)
+
+
+#: True in a confined copy (temporary folders made there travel back by path).
+_IN_COPY = False
+#: The staging folder of the answer being unpickled here (see :func:`adopt_folder`).
+_ADOPTING: _Staging | None = None
+
+
+class _Staging:
+    """The folder a confined copy may write into; removed when no folder adopted from it
+    (:func:`adopt_folder`) is held any more."""
+
+    def __init__(self) -> None:
+        import shutil
+        import tempfile
+        import weakref
+
+        self.path = Path(tempfile.mkdtemp(prefix="robotwright-read-"))
+        self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.path), True)
+
+
+def in_confined_copy() -> bool:
+    """Whether this process is a confined copy made by :func:`run_confined`."""
+    return _IN_COPY
+
+
+def adoption_holder(path: str | os.PathLike[str]) -> object:
+    """While an answer is unpickled: the staging folder object that must live as long as
+    the temporary folder ``path`` made by the copy inside it (hold it beside the folder).
+
+    Raises:
+        ConfinementError: no answer of a confined copy is being read, or ``path`` is not
+            inside its staging folder (a temporary folder travels only from a copy).
+    """
+    staging = _ADOPTING
+    if staging is None or not Path(path).resolve().is_relative_to(staging.path.resolve()):
+        raise ConfinementError(f"{path}: not a temporary folder of a confined reader")
+    return staging
+
+
+class ConfinementError(RobotwrightError):
+    """The confined reader stopped without an answer (killed, crashed) or could not be
+    confined although the kernel offers Landlock."""
+
+
+def confinement() -> str:
+    """How untrusted files are read here: ``"landlock ABI N"`` (a confined process),
+    or why not (``"off: ..."``)."""
+    if os.environ.get("ROBOTWRIGHT_CONFINE", "").lower() in ("off", "0", "no", "false"):
+        return "off: ROBOTWRIGHT_CONFINE=off"
+    if not hasattr(os, "fork"):
+        return "off: this system has no fork()"
+    abi = abi_version()
+    if abi < 1:
+        return "off: the kernel offers no Landlock (Linux 5.13 or later with it enabled)"
+    return f"landlock ABI {abi}"
+
+
+def _user_roots() -> list[Path]:
+    """The folders the user named for this run: trusted asset roots, given packages,
+    ROS_PACKAGE_PATH and AMENT_PREFIX_PATH entries."""
+    from robotwright._paths import trusted_roots
+    from robotwright.parsers.packages import given_package_map
+
+    roots = [Path(p) for p in trusted_roots(())]
+    roots += [Path(p) for p in given_package_map().values()]
+    for variable in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"):
+        roots += [Path(p) for p in os.environ.get(variable, "").split(os.pathsep) if p]
+    return roots
+
+
+def _python_roots() -> list[Path]:
+    """The Python installation and every folder modules are imported from, never the
+    working folder, home or ``/`` (``python -m`` puts the working folder on sys.path)."""
+    paths = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
+    paths.update(v for k, v in sysconfig.get_paths().items() if v)
+    paths.add(str(Path(sys.executable).resolve().parent.parent))
+    paths.add(str(Path(__file__).resolve().parent))  # this package (an editable install)
+    paths.update(p for p in sys.path if p)
+    for name in ("mujoco", "numpy", "trimesh"):
+        module = sys.modules.get(name)
+        if module is not None and getattr(module, "__file__", None):
+            paths.add(str(Path(module.__file__).resolve().parent.parent))
+    closed = {Path("/"), Path.cwd().resolve()}
+    with contextlib.suppress(RuntimeError, KeyError, OSError):
+        closed.add(Path.home().resolve())
+    out = []
+    for p in paths:
+        try:
+            resolved = Path(p).resolve()
+        except (OSError, RuntimeError):
+            continue
+        if resolved not in closed:
+            out.append(resolved)
+    return out
+
+
+def readable_roots(roots: Iterable[str | os.PathLike[str]]) -> list[Path]:
+    """Everything a confined reader of a source with ``roots`` may read (see the module
+    docstring)."""
+    return [
+        *(Path(r) for r in roots),
+        *_user_roots(),
+        *_python_roots(),
+        *(Path(p) for p in SYSTEM_LIBRARY_PATHS),
+    ]
+
+
+def run_confined(
+    step: Callable[..., T],
+    *args: Any,
+    roots: Iterable[str | os.PathLike[str]],
+    what: str,
+    writable: Iterable[str | os.PathLike[str]] = (),
+    **kwargs: Any,
+) -> T:
+    """``step(*args, **kwargs)`` run in a confined copy of this process that may read only
+    below ``roots`` and the folders of :func:`readable_roots` (see the module docstring);
+    its result, warnings (issued again here, in order) and MuJoCo's warnings (handed to
+    the handler in place here) come back. Where confinement is off, the step runs here.
+
+    Args:
+        roots: the folders of the source (its folder or ROS package).
+        what: what is read, for messages (``"robot.xml"``).
+        writable: folders the step writes into besides its own temporary folders
+            (which are made in a staging folder of this call's).
+
+    Raises:
+        Whatever the step raises (rebuilt here with its type and attributes).
+        ConfinementError: the copy stopped without an answer (a crash, a signal).
+    """
+    if _IN_COPY or not confinement().startswith("landlock"):
+        return step(*args, **kwargs)  # already confined, or confinement is off
+    readable = readable_roots(roots)
+    staging = _Staging()
+    read_fd, write_fd = os.pipe()
+    with warnings.catch_warnings():
+        # A fork beside other threads is what this module needs: the copy runs one step
+        # of Python code and ends with os._exit (no thread of the parent is used).
+        warnings.simplefilter("ignore", DeprecationWarning)
+        pid = os.fork()
+    if pid == 0:  # pragma: no cover - the copy's code runs in another process
+        os.close(read_fd)
+        _child(write_fd, readable, [staging.path, *writable], step, args, kwargs)
+    os.close(write_fd)
+    try:
+        with os.fdopen(read_fd, "rb") as pipe:
+            data = pipe.read()
+        _, status = os.waitpid(pid, 0)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        raise
+    if not data:
+        how = (
+            f"signal {os.WTERMSIG(status)}"
+            if os.WIFSIGNALED(status)
+            else f"exit {os.WEXITSTATUS(status)}"
+        )
+        raise ConfinementError(f"{what}: the confined reader stopped without an answer ({how})")
+    global _ADOPTING
+    _ADOPTING = staging
+    try:
+        kind, value, caught, mujoco_messages = pickle.loads(data)  # noqa: S301 - our copy wrote it
+    finally:
+        _ADOPTING = None
+        del data
+    _replay(caught, mujoco_messages)
+    if kind == "raise":
+        raise _rebuilt(value)
+    return value
+
+
+def _child(
+    write_fd: int,
+    readable: list[Path],
+    writable: list[Path],
+    step: Callable[..., Any],
+    args: tuple[Any, ...],
+    kwargs: dict[str, Any],
+) -> None:  # pragma: no cover - runs in the forked copy
+    """The forked copy: confine, run, answer, exit (never returns, never runs the
+    parent's clean-up: ``os._exit``)."""
+    global _IN_COPY
+    _IN_COPY = True
+    code = 0
+    try:
+        # Every temporary file or folder of the step (staged meshes, an expanded xacro)
+        # is made in the staging folder, the one place the copy may write.
+        import tempfile
+
+        tempfile.tempdir = str(writable[0])
+        # Ctrl-C reaches the whole process group: the parent decides and ends the copy.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        mujoco_messages: list[str] = []
+        mujoco = sys.modules.get("mujoco")
+        if mujoco is not None:
+            mujoco.set_mju_user_warning(lambda text: mujoco_messages.append(str(text)))
+        with warnings.catch_warnings(record=True) as caught:
+            try:
+                restrict_self(readable, writable)
+            except LandlockError as exc:
+                raise ConfinementError(f"could not confine the reader: {exc}") from None
+            try:
+                payload: tuple[str, Any] = ("return", step(*args, **kwargs))
+            except BaseException as exc:  # noqa: BLE001 - every exception goes back
+                payload = ("raise", _portable(exc))
+        data = _dumps(payload, caught, mujoco_messages)
+        view = memoryview(data)
+        while view:
+            written = os.write(write_fd, view)
+            view = view[written:]
+    except BaseException:  # noqa: BLE001 - no answer: the parent reports the exit code
+        code = 70
+    finally:
+        os._exit(code)
+
+
+def _dumps(payload: tuple[str, Any], caught: list[Any], mujoco_messages: list[str]) -> bytes:
+    warnings_out = []
+    for w in caught:
+        message = w.message
+        try:
+            pickle.loads(pickle.dumps(message))
+        except Exception:  # noqa: BLE001 - an unpicklable warning travels as its text
+            message = str(message)
+        warnings_out.append((message, w.category, w.filename, w.lineno))
+    try:
+        return _pickled((*payload, warnings_out, mujoco_messages))
+    except Exception:  # noqa: BLE001 - the result could not travel: say so, as an error
+        kind, value = payload
+        error = value if kind == "raise" else None
+        text = f"{error!r}" if error is not None else f"unpicklable result {type(value)!r}"
+        fallback = ("raise", ("builtin", ConfinementError, (text,), {}))
+        return pickle.dumps((*fallback, warnings_out, mujoco_messages))
+
+
+def _pickled(value: Any) -> bytes:
+    """``value`` pickled, a compiled MuJoCo model as its MJB bytes (MuJoCo's own
+    format, several times faster both ways than the model's pickle)."""
+    import io
+
+    buffer = io.BytesIO()
+    pickler = pickle.Pickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
+    mujoco = sys.modules.get("mujoco")
+    if mujoco is not None:
+        pickler.dispatch_table = {mujoco.MjModel: _reduce_model}
+    pickler.dump(value)
+    return buffer.getvalue()
+
+
+def _reduce_model(model: Any) -> tuple:
+    import numpy as np
+
+    mujoco = sys.modules["mujoco"]
+    data = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, data)
+    return (_model_from_mjb, (pickle.PickleBuffer(data),))
+
+
+def _model_from_mjb(data: Any) -> Any:
+    import mujoco
+
+    return mujoco.MjModel.from_binary_path("model.mjb", {"model.mjb": bytes(data)})
+
+
+def _portable(exc: BaseException) -> tuple[str, type, tuple, dict]:
+    """An exception as its type, ``args`` and attributes: rebuilt without calling its
+    ``__init__`` (our errors take keyword-only arguments that pickle would drop)."""
+    state = dict(getattr(exc, "__dict__", {}))
+    try:
+        pickle.dumps((type(exc), exc.args, state))
+    except Exception:  # noqa: BLE001
+        return ("builtin", ConfinementError, (f"{type(exc).__name__}: {exc}",), {})
+    return ("rebuilt", type(exc), exc.args, state)
+
+
+def _rebuilt(value: tuple[str, type, tuple, dict]) -> BaseException:
+    _, cls, args, state = value
+    exc = cls.__new__(cls, *args)
+    exc.args = args
+    exc.__dict__.update(state)
+    return exc
+
+
+def _replay(caught: list[tuple[Any, type, str, int]], mujoco_messages: list[str]) -> None:
+    for message, category, filename, lineno in caught:
+        warnings.warn_explicit(message, category, filename, lineno)
+    if mujoco_messages and "mujoco" in sys.modules:
+        handler = sys.modules["mujoco"].get_mju_user_warning()
+        for text in mujoco_messages:
+            if handler is not None:
+                handler(text)
+            else:  # no handler here: MuJoCo would have printed it; a warning says it
+                warnings.warn(f"MuJoCo: {text}", RuntimeWarning, stacklevel=3)
+
