@@ -353,4 +353,3 @@ def _replay(caught: list[tuple[Any, type, str, int]], mujoco_messages: list[str]
                 handler(text)
             else:  # no handler here: MuJoCo would have printed it; a warning says it
                 warnings.warn(f"MuJoCo: {text}", RuntimeWarning, stacklevel=3)
-

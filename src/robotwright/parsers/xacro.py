@@ -117,7 +117,6 @@ def expand_xacro(
     """
     import json
     import subprocess
-    import sys
 
     src = Path(path)
     request = {
