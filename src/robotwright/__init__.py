@@ -1,5 +1,15 @@
 """robotwright: describe, generate, compose and sense robots for simulation."""
 
+import sys as _sys
+
+if _sys.argv[:1] == ["-m"]:
+    # ``python -m robotwright`` in a robot's folder: Python put the working folder first
+    # on sys.path, and a ``yaml.py`` or ``trimesh.py`` shipped with the robot would be
+    # imported instead of the library. Take it off before anything is imported.
+    from robotwright._no_working_folder import without_working_folder
+
+    _sys.path[:] = without_working_folder(_sys.path)
+
 __version__ = "0.1.0"
 
 from robotwright._mujoco_gl import import_mujoco

@@ -134,7 +134,9 @@ def _python_roots() -> list[Path]:
     paths = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
     paths.update(v for k, v in sysconfig.get_paths().items() if v)
     paths.add(str(Path(sys.executable).resolve().parent.parent))
-    paths.add(str(Path(__file__).resolve().parent))  # this package (an editable install)
+    # The folder holding this package (an editable install's src/): a worker the reader
+    # starts imports robotwright from there.
+    paths.add(str(Path(__file__).resolve().parent.parent))
     paths.update(p for p in sys.path if p)
     for name in ("mujoco", "numpy", "trimesh"):
         module = sys.modules.get(name)
@@ -249,7 +251,8 @@ def _child(
         # is made in the staging folder, the one place the copy may write.
         import tempfile
 
-        tempfile.tempdir = str(writable[0])
+        os.environ.setdefault("ROBOTWRIGHT_SYSTEM_TMP", tempfile.gettempdir())
+        tempfile.tempdir = os.environ["TMPDIR"] = str(writable[0])  # workers it starts too
         # Ctrl-C reaches the whole process group: the parent decides and ends the copy.
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         mujoco_messages: list[str] = []

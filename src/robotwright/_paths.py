@@ -304,12 +304,15 @@ def _check_sub_model(
             f"the sub-model cannot be read as safe XML: {exc}", file=where, element=elem
         ) from None
     here = {"source": str(path), "model_dir": path.parent, "root": root, "trusted": trusted}
-    check_mjcf_includes(tree, **here, _depth=depth + 1)
     try:
-        spec = mujoco.MjSpec.from_file(str(path))
-    except ValueError:
-        return  # MuJoCo refuses the sub-model: it reads none of its assets
-    check_mjcf_spec(spec, **here)
+        check_mjcf_includes(tree, **here, _depth=depth + 1)
+        try:
+            spec = mujoco.MjSpec.from_file(str(path))
+        except ValueError:
+            return  # MuJoCo refuses the sub-model: it reads none of its assets
+        check_mjcf_spec(spec, **here)
+    except UnsafePathError as exc:
+        raise UnsafePathError(str(exc), file=where, element=elem) from None
 
 
 def _check_declared_hfield(el: Any, source: str) -> None:

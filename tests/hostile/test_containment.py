@@ -170,18 +170,13 @@ def test_loose_file_in_shared_folder_cannot_reach_subfolders_above(tmp_path: Pat
             urdf_to_hrdf(_urdf(downloads, uri))
 
 
-@pytest.mark.parametrize(
-    "layout",
-    ["package.xml relative", "package.xml package://", "NAME/urdf package://"],
-)
+@pytest.mark.parametrize("layout", ["package.xml relative", "package.xml package://"])
 def test_ros_package_layouts_convert(tmp_path: Path, layout: str) -> None:
     """``my_robot_description/urdf/robot.urdf`` + ``meshes/``: with a ``package.xml`` the
-    package folder is the root; without one, ``package://my_robot_description`` names the
-    folder above ``urdf/`` (the only ancestor a URI can name without the user)."""
+    package folder is the root."""
     pkg = tmp_path / "my_robot_description"
     _stl(pkg / "meshes" / "part.stl")
-    if layout.startswith("package.xml"):
-        (pkg / "package.xml").write_text("<package><name>my_robot_description</name></package>")
+    (pkg / "package.xml").write_text("<package><name>my_robot_description</name></package>")
     uri = (
         "../meshes/part.stl"
         if layout.endswith("relative")
@@ -189,6 +184,36 @@ def test_ros_package_layouts_convert(tmp_path: Path, layout: str) -> None:
     )
     path = _urdf(pkg / "urdf", uri)
     assert len(urdf_to_hrdf(path).meshes) == 1
+
+
+@pytest.mark.parametrize("name", ["my_robot_description", "home", "Downloads", "tmp"])
+def test_name_urdf_layout_without_package_xml_reaches_nothing_above(
+    tmp_path: Path, name: str, capsys
+) -> None:
+    """``NAME/urdf/robot.urdf`` naming ``package://NAME/...`` without a ``package.xml``:
+    the folder above ``urdf/`` is not the robot's (``~/urdf/robot.urdf`` in a home
+    folder called NAME would reach every file of it); it is read only when the user
+    names it with ``--package NAME=DIR``."""
+    pkg = tmp_path / name
+    _stl(pkg / "meshes" / "part.stl")
+    _stl(pkg / ".ssh" / "id_ed25519.stl")
+    for uri in (f"package://{name}/meshes/part.stl", f"package://{name}/.ssh/id_ed25519.stl"):
+        path = _urdf(pkg / "urdf", uri)
+        with pytest.raises(RobotwrightError, match=f"package '{name}' not found"):
+            urdf_to_hrdf(path)
+        out = tmp_path / "out.xml"
+        assert main(["convert", str(path), "-o", str(out)]) == 2
+        assert "--package" in capsys.readouterr().err
+        assert not out.exists()
+    assert main(["convert", str(path), "-o", str(out), "--package", f"{name}={pkg}"]) == 0
+
+
+def test_name_urdf_layout_of_an_installed_package_resolves(tmp_path: Path) -> None:
+    """The same layout where pip installed it (``site-packages/NAME/urdf/``): the user
+    installed the package, so its folder is the package's."""
+    jvrc = pytest.importorskip("jvrc_description", reason="jvrc-description not installed")
+    urdf = Path(jvrc.__file__).parent / "urdf" / "jvrc1.urdf"
+    assert len(urdf_to_hrdf(urdf).meshes) > 0
 
 
 def test_urdf_folder_without_package_xml_keeps_relative_paths_inside(tmp_path: Path) -> None:

@@ -238,7 +238,10 @@ PACKAGE_SEARCH_DEPTH = 6
 
 def _shared_folders() -> frozenset[Path]:
     """Folders many users or programs write into, never a robot's package."""
-    folders = {Path("/"), Path(tempfile.gettempdir()).resolve()}
+    # A confined reader's temporary folder is its staging folder: the system's is
+    # passed on in ROBOTWRIGHT_SYSTEM_TMP (see robotwright._confine).
+    temps = [tempfile.gettempdir(), os.environ.get("ROBOTWRIGHT_SYSTEM_TMP") or "/tmp"]
+    folders = {Path("/"), *(Path(t).resolve() for t in temps)}
     with contextlib.suppress(RuntimeError, KeyError, OSError):
         folders.add(Path.home().resolve())
     return frozenset(folders)
