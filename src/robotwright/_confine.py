@@ -32,15 +32,25 @@ import pickle
 import signal
 import sys
 import sysconfig
+import threading
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any, TypeVar
 
 from robotwright._landlock import LandlockError, abi_version, restrict_self
 from robotwright.errors import RobotwrightError
 
-__all__ = ["ConfinementError", "confinement", "readable_roots", "run_confined"]
+__all__ = [
+    "ConfinedCall",
+    "ConfinementError",
+    "confinement",
+    "readable_roots",
+    "reader_budget",
+    "run_confined",
+    "start_confined",
+]
 
 T = TypeVar("T")
 
@@ -63,6 +73,7 @@ SYSTEM_LIBRARY_PATHS = (
 _IN_COPY = False
 #: The staging folder of the answer being unpickled here (see :func:`adopt_folder`).
 _ADOPTING: _Staging | None = None
+_ADOPTION_LOCK = threading.Lock()
 
 
 class _Staging:
@@ -95,6 +106,56 @@ def adoption_holder(path: str | os.PathLike[str]) -> object:
     if staging is None or not Path(path).resolve().is_relative_to(staging.path.resolve()):
         raise ConfinementError(f"{path}: not a temporary folder of a confined reader")
     return staging
+
+
+#: Memory a confined reader may allocate beyond what the process held when it was
+#: copied (bytes; ``--max-reader-mb``), and the CPU time it may use (s). MuJoCo allocates
+#: what a file declares (``<size nuserdata>``, keyframes, replicated bodies) as it
+#: reads: past the budget the reader stops with one error, not the machine.
+READER_MEMORY_BYTES = 2_000 * 10**6
+READER_CPU_S = 120
+_BUDGET: ContextVar[tuple[int, int]] = ContextVar(
+    "robotwright_reader_budget", default=(READER_MEMORY_BYTES, READER_CPU_S)
+)
+
+
+@contextlib.contextmanager
+def reader_budget(memory_mb: float | None = None, cpu_s: int | None = None) -> Iterator[None]:
+    """Within the block, confined readers may allocate ``memory_mb`` MB (10**6 bytes)
+    and use ``cpu_s`` seconds of CPU (``None``: the default, :data:`READER_MEMORY_BYTES`
+    and :data:`READER_CPU_S`).
+
+    Raises:
+        ValueError: a value that is not positive.
+    """
+    memory, cpu = _BUDGET.get()
+    if memory_mb is not None:
+        if not 0 < memory_mb < float("inf"):
+            raise ValueError(f"max_reader_mb must be a positive number of MB, got {memory_mb}")
+        memory = round(memory_mb * 10**6)
+    if cpu_s is not None:
+        if cpu_s <= 0:
+            raise ValueError(f"reader CPU time must be positive, got {cpu_s}")
+        cpu = int(cpu_s)
+    token = _BUDGET.set((memory, cpu))
+    try:
+        yield
+    finally:
+        _BUDGET.reset(token)
+
+
+def reader_memory_bytes() -> int:
+    """The memory a confined reader may allocate now (bytes; see :func:`reader_budget`)."""
+    return _BUDGET.get()[0]
+
+
+def _mapped_bytes() -> int:
+    """The address space this process maps now (0 where /proc cannot tell)."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
 
 
 class ConfinementError(RobotwrightError):
@@ -190,20 +251,52 @@ def run_confined(
         Whatever the step raises (rebuilt here with its type and attributes).
         ConfinementError: the copy stopped without an answer (a crash, a signal).
     """
+    return start_confined(step, *args, roots=roots, what=what, writable=writable, **kwargs)()
+
+
+class ConfinedCall:
+    """A step started by :func:`start_confined`; calling it waits for the answer (once)."""
+
+    def __init__(self, run: Callable[[], Any]) -> None:
+        self._run = run
+
+    def __call__(self) -> Any:
+        return self._run()
+
+
+def start_confined(
+    step: Callable[..., T],
+    *args: Any,
+    roots: Iterable[str | os.PathLike[str]],
+    what: str,
+    writable: Iterable[str | os.PathLike[str]] = (),
+    **kwargs: Any,
+) -> ConfinedCall:
+    """:func:`run_confined`, in two halves: the copy is made now, and the returned call
+    waits for its answer. Start a copy before other threads run MuJoCo: a copy made
+    while another thread holds one of MuJoCo's locks would wait for it for ever (the
+    answer may then be waited for on any thread). Where confinement is off, the step
+    runs when the call is made."""
     if _IN_COPY or not confinement().startswith("landlock"):
-        return step(*args, **kwargs)  # already confined, or confinement is off
+        return ConfinedCall(lambda: step(*args, **kwargs))  # confined already, or off
     readable = readable_roots(roots)
     staging = _Staging()
     read_fd, write_fd = os.pipe()
     with warnings.catch_warnings():
-        # A fork beside other threads is what this module needs: the copy runs one step
-        # of Python code and ends with os._exit (no thread of the parent is used).
+        # The copy runs one step of Python code and ends with os._exit; it uses no
+        # thread of the parent (callers start it before other threads run MuJoCo).
         warnings.simplefilter("ignore", DeprecationWarning)
         pid = os.fork()
     if pid == 0:  # pragma: no cover - the copy's code runs in another process
         os.close(read_fd)
-        _child(write_fd, readable, [staging.path, *writable], step, args, kwargs)
+        _child(write_fd, readable, [staging.path, *writable], _BUDGET.get(), step, args, kwargs)
     os.close(write_fd)
+    budget = _BUDGET.get()
+    return ConfinedCall(lambda: _answer(pid, read_fd, staging, what, budget))
+
+
+def _answer(pid: int, read_fd: int, staging: _Staging, what: str, budget: tuple) -> Any:
+    """The copy's answer: its result, or its exception raised here."""
     try:
         with os.fdopen(read_fd, "rb") as pipe:
             data = pipe.read()
@@ -214,29 +307,50 @@ def run_confined(
             os.waitpid(pid, 0)
         raise
     if not data:
-        how = (
-            f"signal {os.WTERMSIG(status)}"
-            if os.WIFSIGNALED(status)
-            else f"exit {os.WEXITSTATUS(status)}"
-        )
-        raise ConfinementError(f"{what}: the confined reader stopped without an answer ({how})")
+        raise ConfinementError(f"{what}: {_stopped(status, budget)}")
     global _ADOPTING
-    _ADOPTING = staging
-    try:
-        kind, value, caught, mujoco_messages = pickle.loads(data)  # noqa: S301 - our copy wrote it
-    finally:
-        _ADOPTING = None
-        del data
+    with _ADOPTION_LOCK:
+        _ADOPTING = staging
+        try:
+            kind, value, caught, mujoco_messages = pickle.loads(data)  # noqa: S301 - our copy's
+        finally:
+            _ADOPTING = None
+            del data
     _replay(caught, mujoco_messages)
     if kind == "raise":
         raise _rebuilt(value)
     return value
 
 
+def _stopped(status: int, budget: tuple[int, int]) -> str:
+    """Why the copy ended without an answer, with the limit that ended it."""
+    memory, cpu = budget
+    if os.WIFSIGNALED(status):
+        sig = os.WTERMSIG(status)
+        if sig == signal.SIGXCPU:
+            return (
+                f"reading it ran past {cpu} s of CPU time; refused (a file declaring more "
+                "work than a robot needs)"
+            )
+        return f"the confined reader stopped without an answer (signal {sig})"
+    code = os.WEXITSTATUS(status)
+    if code == _OUT_OF_MEMORY:
+        return (
+            f"reading it needed more than {memory / 10**6:,.0f} MB of memory; refused "
+            "(--max-reader-mb raises the limit)"
+        )
+    return f"the confined reader stopped without an answer (exit {code})"
+
+
+#: Exit status of a copy that ran out of its memory budget.
+_OUT_OF_MEMORY = 71
+
+
 def _child(
     write_fd: int,
     readable: list[Path],
     writable: list[Path],
+    budget: tuple[int, int],
     step: Callable[..., Any],
     args: tuple[Any, ...],
     kwargs: dict[str, Any],
@@ -260,6 +374,7 @@ def _child(
         if mujoco is not None:
             mujoco.set_mju_user_warning(lambda text: mujoco_messages.append(str(text)))
         with warnings.catch_warnings(record=True) as caught:
+            _limit_resources(budget)  # first: /proc is closed once confined
             try:
                 restrict_self(readable, writable)
             except LandlockError as exc:
@@ -268,15 +383,33 @@ def _child(
                 payload: tuple[str, Any] = ("return", step(*args, **kwargs))
             except BaseException as exc:  # noqa: BLE001 - every exception goes back
                 payload = ("raise", _portable(exc))
+        if payload[0] == "raise" and _is_out_of_memory(payload[1]):
+            os._exit(_OUT_OF_MEMORY)
         data = _dumps(payload, caught, mujoco_messages)
         view = memoryview(data)
         while view:
             written = os.write(write_fd, view)
             view = view[written:]
+    except MemoryError:
+        code = _OUT_OF_MEMORY
     except BaseException:  # noqa: BLE001 - no answer: the parent reports the exit code
         code = 70
     finally:
         os._exit(code)
+
+
+def _limit_resources(budget: tuple[int, int]) -> None:  # pragma: no cover - in the copy
+    """Memory (address space beyond what is mapped now) and CPU time of the copy: the
+    kernel ends it past either (SIGXCPU, or a failed allocation that MuJoCo and Python
+    report as an error)."""
+    import resource
+
+    memory, cpu = budget
+    mapped = _mapped_bytes()
+    with contextlib.suppress(ValueError, OSError):
+        if mapped:
+            resource.setrlimit(resource.RLIMIT_AS, (mapped + memory, mapped + memory))
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu))
 
 
 def _dumps(payload: tuple[str, Any], caught: list[Any], mujoco_messages: list[str]) -> bytes:
@@ -296,6 +429,16 @@ def _dumps(payload: tuple[str, Any], caught: list[Any], mujoco_messages: list[st
         text = f"{error!r}" if error is not None else f"unpicklable result {type(value)!r}"
         fallback = ("raise", ("builtin", ConfinementError, (text,), {}))
         return pickle.dumps((*fallback, warnings_out, mujoco_messages))
+
+
+def _is_out_of_memory(portable: tuple) -> bool:
+    """Whether the step failed for want of memory: Python's MemoryError, or MuJoCo's
+    allocation failure (its messages say it could not allocate)."""
+    _, cls, args, _ = portable
+    if issubclass(cls, MemoryError):
+        return True
+    text = " ".join(str(a) for a in args).lower()
+    return "could not allocate" in text or "bad_alloc" in text or "unknown exception" in text
 
 
 def _pickled(value: Any) -> bytes:

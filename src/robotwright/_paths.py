@@ -258,6 +258,8 @@ def check_mjcf_includes(
                     ) from None
                 pending.append((child, str(path), depth + 1))
                 continue
+            if el.tag in ("size", "replicate", "flexcomp"):
+                check_declared_counts(el, where)
             if el.tag == "hfield" and not el.get("file"):
                 # MuJoCo's XML reader allocates the declared samples as it reads the
                 # element (3.6 GB for 30,000 x 30,000): refuse an oversized one before.
@@ -313,6 +315,73 @@ def _check_sub_model(
         check_mjcf_spec(spec, **here)
     except UnsafePathError as exc:
         raise UnsafePathError(str(exc), file=where, element=elem) from None
+
+
+#: Bytes MuJoCo allocates per replicated body and per flexcomp point at least (an
+#: estimate on the low side): the counts a file may declare follow the reader's memory
+#: budget (``--max-reader-mb``).
+_BYTES_PER_REPLICA = 40_000
+_BYTES_PER_FLEX_POINT = 4_000
+_USER_FIELDS = (
+    "nuser_body", "nuser_jnt", "nuser_geom", "nuser_site", "nuser_cam",
+    "nuser_tendon", "nuser_actuator", "nuser_sensor",
+)  # fmt: skip
+
+
+def _declared_int(el: Any, attr: str) -> int:
+    try:
+        return int(float(el.get(attr) or 0))
+    except (ValueError, OverflowError):
+        return 0  # not a number: MuJoCo's reader refuses it
+
+
+def check_declared_counts(el: Any, source: str) -> None:
+    """Refuse a ``<size>``, ``<replicate>`` (with the ``<replicate>`` elements nested in
+    it) or ``<flexcomp>`` element declaring more than the confined reader's memory budget
+    holds, before MuJoCo's reader allocates it: a 200-byte file with ``<size
+    nuserdata="3e8">`` asks for 2.4 GB.
+
+    Raises:
+        InputFileError: naming ``source``, the element, the count and the override.
+    """
+    from robotwright._confine import reader_memory_bytes
+
+    budget = reader_memory_bytes()
+    hint = "(--max-reader-mb raises the reader's memory budget)"
+
+    def refuse(what: str, count: int, need: int) -> None:
+        raise InputFileError(
+            source,
+            f"<{el.tag}>: {what} asks for {count:,} ({need / 10**6:,.0f} MB or more), over "
+            f"the reader's memory budget of {budget / 10**6:,.0f} MB {hint}",
+        )
+
+    if el.tag == "size":
+        for attr in ("nuserdata", *_USER_FIELDS):
+            count = _declared_int(el, attr)
+            if count * 8 > budget:
+                refuse(attr, count, count * 8)
+    elif el.tag == "replicate":
+        copies = _replicas(el)
+        if copies * _BYTES_PER_REPLICA > budget:
+            refuse("count (nested replicates multiplied)", copies, copies * _BYTES_PER_REPLICA)
+    elif el.tag == "flexcomp":
+        counts = (el.get("count") or "").split()
+        points = 1
+        for text in counts[:3]:
+            try:
+                points *= max(1, int(float(text)))
+            except (ValueError, OverflowError):
+                return
+        if points * _BYTES_PER_FLEX_POINT > budget:
+            refuse("count (points)", points, points * _BYTES_PER_FLEX_POINT)
+
+
+def _replicas(el: Any) -> int:
+    """Copies a ``<replicate>`` makes of its deepest content: its count times the largest
+    product below it."""
+    below = [_replicas(child) for child in el if getattr(child, "tag", None) == "replicate"]
+    return max(1, _declared_int(el, "count")) * max([1, *below])
 
 
 def _check_declared_hfield(el: Any, source: str) -> None:

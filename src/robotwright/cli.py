@@ -18,6 +18,7 @@ from typing import Any
 
 from robotwright import __version__
 from robotwright._atomic import mesh_size_limit
+from robotwright._confine import reader_budget
 from robotwright._limits import keyframe_limit
 from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, Note, collect_notes, summary_line
@@ -182,6 +183,15 @@ def build_parser() -> argparse.ArgumentParser:
             help="most keyframes a model read may hold (default 10,000): MuJoCo allocates "
             "a full state per keyframe",
         )
+    for name in _ASSET_COMMANDS:
+        sub.choices[name].add_argument(
+            "--max-reader-mb",
+            type=_positive_mb,
+            default=None,
+            metavar="MB",
+            help="memory the confined reader of an input may allocate, in MB (default "
+            "2000): MuJoCo allocates what a file declares as it reads it",
+        )
     for name in _SCAN_COMMANDS:
         sub.choices[name].add_argument(
             "--max-scan-mb",
@@ -310,6 +320,7 @@ def _run(args: argparse.Namespace) -> int:
         # Files copied next to a file output replace others only with --overwrite.
         copies = copies_replace(args.overwrite) if "overwrite" in args else nullcontext()
         keys = keyframe_limit(getattr(args, "max_keyframes", None))
+        budget = reader_budget(getattr(args, "max_reader_mb", None))
         sources = given_source_options(source_options(args))
         with (
             trusted_asset_roots(roots),
@@ -317,6 +328,7 @@ def _run(args: argparse.Namespace) -> int:
             limit,
             scans,
             keys,
+            budget,
             sources,
             copies,
             collect_notes() as caught,

@@ -824,6 +824,13 @@ class ReferenceLoader:
     #: For a URDF MuJoCo refuses, with ``reference="auto"``: yourdfpy's view (None: the
     #: refusal is the answer).
     fallback: Callable[[ValueError], RobotView] | None = None
+    #: Starts the import in a confined reader now and returns the wait for its view
+    #: (see :func:`robotwright._confine.start_confined`); None: :attr:`load` it is.
+    start: Callable[[], Callable[[], RobotView]] | None = None
+
+    def started(self) -> Callable[[], RobotView]:
+        """The import, started now (before other threads run MuJoCo)."""
+        return self.start() if self.start is not None else self.load
 
     def instead(self, exc: ValueError) -> RobotView:
         if self.fallback is None:
@@ -846,7 +853,7 @@ def _yourdfpy_instead(path: Path, compiler: dict[str, Any], exc: ValueError) -> 
 def reference_loader(path: Path, reference: str = "auto", **options: Any) -> ReferenceLoader:
     """The reference of ``path`` (see :func:`reference_view`), prepared to be loaded."""
     _check_reference(reference)
-    from robotwright._confine import run_confined
+    from robotwright._confine import start_confined
     from robotwright.parsers.packages import robot_root
 
     trusted = [*(options.get("asset_roots") or ()), *(options.get("package_map") or {}).values()]
@@ -854,11 +861,11 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
         root = options.get("root_body")
         roots = [Path(path).resolve().parent, *trusted]
 
-        def load_mjcf() -> RobotView:
-            model = run_confined(_model_from_path, str(path), roots=roots, what=str(path))
-            return view_from_model(model, root=root)
+        def start_mjcf() -> Callable[[], RobotView]:
+            call = start_confined(_model_from_path, str(path), roots=roots, what=str(path))
+            return lambda: view_from_model(call(), root=root)
 
-        return ReferenceLoader(load_mjcf)
+        return ReferenceLoader(lambda: start_mjcf()(), start=start_mjcf)
     compiler = {
         k: options[k] for k in ("balance_inertia", "bound_mass", "bound_inertia") if k in options
     }
@@ -884,11 +891,11 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
     density = options.get("density")  # of links without <inertial>, as the parser's
     roots = [robot_root(Path(path)), *trusted]
 
-    def load_urdf() -> RobotView:
-        model = run_confined(compile_urdf, text, density, roots=roots, what=str(path))
-        return view_from_model(model, "mujoco")
+    def start_urdf() -> Callable[[], RobotView]:
+        call = start_confined(compile_urdf, text, density, roots=roots, what=str(path))
+        return lambda: view_from_model(call(), "mujoco")
 
-    return ReferenceLoader(load_urdf, fallback)
+    return ReferenceLoader(lambda: start_urdf()(), fallback, start=start_urdf)
 
 
 def _model_from_path(path: str) -> mujoco.MjModel:
@@ -1006,7 +1013,9 @@ def _roundtrip_on(
     except Exception as exc:
         report.error = f"no reference: {type(exc).__name__}: {exc}"
         return report
-    ref_job = pool.submit(loader.load)  # MuJoCo's import; a fallback runs only if needed
+    # MuJoCo's import, started in its confined reader before the pool's threads run
+    # MuJoCo; a fallback runs only if needed.
+    ref_job = pool.submit(loader.started())
     mjcf_job = pool.submit(lambda: mujoco.MjSpec.from_string(mjcf_text).compile())
     ours_urdf: OurURDF | Exception | None = None
     urdf_job = None

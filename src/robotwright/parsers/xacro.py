@@ -91,7 +91,7 @@ def read_robot_xml(path: Path, options: Any, rep: Reporter) -> ET.Element:
 #: calling the previous one twice, 40 deep, or ``${'x' * 10**10}``): wall time (s), CPU
 #: time (s) and address space (bytes) of the worker process.
 XACRO_TIMEOUT_S = 120
-XACRO_CPU_S = 60
+XACRO_CPU_S = 4
 XACRO_MEMORY_BYTES = 4 << 30
 
 

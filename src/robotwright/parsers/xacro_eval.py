@@ -313,8 +313,28 @@ def _math_guard(name: str) -> Callable[..., None]:
             _is_int(v) and abs(v) > 1500 for v in args
         ):
             raise ExpressionError(f"math.{name}(): arguments over 1500 are refused")
+        if name == "prod" and args:
+            _prod_guard(args[0])
 
     return guard
+
+
+def _prod_guard(values: Any) -> None:
+    """``math.prod`` of integers whose product would pass :data:`MAX_INT_BITS` bits is
+    refused before it is computed (``math.prod(range(1, 999999))`` runs for minutes)."""
+    bits = 0
+    for value in values if isinstance(values, (list, tuple, range)) else ():
+        if _is_int(value) and value:
+            bits += abs(value).bit_length()
+            if bits > MAX_INT_BITS + 64:
+                raise ExpressionError(f"math.prod(): a product over {MAX_INT_BITS} bits")
+
+
+def _round_guard(number: Any = None, ndigits: Any = None) -> None:
+    """``round(x, n)`` with ``|n|`` over :data:`MAX_INT_BITS` computes ``10**|n|``
+    (``round(10**1000, -10**9)`` runs for minutes): refused."""
+    if _is_int(ndigits) and abs(ndigits) > MAX_INT_BITS:
+        raise ExpressionError(f"round(): ndigits over {MAX_INT_BITS} in size is refused")
 
 
 def _math_members() -> dict[str, Any]:
@@ -353,7 +373,7 @@ def _builtins() -> dict[str, Any]:
         "ord": _plain("ord", ord),
         "range": _plain("range", _range, _range_guard),
         "reversed": _plain("reversed", lambda x: list(reversed(x))),
-        "round": _plain("round", round),
+        "round": _plain("round", round, _round_guard),
         "sorted": _plain("sorted", sorted),
         "str": _plain("str", _str),
         "sum": _plain("sum", sum),
