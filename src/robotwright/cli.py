@@ -297,17 +297,32 @@ def _closed_pipe(out: Any) -> int:
     return 0
 
 
+#: Longest error line printed (characters) and most problem lines under a heading: a
+#: file can make a message as long as it likes (a 10,000-body world named in one line).
+MAX_ERROR_LINE = 1000
+MAX_ERROR_LINES = 20
+
+
 def _one_line(text: str) -> str:
-    """``text`` on one line: MuJoCo's messages carry the element and line on a second."""
-    return " ".join(line.strip() for line in text.splitlines() if line.strip())
+    """``text`` on one line (MuJoCo's messages carry the element and line on a second),
+    at most :data:`MAX_ERROR_LINE` characters."""
+    line = " ".join(part.strip() for part in text.splitlines() if part.strip())
+    if len(line) <= MAX_ERROR_LINE:
+        return line
+    cut = line[:MAX_ERROR_LINE].rsplit(" ", 1)[0] or line[:MAX_ERROR_LINE]
+    return f"{cut} ... (and {len(line) - len(cut):,} more characters)"
 
 
 def _error_text(exc: RobotwrightError) -> str:
     """The message of a refusal: one line, or for several problems one line each under
-    a heading line."""
+    a heading line (at most :data:`MAX_ERROR_LINES`, then how many more)."""
     if isinstance(exc, ProblemsError) and len(exc.problems) > 1:
         head, _, _ = str(exc).partition("\n")
-        return "\n".join([head, *(f"  - {_one_line(str(p))}" for p in exc.problems)])
+        shown = [f"  - {_one_line(str(p))}" for p in exc.problems[:MAX_ERROR_LINES]]
+        more = len(exc.problems) - MAX_ERROR_LINES
+        if more > 0:
+            shown.append(f"  - and {more:,} more")
+        return "\n".join([_one_line(head), *shown])
     return _one_line(str(exc))
 
 

@@ -149,6 +149,7 @@ def _run(args: argparse.Namespace) -> int:
             print(f"note: {line}", file=sys.stderr)
     elif lines:
         print(f"note: {lines[0]} (and {len(lines) - 1} more; -v lists each)", file=sys.stderr)
+    _stop_on_signals()
     try:
         # Inside the try: a Ctrl-C right after the address is printed still stops cleanly.
         print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
@@ -159,3 +160,18 @@ def _run(args: argparse.Namespace) -> int:
     finally:
         viewer.stop()
     return 0
+
+
+def _stop_on_signals() -> None:
+    """Ctrl-C (SIGINT) and SIGTERM stop the viewer, also where SIGINT was inherited as
+    ignored (a background job of a script starts with it ignored)."""
+    import signal
+
+    def stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            signal.signal(sig, stop)
+        except (ValueError, OSError):  # not the main thread: the caller's handlers stay
+            pass

@@ -63,7 +63,28 @@ MAX_FRAME_BYTES = 1 << 20
 MAX_DEPTH = 16
 
 _HOST_NAME = re.compile(r"[a-z0-9]([a-z0-9\-._]*[a-z0-9])?\Z")
-_PORT = re.compile(r"[0-9]{1,5}\Z")
+# A port as browsers write it: no sign, no leading zero (``localhost:08931`` is not
+# ``localhost:8931`` to every parser between the page and us).
+_PORT = re.compile(r"(0|[1-9][0-9]{0,4})\Z")
+
+#: The messages viser's page sends for what the viewer offers (camera, GUI controls,
+#: pointer, clicks, drags, renders, local settings); every other type is refused,
+#: among them ShareUrlRequest, file uploads, forms and commands.
+PAGE_MESSAGES = frozenset(
+    {
+        "ViewerCameraMessage",
+        "GuiUpdateMessage",
+        "GuiButtonHoldMessage",
+        "ScenePointerMessage",
+        "SceneNodeClickMessage",
+        "SceneNodeDragMessage",
+        "TransformControlsUpdateMessage",
+        "TransformControlsDragStartMessage",
+        "TransformControlsDragEndMessage",
+        "GetRenderResponseMessage",
+        "LocalStorageGetItemResponseMessage",
+    }
+)
 
 
 def host_key(host: str) -> str:
@@ -295,6 +316,10 @@ def check_frame(raw: object, deserialize: Callable[[bytes], Any]) -> tuple[Any, 
         return None, f"nested deeper than {MAX_DEPTH} levels"
     if not isinstance(mapping, dict) or not isinstance(mapping.get("type"), str):
         return None, "not a message (a map with a 'type')"
+    if mapping["type"] not in PAGE_MESSAGES:
+        # A share-URL request makes viser dial its public relay from a forked copy;
+        # uploads, forms and commands are features the viewer's page does not offer.
+        return None, f"{mapping['type'][:60]!r}: not a message the viewer's page sends"
     try:
         return deserialize(raw), None
     except Exception as exc:  # viser's reader fails in many ways on foreign input
