@@ -165,13 +165,13 @@ def _run(args: argparse.Namespace) -> int:
 def _stop_on_signals() -> None:
     """Ctrl-C (SIGINT) and SIGTERM stop the viewer, also where SIGINT was inherited as
     ignored (a background job of a script starts with it ignored)."""
+    import contextlib
     import signal
 
     def stop(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
 
     for sig in (signal.SIGINT, signal.SIGTERM):
-        try:
+        # Not the main thread (a caller's thread): the caller's handlers stay.
+        with contextlib.suppress(ValueError, OSError):
             signal.signal(sig, stop)
-        except (ValueError, OSError):  # not the main thread: the caller's handlers stay
-            pass
