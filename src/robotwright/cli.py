@@ -252,6 +252,16 @@ def _report_notes(caught: CaughtNotes, verbose: bool) -> None:
         print(summary_line(caught.notes, "-v lists each"), file=sys.stderr)
 
 
+def _say_confinement() -> None:
+    """With ``-v``, where untrusted files were read without a confined reader (no
+    Landlock here): the path checks alone held them (see docs/security.md)."""
+    from robotwright._confine import confinement
+
+    how = confinement()
+    if not how.startswith("landlock"):
+        print(f"note: input files were read without confinement ({how})", file=sys.stderr)
+
+
 def _mujoco_warnings(command: str) -> Any:
     """MuJoCo's warnings gathered while a command that reads models runs (see
     :mod:`robotwright._mujoco_log`); other commands do not import MuJoCo for it."""
@@ -361,6 +371,8 @@ def _run(args: argparse.Namespace) -> int:
         if not args.verbose and getattr(args, "shows_only", False):
             caught.notes = []
         _report_notes(caught, bool(args.verbose))
+        if args.verbose and args.command in _ASSET_COMMANDS:
+            _say_confinement()
         return code
     except RobotwrightError as exc:
         print(f"error: {_error_text(exc)}", file=sys.stderr)

@@ -108,6 +108,8 @@ def _refused_hosts(port: int) -> list[list[str]]:
         [f"localhost :{port}"],
         [f"localhost:{port}/x"],
         [f"localhost:+{port}"],
+        [f"localhost:0{port}"],  # a leading zero: another parser may read it otherwise
+        [f"127.0.0.1:00{port}"],
         [f"localhost:{port}99999"],
         ["localhost:"],
         [""],
@@ -570,3 +572,74 @@ def test_listening_beyond_loopback_warns() -> None:
         line.startswith("warning: listening on 0.0.0.0") and "anyone" in line
         for line in stderr.splitlines()
     )
+
+
+def _children() -> set[int]:
+    """Process ids of this process's children (every thread's)."""
+    out: set[int] = set()
+    for task in os.listdir("/proc/self/task"):
+        try:
+            with open(f"/proc/self/task/{task}/children") as f:
+                out.update(int(x) for x in f.read().split())
+        except OSError:
+            continue
+    return out
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/task"), reason="needs Linux /proc")
+@pytest.mark.parametrize(
+    "message",
+    [
+        {"type": "ShareUrlRequest"},
+        {"type": "ShareUrlDisconnect"},
+        {
+            "type": "FileTransferStartUpload",
+            "source_component_uuid": "x",
+            "transfer_uuid": "t",
+            "filename": "a",
+            "mime_type": "text/plain",
+            "part_count": 1,
+            "size_bytes": 1,
+        },
+        {"type": "CommandTriggerMessage", "name": "x"},
+        {"type": "GuiFormSubmitMessage", "uuid": "x"},
+        {"type": "NoSuchMessage"},
+    ],
+)
+def test_messages_the_page_never_sends_are_refused(
+    page: tuple[Viewer, ClientConnection], message: dict
+) -> None:
+    """A share-URL request made viser fork a copy that dialled its public relay; no
+    message outside what the viewer's page sends reaches viser, and nothing forks."""
+    viewer, ws = page
+    before_children = _children()
+    before = viewer.refused_count
+    ws.send(msgspec.msgpack.encode(message))
+    assert viewer.wait_for_refusals(before + 1, DEADLINE), message["type"]
+    assert any("not a message the viewer's page sends" in r for r in viewer.refused)
+    time.sleep(0.2)
+    assert _children() <= before_children
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_view_stops_on_signals_even_when_sigint_was_ignored(sig: signal.Signals) -> None:
+    """A background job of a script starts with SIGINT ignored: Ctrl-C (or SIGTERM)
+    still stops the viewer, exit 0."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "robotwright", "view", "arm6", "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+    )
+    try:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            if line.startswith("open "):
+                break
+        proc.send_signal(sig)
+        _, stderr = proc.communicate(timeout=DEADLINE)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, stderr

@@ -199,6 +199,32 @@ def check_compiles(hrdf: HRDF) -> list[Problem]:
     return out
 
 
+def too_deep_for_mjcf(hrdf: HRDF) -> str | None:
+    """Why no MJCF of ``hrdf`` can be compiled (its bodies nest deeper than MuJoCo's
+    MJCF reader reads; HRDF and URDF files are flat and hold it), or None."""
+    from robotwright._inputs import MJCF_MAX_BODY_DEPTH
+
+    depth: dict[int, int] = {}
+    for index in range(len(hrdf.bodies)):
+        chain = []
+        k = index
+        while k >= 0 and k not in depth:
+            chain.append(k)
+            k = hrdf.bodies[k].parent
+            if len(chain) > len(hrdf.bodies):
+                return None  # a cycle: validation reports it
+        base = depth.get(k, 0)
+        for offset, body in enumerate(reversed(chain), start=1):
+            depth[body] = base + offset
+    deepest = max(depth.values(), default=0)
+    if deepest <= MJCF_MAX_BODY_DEPTH:
+        return None
+    return (
+        f"the robot nests {deepest} bodies deep and MuJoCo's MJCF reader at most "
+        f"{MJCF_MAX_BODY_DEPTH}, so no MJCF of it compiles to compare with"
+    )
+
+
 def require_compiles(hrdf: HRDF, doing: str) -> None:
     """Refuse a model MuJoCo refuses, saying where: ``convert``/``export`` call it before
     writing (so they never write what ``validate`` calls invalid, and exit 0), ``render``
@@ -214,6 +240,8 @@ def require_compiles(hrdf: HRDF, doing: str) -> None:
     """
     from robotwright.errors import HRDFError
 
+    if too_deep_for_mjcf(hrdf) is not None:
+        return  # MuJoCo cannot judge it: the MJCF writer refuses it, flat formats hold it
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # conversion warnings are reported on export
         message = _compile_xml(_generated_xml(hrdf))  # table errors raise HRDFError here
@@ -229,4 +257,10 @@ def _without_extra(hrdf: HRDF) -> HRDF:
     return dataclasses.replace(hrdf, mjcf_extra=None)
 
 
-__all__ = ["GENERATED", "check_compiles", "check_meshes", "require_compiles"]
+__all__ = [
+    "GENERATED",
+    "check_compiles",
+    "check_meshes",
+    "require_compiles",
+    "too_deep_for_mjcf",
+]

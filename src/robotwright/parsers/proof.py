@@ -1036,6 +1036,13 @@ def prove(
     robot holds), and MuJoCo's import of our URDF against that MJCF
     (:func:`robotwright.parsers.proof_urdf.prove_urdf_output`: what a URDF holds)."""
     options = dict(options or {})
+    from robotwright.hrdf.compiles import too_deep_for_mjcf
+
+    deep = too_deep_for_mjcf(hrdf)
+    if deep is not None:
+        # The robot is written (HRDF and URDF files are flat), but MuJoCo cannot compile
+        # an MJCF of it to compare with: say so instead of refusing the conversion.
+        return [Problem(str(source), f"proof: not made: {deep}", severity="warning")]
     found: list[Problem] = []
     if out_kind == "urdf":
         # The URDF form against our MJCF of the same robot (what a URDF can hold), and

@@ -360,6 +360,14 @@ def _patched(xacro: Any, substitution_args: Any, guard: _Guard) -> Iterator[None
     def optenv_default(_name: str, default: str = "") -> str:
         return default
 
+    saved_extension = xacro.eval_extension
+
+    def eval_extension(text: str) -> Any:
+        # $(cwd) writes the working folder (a user's path) into the output, like $(env).
+        if text.strip() == "$(cwd)":
+            raise _Refused("$(cwd): reading the working folder is refused; use $(arg ...)")
+        return saved_extension(text)
+
     saved_find = substitution_args._eval_find
     saved_env = substitution_args._eval_env
     saved_optenv = substitution_args._eval_optenv
@@ -371,9 +379,11 @@ def _patched(xacro: Any, substitution_args: Any, guard: _Guard) -> Iterator[None
     substitution_args._eval_optenv = optenv_default
     substitution_args._eval_dict.update(find=guard.find, env=refuse_env, optenv=optenv_default)
     xacro.open = guard.open  # module global: shadows the builtin in xacro's own code
+    xacro.eval_extension = eval_extension
     try:
         yield
     finally:
+        xacro.eval_extension = saved_extension
         substitution_args._eval_find = saved_find
         substitution_args._eval_env = saved_env
         substitution_args._eval_optenv = saved_optenv
