@@ -211,8 +211,6 @@ def check_mjcf_includes(
         UnsafePathError: naming the file and element; also for an included file that is
             not well-formed or unsafe XML, and for includes nested too deep.
     """
-    import defusedxml
-    import defusedxml.ElementTree as SafeET
 
     pending = [(tree, source, _depth)]
     dirs = [""]
@@ -245,17 +243,7 @@ def check_mjcf_includes(
                         element=elem,
                     )
                 included.add(path)
-                try:
-                    # Regular file, size cap: a FIFO or /dev/zero include never blocks.
-                    child = SafeET.fromstring(read_bytes(path, MAX_XML_BYTES))
-                except InputFileError as exc:
-                    raise UnsafePathError(exc.reason, file=where, element=elem) from None
-                except (defusedxml.DefusedXmlException, SafeET.ParseError, OSError) as exc:
-                    raise UnsafePathError(
-                        f"the included file cannot be read as safe XML: {exc}",
-                        file=where,
-                        element=elem,
-                    ) from None
+                child = _read_named_xml(path, "the included file", where, elem)
                 pending.append((child, str(path), depth + 1))
                 continue
             if el.tag in ("size", "replicate", "flexcomp"):
@@ -283,28 +271,39 @@ def check_mjcf_includes(
                             _check_sub_model(found, where, elem, root, trusted, depth)
 
 
+def _read_named_xml(path: Path, what: str, where: str, elem: str) -> Any:
+    """The root element of the XML file ``path`` that ``elem`` of ``where`` names, read
+    safely (regular file, size cap: a FIFO or /dev/zero never blocks; no entities).
+
+    Raises:
+        UnsafePathError: naming ``where`` and ``elem``.
+    """
+    import defusedxml
+    import defusedxml.ElementTree as SafeET
+
+    try:
+        return SafeET.fromstring(read_bytes(path, MAX_XML_BYTES))
+    except InputFileError as exc:
+        raise UnsafePathError(exc.reason, file=where, element=elem) from None
+    except (defusedxml.DefusedXmlException, SafeET.ParseError, OSError) as exc:
+        raise UnsafePathError(
+            f"{what} cannot be read as safe XML: {exc}", file=where, element=elem
+        ) from None
+
+
 def _check_sub_model(
     path: Path, where: str, elem: str, root: PathLike, trusted: Sequence[Path] | None, depth: int
 ) -> None:
     """An ``<asset><model file>`` sub-model is a model of its own: MuJoCo reads its
     includes from its folder and its meshes and textures with its own ``<compiler
     meshdir/texturedir/assetdir>``. Check them so, inside the same root."""
-    import defusedxml
-    import defusedxml.ElementTree as SafeET
     import mujoco
 
     if depth + 1 > MAX_INCLUDE_DEPTH:
         raise UnsafePathError(
             f"sub-models nest deeper than {MAX_INCLUDE_DEPTH} levels", file=where, element=elem
         )
-    try:
-        tree = SafeET.fromstring(read_bytes(path, MAX_XML_BYTES))
-    except InputFileError as exc:
-        raise UnsafePathError(exc.reason, file=where, element=elem) from None
-    except (defusedxml.DefusedXmlException, SafeET.ParseError, OSError) as exc:
-        raise UnsafePathError(
-            f"the sub-model cannot be read as safe XML: {exc}", file=where, element=elem
-        ) from None
+    tree = _read_named_xml(path, "the sub-model", where, elem)
     here = {"source": str(path), "model_dir": path.parent, "root": root, "trusted": trusted}
     try:
         check_mjcf_includes(tree, **here, _depth=depth + 1)

@@ -156,3 +156,20 @@ def body_differences():
     """``(ref, ours, root) -> list[str]``: the bodies whose mass, centre of mass or world
     inertia tensor differ between two compiled models (the corpus tests' body check)."""
     return _every_body_inertia
+
+
+@pytest.fixture
+def layout_package():
+    """``path -> {NAME: folder}``: see :func:`_named_layout_package`."""
+    return _named_layout_package
+
+
+def _named_layout_package(path: Path) -> dict[str, Path]:
+    """The package a user names for a URDF in the ROS layout without its
+    ``package.xml`` (``NAME/urdf/robot.urdf`` naming ``package://NAME/...``, as several
+    wheels ship robots): ``--package NAME=DIR``. robotwright reaches ``NAME/`` by itself
+    only where pip installed it (docs/security.md); the corpora are unzipped wheels."""
+    folder = path.resolve().parent
+    if folder.name == "urdf" and not (folder.parent / "package.xml").exists():
+        return {folder.parent.name: folder.parent}
+    return {}

@@ -96,13 +96,15 @@ def _robot_root(model: mujoco.MjModel) -> str | None:
 
 @pytest.mark.corpus
 @pytest.mark.parametrize(("corpus", "rel"), _params())
-def test_corpus_file_roundtrips(corpus: str, rel: str, body_differences) -> None:
+def test_corpus_file_roundtrips(corpus: str, rel: str, body_differences, layout_package) -> None:
     root = CORPORA[corpus]
     path = root / rel
     source = _source_model(path)
     if source.nbody < 2:
         pytest.skip("the file holds no body: nothing to convert")
     options: dict = {"asset_roots": (root,)}
+    if layout_package(path):
+        options["package_map"] = layout_package(path)
     robot = _robot_root(source) if path.suffix == ".xml" else None
     if robot is not None:
         options["root_body"] = robot

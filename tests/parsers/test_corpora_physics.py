@@ -129,7 +129,9 @@ def robot_root(model: mujoco.MjModel) -> str | None:
     return model.body(best).name or f"body_{best}"  # as the parsers name an unnamed body
 
 
-def check_file(corpus: str, rel: str, work: Path, body_differences) -> tuple[str, str]:
+def check_file(
+    corpus: str, rel: str, work: Path, body_differences, layout_package
+) -> tuple[str, str]:
     """(outcome, detail) of one file: ``"not compilable"`` (MuJoCo's reason),
     ``"refused"`` (our error), ``"exact"``, or ``"differs"`` (what differs)."""
     from robotwright.parsers.proof import prove
@@ -138,6 +140,8 @@ def check_file(corpus: str, rel: str, work: Path, body_differences) -> tuple[str
     root, _, corpus_options = CORPORA[corpus]
     path = root / rel
     options: dict = {"asset_roots": (root,), **corpus_options}
+    if layout_package(path):
+        options["package_map"] = layout_package(path)
     expanded, expanded_options = path, options
     if is_xacro(path):
         try:  # the expansion is ours: its refusal is ours too
@@ -176,9 +180,9 @@ def check_file(corpus: str, rel: str, work: Path, body_differences) -> tuple[str
 @pytest.mark.corpus(always=tuple(EXPECTED_REFUSALS))
 @pytest.mark.parametrize(("corpus", "rel"), _params())
 def test_corpus_file_physics_complete(
-    corpus: str, rel: str, tmp_path: Path, body_differences
+    corpus: str, rel: str, tmp_path: Path, body_differences, layout_package
 ) -> None:
-    outcome, detail = check_file(corpus, rel, tmp_path, body_differences)
+    outcome, detail = check_file(corpus, rel, tmp_path, body_differences, layout_package)
     key = f"{corpus}/{rel}"
     if outcome == "not compilable":
         assert key not in EXPECTED_REFUSALS, "a refusal is listed for a file MuJoCo refuses"

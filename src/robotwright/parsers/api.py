@@ -80,7 +80,7 @@ def _confined(
             writable=[work] if work else [],
             what=os.fspath(path),
         )
-    if parsed:
+    if parsed:  # the MJCF parser's compile of this file, for the proof
         restore_parsed(parsed)
     return result
 

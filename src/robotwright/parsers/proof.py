@@ -896,8 +896,32 @@ def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel
 
 
 def parsed_state() -> dict:
-    """What :func:`remember_parsed` keeps, to carry it out of a confined reader."""
-    return dict(_PARSED)
+    """What :func:`remember_parsed` keeps, to carry it out of a confined reader: there,
+    the model is saved to an MJB file (MuJoCo's format) in a temporary folder that
+    travels by path, and is loaded only if the proof takes it."""
+    from robotwright._confine import in_confined_copy
+
+    if not in_confined_copy():
+        return dict(_PARSED)
+    return {
+        key: (_SavedModel(model), meshes)
+        for key, (model, meshes) in _PARSED.items()
+        if not isinstance(model, _SavedModel)  # the parent's own, copied with the process
+    }
+
+
+class _SavedModel:
+    """A compiled model saved by a confined reader, loaded on first use."""
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        from robotwright.parsers.meshes import TempFolder
+
+        self.folder = TempFolder(prefix="robotwright-parsed-")
+        self.path = self.folder.path / "model.mjb"
+        mujoco.mj_saveModel(model, str(self.path), None)
+
+    def load(self) -> mujoco.MjModel:
+        return mujoco.MjModel.from_binary_path(str(self.path))
 
 
 def restore_parsed(state: dict) -> None:
@@ -908,7 +932,10 @@ def restore_parsed(state: dict) -> None:
 
 def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, tuple[str, str, dict]] | None:
     key = _stat_key(path)
-    return _PARSED.pop(key, None) if key is not None else None
+    taken = _PARSED.pop(key, None) if key is not None else None
+    if taken is not None and isinstance(taken[0], _SavedModel):
+        taken = (taken[0].load(), taken[1])
+    return taken
 
 
 def _mesh_sources(hrdf: HRDF) -> list[Path]:
