@@ -280,6 +280,8 @@ def start_confined(
     if _IN_COPY or not confinement().startswith("landlock"):
         return ConfinedCall(lambda: step(*args, **kwargs))  # confined already, or off
     readable = readable_roots(roots)
+    for folder in writable:  # a rule needs the folder: make it as the step would
+        Path(folder).mkdir(parents=True, exist_ok=True)
     staging = _Staging()
     read_fd, write_fd = os.pipe()
     with warnings.catch_warnings():
@@ -312,11 +314,12 @@ def _answer(pid: int, read_fd: int, staging: _Staging, what: str, budget: tuple)
     with _ADOPTION_LOCK:
         _ADOPTING = staging
         try:
-            kind, value, caught, mujoco_messages = pickle.loads(data)  # noqa: S301 - our copy's
+            kind, value, caught, mujoco_messages, side = pickle.loads(data)  # noqa: S301
         finally:
             _ADOPTING = None
             del data
     _replay(caught, mujoco_messages)
+    _replay_side(side)
     if kind == "raise":
         raise _rebuilt(value)
     return value
@@ -371,8 +374,11 @@ def _child(
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         mujoco_messages: list[str] = []
         mujoco = sys.modules.get("mujoco")
-        if mujoco is not None:
+        if mujoco is not None and mujoco.get_mju_user_warning() is not None:
+            # The parent gathers MuJoCo's warnings (the command line): gather them here
+            # for its handler. Without one, MuJoCo issues Python warnings, replayed too.
             mujoco.set_mju_user_warning(lambda text: mujoco_messages.append(str(text)))
+        side = _SideOutput()
         with warnings.catch_warnings(record=True) as caught:
             _limit_resources(budget)  # first: /proc is closed once confined
             try:
@@ -383,9 +389,10 @@ def _child(
                 payload: tuple[str, Any] = ("return", step(*args, **kwargs))
             except BaseException as exc:  # noqa: BLE001 - every exception goes back
                 payload = ("raise", _portable(exc))
+        side.close()
         if payload[0] == "raise" and _is_out_of_memory(payload[1]):
             os._exit(_OUT_OF_MEMORY)
-        data = _dumps(payload, caught, mujoco_messages)
+        data = _dumps(payload, caught, mujoco_messages, side.taken())
         view = memoryview(data)
         while view:
             written = os.write(write_fd, view)
@@ -395,7 +402,54 @@ def _child(
     except BaseException:  # noqa: BLE001 - no answer: the parent reports the exit code
         code = 70
     finally:
+        for stream in (sys.stdout, sys.stderr):  # what went to the terminal, out first
+            with contextlib.suppress(Exception):
+                stream.flush()
         os._exit(code)
+
+
+class _SideOutput:  # pragma: no cover - used in the forked copy
+    """What the step says besides its result, carried back to the parent: its log records
+    (the parent's handlers show them: a command's own collectors live there) and, where
+    the parent's stdout/stderr are not files (a test's capture), what it prints. Printing
+    to a real file goes straight there, so progress lines still come as they happen."""
+
+    def __init__(self) -> None:
+        import io
+        import logging
+
+        self.records: list[Any] = []
+        records = self.records
+
+        def handle(logger: logging.Logger, record: logging.LogRecord) -> None:
+            if not logger.disabled and logger.filter(record):
+                records.append(record)
+
+        logging.Logger.handle = handle  # type: ignore[method-assign]
+        self.streams: dict[str, io.StringIO] = {}
+        for name in ("stdout", "stderr"):
+            stream = getattr(sys, name)
+            try:
+                stream.fileno()
+            except Exception:  # noqa: BLE001 - in memory (io.UnsupportedOperation, ...)
+                self.streams[name] = io.StringIO()
+                setattr(sys, name, self.streams[name])
+
+    def close(self) -> None:
+        import logging
+
+        del logging.Logger.handle  # the class's own method again (for what follows)
+
+    def taken(self) -> dict[str, Any]:
+        records = []
+        for record in self.records:
+            record.msg, record.args = record.getMessage(), None
+            record.exc_info = record.exc_text = None
+            records.append(record)
+        return {
+            "records": records,
+            **{name: stream.getvalue() for name, stream in self.streams.items()},
+        }
 
 
 def _limit_resources(budget: tuple[int, int]) -> None:  # pragma: no cover - in the copy
@@ -412,7 +466,9 @@ def _limit_resources(budget: tuple[int, int]) -> None:  # pragma: no cover - in 
         resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu))
 
 
-def _dumps(payload: tuple[str, Any], caught: list[Any], mujoco_messages: list[str]) -> bytes:
+def _dumps(
+    payload: tuple[str, Any], caught: list[Any], mujoco_messages: list[str], side: dict
+) -> bytes:
     warnings_out = []
     for w in caught:
         message = w.message
@@ -422,13 +478,13 @@ def _dumps(payload: tuple[str, Any], caught: list[Any], mujoco_messages: list[st
             message = str(message)
         warnings_out.append((message, w.category, w.filename, w.lineno))
     try:
-        return _pickled((*payload, warnings_out, mujoco_messages))
+        return _pickled((*payload, warnings_out, mujoco_messages, side))
     except Exception:  # noqa: BLE001 - the result could not travel: say so, as an error
         kind, value = payload
         error = value if kind == "raise" else None
         text = f"{error!r}" if error is not None else f"unpicklable result {type(value)!r}"
         fallback = ("raise", ("builtin", ConfinementError, (text,), {}))
-        return pickle.dumps((*fallback, warnings_out, mujoco_messages))
+        return pickle.dumps((*fallback, warnings_out, mujoco_messages, {}))
 
 
 def _is_out_of_memory(portable: tuple) -> bool:
@@ -489,6 +545,20 @@ def _rebuilt(value: tuple[str, type, tuple, dict]) -> BaseException:
     return exc
 
 
+def _replay_side(side: dict) -> None:
+    """The copy's log records through this process's loggers, and what it printed to a
+    stream that was not a file, printed here."""
+    import logging
+
+    for record in side.get("records", ()):
+        logger = logging.getLogger(record.name)
+        if logger.isEnabledFor(record.levelno):
+            logger.handle(record)
+    for name in ("stdout", "stderr"):
+        if side.get(name):
+            getattr(sys, name).write(side[name])
+
+
 def _replay(caught: list[tuple[Any, type, str, int]], mujoco_messages: list[str]) -> None:
     for message, category, filename, lineno in caught:
         warnings.warn_explicit(message, category, filename, lineno)
@@ -497,5 +567,5 @@ def _replay(caught: list[tuple[Any, type, str, int]], mujoco_messages: list[str]
         for text in mujoco_messages:
             if handler is not None:
                 handler(text)
-            else:  # no handler here: MuJoCo would have printed it; a warning says it
-                warnings.warn(f"MuJoCo: {text}", RuntimeWarning, stacklevel=3)
+            else:  # the handler went while the copy ran: as MuJoCo's own default does
+                warnings.warn(text, UserWarning, stacklevel=3)

@@ -170,6 +170,8 @@ class MeshStore:
             dest = self.root / "meshes" / name
             # A hard link costs nothing and, unlike a symlink, resolves inside the
             # staging folder (HRDF checks that mesh files stay inside the robot folder).
+            # A confined reader copies instead: Landlock refuses a link that would give
+            # a read-only file write access in the staging folder.
             try:
                 os.link(source, dest)
             except OSError:
