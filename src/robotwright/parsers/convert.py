@@ -7,6 +7,7 @@ on its own.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 import warnings
@@ -113,7 +114,10 @@ def _convert(
 
     options = dict(options)
     repairs = pop_config(options)  # opt-in collision-mesh repairs, after the parse
-    hrdf, problems = load_any(src_p, strict=strict, **options)
+    from robotwright.parsers.proof import proof_follows
+
+    with proof_follows() if proof else contextlib.nullcontext():
+        hrdf, problems = load_any(src_p, strict=strict, **options)
     messages = [str(p) for p in problems]
     hrdf, repaired = repair_collision_meshes(hrdf, repairs)
     messages += [str(r) for r in repaired]

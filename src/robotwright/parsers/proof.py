@@ -32,7 +32,9 @@ zero). Integers and flags must be equal.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -783,11 +785,17 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
     from robotwright._confine import run_confined
     from robotwright.parsers.packages import robot_root
 
+    # MuJoCo caches the meshes it decodes by file name, in the process that decodes
+    # them: the output is read through the source's names only where the source was
+    # compiled in this process. A confined reader compiled it in a copy; the output then
+    # reads the staged copies (the same bytes), which the output's check decoded here.
+    here = _compiled_in_this_process()
     if kind == "mjcf":
         parsed = _take_parsed(path)
         if parsed is not None:
             model, meshes = parsed
-            _SOURCE_MESHES[id(model)] = meshes
+            if here:
+                _SOURCE_MESHES[id(model)] = meshes
             return model
     root = Path(path).resolve().parent if kind == "mjcf" else robot_root(Path(path))
     extra = [Path(p) for p in (options.get("package_map") or {}).values()]
@@ -801,9 +809,16 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
     if compiled is None:
         return None
     model, meshes = compiled
-    if meshes is not None:
+    if meshes is not None and here:
         _SOURCE_MESHES[id(model)] = meshes
     return model
+
+
+def _compiled_in_this_process() -> bool:
+    """Whether untrusted files are compiled in this process (no confined reader)."""
+    from robotwright._confine import confinement, in_confined_copy
+
+    return in_confined_copy() or not confinement().startswith("landlock")
 
 
 def _compile_source(
@@ -884,6 +899,22 @@ def _stat_key(path: str | Path) -> tuple[str, int, int] | None:
         return None
 
 
+#: Whether a proof follows the parse (see :func:`proof_follows`).
+_PROOF_FOLLOWS: ContextVar[bool] = ContextVar("robotwright_proof_follows", default=False)
+
+
+@contextmanager
+def proof_follows() -> Iterator[None]:
+    """Within the block, a confined reader hands the MJCF parser's compile of its file
+    back for the proof (elsewhere, ``info`` or ``render``, it is dropped: saving a large
+    model costs time nobody uses)."""
+    token = _PROOF_FOLLOWS.set(True)
+    try:
+        yield
+    finally:
+        _PROOF_FOLLOWS.reset(token)
+
+
 def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel) -> None:
     """Keep ``model``, the parser's compile of the MJCF file ``path`` from ``spec``
     (compiled, not changed since), for the proof of the conversion that follows."""
@@ -903,6 +934,8 @@ def parsed_state() -> dict:
 
     if not in_confined_copy():
         return dict(_PARSED)
+    if not _PROOF_FOLLOWS.get():
+        return {}
     return {
         key: (_SavedModel(model), meshes)
         for key, (model, meshes) in _PARSED.items()
