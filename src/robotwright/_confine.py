@@ -13,7 +13,8 @@ reading step in a forked copy of this process that the kernel confines with Land
   ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``),
 - the Python installation and the shared libraries it loads,
 
-writes nothing anywhere and opens no TCP connection. The step's result, its warnings,
+writes only into a staging folder of its own (and a work folder the caller names), and
+opens no TCP connection. The step's result, its warnings,
 MuJoCo's warnings and its exception travel back through a pipe (pickled: the parent
 unpickles only what its own forked copy wrote). A copy of a running process starts in
 about a millisecond, so confinement costs little beyond the transfer of the result.
@@ -71,14 +72,14 @@ SYSTEM_LIBRARY_PATHS = (
 
 #: True in a confined copy (temporary folders made there travel back by path).
 _IN_COPY = False
-#: The staging folder of the answer being unpickled here (see :func:`adopt_folder`).
+#: The staging folder of the answer being unpickled here (see :func:`adoption_holder`).
 _ADOPTING: _Staging | None = None
 _ADOPTION_LOCK = threading.Lock()
 
 
 class _Staging:
     """The folder a confined copy may write into; removed when no folder adopted from it
-    (:func:`adopt_folder`) is held any more."""
+    (:func:`adoption_holder`) is held any more."""
 
     def __init__(self) -> None:
         import shutil
@@ -190,15 +191,20 @@ def _user_roots() -> list[Path]:
 
 
 def _python_roots() -> list[Path]:
-    """The Python installation and every folder modules are imported from, never the
-    working folder, home or ``/`` (``python -m`` puts the working folder on sys.path)."""
+    """The Python installation (prefixes, site-packages, the interpreter's folder) and
+    the folder holding robotwright itself, never the working folder, home or ``/``.
+    Other ``sys.path`` entries (a script's folder, ``PYTHONPATH``) stay closed: they
+    may hold the user's files, and a reader imports nothing from there."""
     paths = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
     paths.update(v for k, v in sysconfig.get_paths().items() if v)
     paths.add(str(Path(sys.executable).resolve().parent.parent))
     # The folder holding this package (an editable install's src/): a worker the reader
     # starts imports robotwright from there.
     paths.add(str(Path(__file__).resolve().parent.parent))
-    paths.update(p for p in sys.path if p)
+    import site
+
+    with contextlib.suppress(AttributeError):
+        paths.add(site.getusersitepackages())  # pip install --user
     for name in ("mujoco", "numpy", "trimesh"):
         module = sys.modules.get(name)
         if module is not None and getattr(module, "__file__", None):
