@@ -317,7 +317,7 @@ def load_robot_with_notes(
     _check_applies(resolved, opts)
     roots = tuple(asset_roots)
     work = opts.get("work_dir")
-    hrdf, notes, parsed = run_confined(
+    return run_confined(
         _read_source,
         resolved,
         strict,
@@ -327,11 +327,6 @@ def load_robot_with_notes(
         writable=[work] if work else [],
         what=str(resolved.path),
     )
-    if parsed:
-        from robotwright.parsers.proof import restore_parsed
-
-        restore_parsed(parsed)
-    return hrdf, notes
 
 
 def source_roots(resolved: ResolvedSource) -> list[Path]:
@@ -365,16 +360,15 @@ def _read_source(
         for w in caught:
             if not issubclass(w.category, HRDFWarning):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        return hrdf, notes, None
+        return hrdf, notes
     from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
-    from robotwright.parsers.proof import parsed_state
 
     parse = mjcf_to_hrdf_with_warnings if resolved.kind == "mjcf" else urdf_to_hrdf_with_warnings
     if roots:
         opts = {**opts, "asset_roots": roots}
     with _quiet_parser_log():
         result = parse(resolved.path, strict=strict, **opts)
-    return result.hrdf, [str(w) for w in result.warnings], parsed_state()
+    return result.hrdf, [str(w) for w in result.warnings]
 
 
 def load_robot(

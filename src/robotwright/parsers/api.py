@@ -60,32 +60,20 @@ def _confined(
     parse: Any, path: str | os.PathLike, opts: Any, strict: bool, root: Path, options: dict
 ) -> ParseResult:
     """``parse(path, opts, strict=strict)`` in a confined reader that may read ``root``
-    and the folders ``options`` trusts, and write its ``work_dir``; the MJCF parser's
-    compile of the file comes back for the proof."""
+    and the folders ``options`` trusts, and write its ``work_dir``."""
     from robotwright._confine import run_confined
     from robotwright._mesh_reader import reading_root
-    from robotwright.parsers.proof import restore_parsed
 
     roots = [root, *(options.get("asset_roots") or ())]
     roots += list((options.get("package_map") or {}).values())
     work = options.get("work_dir")
     with reading_root(root):
-        result, parsed = run_confined(
-            _parse_and_keep,
+        return run_confined(
             parse,
             path,
             opts,
-            strict,
+            strict=strict,
             roots=roots,
             writable=[work] if work else [],
             what=os.fspath(path),
         )
-    if parsed:  # the MJCF parser's compile of this file, for the proof
-        restore_parsed(parsed)
-    return result
-
-
-def _parse_and_keep(parse: Any, path: Any, opts: Any, strict: bool) -> tuple[ParseResult, dict]:
-    from robotwright.parsers.proof import parsed_state
-
-    return parse(path, opts, strict=strict), parsed_state()

@@ -7,7 +7,6 @@ on its own.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import tempfile
 import warnings
@@ -109,25 +108,36 @@ def _convert(
     options: dict[str, Any],
     proof: bool = True,
 ) -> list[str]:
+    from robotwright._confine import run_confined
     from robotwright.hrdf.compiles import require_compiles
-    from robotwright.parsers.collision import pop_config, repair_collision_meshes
+    from robotwright.parsers.collision import pop_config
 
     options = dict(options)
     repairs = pop_config(options)  # opt-in collision-mesh repairs, after the parse
-    from robotwright.parsers.proof import proof_follows
-
-    with proof_follows() if proof else contextlib.nullcontext():
-        hrdf, problems = load_any(src_p, strict=strict, **options)
-    messages = [str(p) for p in problems]
-    hrdf, repaired = repair_collision_meshes(hrdf, repairs)
-    messages += [str(r) for r in repaired]
+    # Reading, repairs and the proof in one confined reader: the proof compiles the
+    # source and the output where MuJoCo has just decoded the source's meshes.
+    work = options.get("work_dir")
+    hrdf, messages, proved = run_confined(
+        _read_and_prove,
+        src_p,
+        out_kind,
+        strict,
+        options,
+        repairs,
+        proof,
+        roots=_source_roots(src_p, options),
+        writable=[work] if work else [],
+        what=str(src_p),
+    )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             # What MuJoCo refuses is not written (validate calls such a folder invalid).
             require_compiles(hrdf, f"cannot write {dst_p}")
             if proof:
-                messages += _proof(src_p, hrdf, out_kind, messages, strict, options)
+                if proved is None:  # the reader could not prove it: say why here
+                    proved = _proof(src_p, hrdf, out_kind, messages, strict, options)
+                messages += proved
             if out_kind == "hrdf":
                 hrdf.save(dst_p, overwrite=overwrite)
             else:
@@ -148,6 +158,50 @@ def _convert(
             ) from exc
     messages += [str(w.message) for w in caught]
     return messages
+
+
+def _source_roots(src_p: Path, options: dict[str, Any]) -> list[Path]:
+    """The folders the source may read (its folder, or a URDF's ROS package), and those
+    the options trust."""
+    from robotwright.parsers.packages import robot_root
+
+    kind = file_kind(src_p, existing=True)
+    if kind == "hrdf":
+        root = src_p.resolve()
+    elif kind == "mjcf":
+        root = src_p.resolve().parent
+    else:
+        root = robot_root(src_p)
+    trusted = [Path(p) for p in options.get("asset_roots") or ()]
+    return [root, *trusted, *(Path(p) for p in (options.get("package_map") or {}).values())]
+
+
+def _read_and_prove(
+    src_p: Path,
+    out_kind: str,
+    strict: bool,
+    options: dict[str, Any],
+    repairs: Any,
+    proof: bool,
+) -> tuple[HRDF, list[str], list[str] | None]:
+    """Read the source, repair its collision meshes and prove the conversion (run in a
+    confined reader): the robot, the notes, and the proof's notes (None: not proved
+    here, for example because the output does not compile; the caller says why)."""
+    from robotwright.parsers.collision import repair_collision_meshes
+
+    hrdf, problems = load_any(src_p, strict=strict, **options)
+    messages = [str(p) for p in problems]
+    hrdf, repaired = repair_collision_meshes(hrdf, repairs)
+    messages += [str(r) for r in repaired]
+    proved = None
+    if proof:
+        try:
+            proved = _proof(src_p, hrdf, out_kind, messages, strict, options)
+        except ConversionError:
+            raise  # a strict proof's refusal is the conversion's answer
+        except Exception:  # noqa: BLE001 - the output's own check gives the reason
+            proved = None
+    return hrdf, messages, proved
 
 
 def _proof(

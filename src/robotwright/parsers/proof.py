@@ -32,9 +32,7 @@ zero). Integers and flags must be equal.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Iterator, Sequence
-from contextlib import contextmanager
-from contextvars import ContextVar
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -899,22 +897,6 @@ def _stat_key(path: str | Path) -> tuple[str, int, int] | None:
         return None
 
 
-#: Whether a proof follows the parse (see :func:`proof_follows`).
-_PROOF_FOLLOWS: ContextVar[bool] = ContextVar("robotwright_proof_follows", default=False)
-
-
-@contextmanager
-def proof_follows() -> Iterator[None]:
-    """Within the block, a confined reader hands the MJCF parser's compile of its file
-    back for the proof (elsewhere, ``info`` or ``render``, it is dropped: saving a large
-    model costs time nobody uses)."""
-    token = _PROOF_FOLLOWS.set(True)
-    try:
-        yield
-    finally:
-        _PROOF_FOLLOWS.reset(token)
-
-
 def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel) -> None:
     """Keep ``model``, the parser's compile of the MJCF file ``path`` from ``spec``
     (compiled, not changed since), for the proof of the conversion that follows."""
@@ -926,49 +908,9 @@ def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel
         _PARSED[key] = (model, meshes)
 
 
-def parsed_state() -> dict:
-    """What :func:`remember_parsed` keeps, to carry it out of a confined reader: there,
-    the model is saved to an MJB file (MuJoCo's format) in a temporary folder that
-    travels by path, and is loaded only if the proof takes it."""
-    from robotwright._confine import in_confined_copy
-
-    if not in_confined_copy():
-        return dict(_PARSED)
-    if not _PROOF_FOLLOWS.get():
-        return {}
-    return {
-        key: (_SavedModel(model), meshes)
-        for key, (model, meshes) in _PARSED.items()
-        if not isinstance(model, _SavedModel)  # the parent's own, copied with the process
-    }
-
-
-class _SavedModel:
-    """A compiled model saved by a confined reader, loaded on first use."""
-
-    def __init__(self, model: mujoco.MjModel) -> None:
-        from robotwright.parsers.meshes import TempFolder
-
-        self.folder = TempFolder(prefix="robotwright-parsed-")
-        self.path = self.folder.path / "model.mjb"
-        mujoco.mj_saveModel(model, str(self.path), None)
-
-    def load(self) -> mujoco.MjModel:
-        return mujoco.MjModel.from_binary_path(str(self.path))
-
-
-def restore_parsed(state: dict) -> None:
-    """Keep what :func:`parsed_state` gave in a confined reader, here."""
-    _PARSED.clear()
-    _PARSED.update(state)
-
-
 def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, tuple[str, str, dict]] | None:
     key = _stat_key(path)
-    taken = _PARSED.pop(key, None) if key is not None else None
-    if taken is not None and isinstance(taken[0], _SavedModel):
-        taken = (taken[0].load(), taken[1])
-    return taken
+    return _PARSED.pop(key, None) if key is not None else None
 
 
 def _mesh_sources(hrdf: HRDF) -> list[Path]:
