@@ -345,9 +345,9 @@ def source_roots(resolved: ResolvedSource) -> list[Path]:
 
 def _read_source(
     resolved: ResolvedSource, strict: bool, roots: tuple, opts: dict[str, Any]
-) -> tuple[HRDF, list[str], Any]:
-    """The reading step of :func:`load_robot_with_notes` (run confined): the HRDF, the
-    notes, and the MJCF parser's compile of the file kept for the proof."""
+) -> tuple[HRDF, list[str]]:
+    """The reading step of :func:`load_robot_with_notes` (run confined): the HRDF and
+    the readers' notes."""
     from robotwright.hrdf.model import HRDF
 
     if resolved.kind == "hrdf":
