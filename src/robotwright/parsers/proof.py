@@ -791,9 +791,9 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
     if kind == "mjcf":
         parsed = _take_parsed(path)
         if parsed is not None:
-            model, meshes = parsed
+            model, folder, meshdir, files = parsed
             if here:
-                _SOURCE_MESHES[id(model)] = meshes
+                _SOURCE_MESHES[id(model)] = _mesh_files(folder, meshdir, files)
             return model
     root = Path(path).resolve().parent if kind == "mjcf" else robot_root(Path(path))
     extra = [Path(p) for p in (options.get("package_map") or {}).values()]
@@ -883,10 +883,10 @@ def _mesh_files(
     return folder, meshdir, names
 
 
-#: the last MJCF the parser compiled: (resolved path, size and mtime) -> its model and
-#: mesh files (see :func:`_mesh_files`); taken by :func:`source_model` (one compile of the
-#: source saved). At most one is kept.
-_PARSED: dict[tuple[str, int, int], tuple[mujoco.MjModel, tuple[str, str, dict]]] = {}
+#: the last MJCF the parser compiled: (resolved path, size and mtime) -> its model, model
+#: folder, mesh folder and mesh file names; taken by :func:`source_model` (one compile
+#: of the source saved). At most one is kept.
+_PARSED: dict[tuple[str, int, int], tuple[mujoco.MjModel, str, str, list[str]]] = {}
 
 
 def _stat_key(path: str | Path) -> tuple[str, int, int] | None:
@@ -904,11 +904,10 @@ def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel
     key = _stat_key(path)
     if key is not None:
         files = [m.file for m in spec.meshes]
-        meshes = _mesh_files(spec.modelfiledir or "", spec.compiler.meshdir or "", files)
-        _PARSED[key] = (model, meshes)
+        _PARSED[key] = (model, spec.modelfiledir or "", spec.compiler.meshdir or "", files)
 
 
-def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, tuple[str, str, dict]] | None:
+def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, str, str, list[str]] | None:
     key = _stat_key(path)
     return _PARSED.pop(key, None) if key is not None else None
 
