@@ -164,43 +164,26 @@ def build_parser() -> argparse.ArgumentParser:
             help="URDF/xacro: package://NAME/... and $(find NAME) name folder DIR (by default "
             "only packages inside the robot's own folder or ROS package are found); repeatable",
         )
-    for name in _MESH_COMMANDS:
-        sub.choices[name].add_argument(
-            "--max-mesh-mb",
-            type=_positive_mb,
-            default=None,
-            metavar="MB",
-            help="largest mesh, height field or texture a model may read or copy into an "
-            "output, in MB (default 512; counted as the file's size, or the data a height "
-            "field or image declares): a larger one is refused before it is read",
-        )
-    for name in _ASSET_COMMANDS:
-        sub.choices[name].add_argument(
-            "--max-keyframes",
-            type=_count_arg,
-            default=None,
-            metavar="N",
-            help="most keyframes a model read may hold (default 10,000): MuJoCo allocates "
-            "a full state per keyframe",
-        )
-    for name in _ASSET_COMMANDS:
-        sub.choices[name].add_argument(
-            "--max-reader-mb",
-            type=_positive_mb,
-            default=None,
-            metavar="MB",
-            help="memory the confined reader of an input may allocate, in MB (default "
-            "2000): MuJoCo allocates what a file declares as it reads it",
-        )
-    for name in _SCAN_COMMANDS:
-        sub.choices[name].add_argument(
-            "--max-scan-mb",
-            type=_positive_mb,
-            default=None,
-            metavar="MB",
-            help="largest size of a scan's arrays once loaded, in MB (default 1000): a "
-            "scan .npz declaring more is refused before it is loaded",
-        )
+    limits = (
+        (_MESH_COMMANDS, "--max-mesh-mb", _positive_mb, "MB",
+         "largest mesh, height field or texture a model may read or copy into an output, "
+         "in MB (default 512; counted as the file's size, or the data a height field or "
+         "image declares): a larger one is refused before it is read"),
+        (_ASSET_COMMANDS, "--max-keyframes", _count_arg, "N",
+         "most keyframes a model read may hold (default 10,000): MuJoCo allocates a full "
+         "state per keyframe"),
+        (_ASSET_COMMANDS, "--max-reader-mb", _positive_mb, "MB",
+         "memory the confined reader of an input may allocate, in MB (default 2000): "
+         "MuJoCo allocates what a file declares as it reads it"),
+        (_SCAN_COMMANDS, "--max-scan-mb", _positive_mb, "MB",
+         "largest size of a scan's arrays once loaded, in MB (default 1000): a scan .npz "
+         "declaring more is refused before it is loaded"),
+    )  # fmt: skip
+    for commands, flag, kind, metavar, text in limits:
+        for name in commands:
+            sub.choices[name].add_argument(
+                flag, type=kind, default=None, metavar=metavar, help=text
+            )
     return parser
 
 
