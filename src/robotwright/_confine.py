@@ -44,7 +44,6 @@ from robotwright._landlock import LandlockError, abi_version, restrict_self
 from robotwright.errors import RobotwrightError
 
 __all__ = [
-    "ConfinedCall",
     "ConfinementError",
     "confinement",
     "readable_roots",
@@ -190,6 +189,19 @@ def _user_roots() -> list[Path]:
     return roots
 
 
+def site_package_folders() -> list[Path]:
+    """The folders pip installs packages into for this interpreter (site-packages,
+    the user's site folder), resolved."""
+    import site
+
+    places = {sysconfig.get_paths().get(k) for k in ("purelib", "platlib")}
+    with contextlib.suppress(AttributeError):
+        places.update(site.getsitepackages())
+    with contextlib.suppress(AttributeError):
+        places.add(site.getusersitepackages())  # pip install --user
+    return [Path(p).resolve() for p in places if p]
+
+
 def _python_roots() -> list[Path]:
     """The Python installation (prefixes, site-packages, the interpreter's folder) and
     the folder holding robotwright itself, never the working folder, home or ``/``.
@@ -201,10 +213,7 @@ def _python_roots() -> list[Path]:
     # The folder holding this package (an editable install's src/): a worker the reader
     # starts imports robotwright from there.
     paths.add(str(Path(__file__).resolve().parent.parent))
-    import site
-
-    with contextlib.suppress(AttributeError):
-        paths.add(site.getusersitepackages())  # pip install --user
+    paths.update(str(p) for p in site_package_folders())
     for name in ("mujoco", "numpy", "trimesh"):
         module = sys.modules.get(name)
         if module is not None and getattr(module, "__file__", None):
@@ -260,16 +269,6 @@ def run_confined(
     return start_confined(step, *args, roots=roots, what=what, writable=writable, **kwargs)()
 
 
-class ConfinedCall:
-    """A step started by :func:`start_confined`; calling it waits for the answer (once)."""
-
-    def __init__(self, run: Callable[[], Any]) -> None:
-        self._run = run
-
-    def __call__(self) -> Any:
-        return self._run()
-
-
 def start_confined(
     step: Callable[..., T],
     *args: Any,
@@ -277,14 +276,14 @@ def start_confined(
     what: str,
     writable: Iterable[str | os.PathLike[str]] = (),
     **kwargs: Any,
-) -> ConfinedCall:
+) -> Callable[[], T]:
     """:func:`run_confined`, in two halves: the copy is made now, and the returned call
-    waits for its answer. Start a copy before other threads run MuJoCo: a copy made
+    waits for its answer (call it once). Start a copy before other threads run MuJoCo: a copy made
     while another thread holds one of MuJoCo's locks would wait for it for ever (the
     answer may then be waited for on any thread). Where confinement is off, the step
     runs when the call is made."""
     if _IN_COPY or not confinement().startswith("landlock"):
-        return ConfinedCall(lambda: step(*args, **kwargs))  # confined already, or off
+        return lambda: step(*args, **kwargs)  # confined already, or off
     readable = readable_roots(roots)
     for folder in writable:  # a rule needs the folder: make it as the step would
         Path(folder).mkdir(parents=True, exist_ok=True)
@@ -300,7 +299,7 @@ def start_confined(
         _child(write_fd, readable, [staging.path, *writable], _BUDGET.get(), step, args, kwargs)
     os.close(write_fd)
     budget = _BUDGET.get()
-    return ConfinedCall(lambda: _answer(pid, read_fd, staging, what, budget))
+    return lambda: _answer(pid, read_fd, staging, what, budget)
 
 
 def _answer(pid: int, read_fd: int, staging: _Staging, what: str, budget: tuple) -> Any:

@@ -311,6 +311,7 @@ def load_robot_with_notes(
             option that does not apply to the source's kind.
     """
     from robotwright._confine import run_confined
+    from robotwright.parsers.packages import source_read_roots
 
     resolved = resolve_source(source)
     opts = {**_GIVEN.get(), **options}
@@ -323,24 +324,10 @@ def load_robot_with_notes(
         strict,
         roots,
         opts,
-        roots=[*source_roots(resolved), *roots],
+        roots=source_read_roots(resolved.path, resolved.kind, {"asset_roots": roots}),
         writable=[work] if work else [],
         what=str(resolved.path),
     )
-
-
-def source_roots(resolved: ResolvedSource) -> list[Path]:
-    """The folders a source may read by itself (see docs/security.md): an HRDF folder,
-    an MJCF file's folder, a URDF or xacro file's ROS package or folder."""
-    if resolved.kind == "hrdf":
-        folders = [resolved.path]
-    elif resolved.kind == "mjcf":
-        folders = [resolved.path.resolve().parent]
-    else:
-        from robotwright.parsers.packages import robot_root
-
-        folders = [robot_root(resolved.path)]
-    return folders
 
 
 def _read_source(

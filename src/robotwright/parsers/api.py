@@ -13,7 +13,6 @@ folder (a URDF's ROS package) and the folders the caller trusted.
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any
 
 from robotwright.hrdf.model import HRDF
@@ -24,12 +23,9 @@ def urdf_to_hrdf_with_warnings(
     path: str | os.PathLike, *, strict: bool = False, **options: Any
 ) -> ParseResult:
     """Parse a URDF; ``options`` are the fields of :class:`~robotwright.parsers.URDFOptions`."""
-    from robotwright.parsers.packages import robot_root
     from robotwright.parsers.urdf import URDFOptions, parse_urdf
 
-    opts = URDFOptions(**options)
-    root = robot_root(_path(path))
-    return _confined(parse_urdf, path, opts, strict, root, options)
+    return _confined(parse_urdf, path, URDFOptions(**options), strict, "urdf", options)
 
 
 def urdf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any) -> HRDF:
@@ -43,8 +39,7 @@ def mjcf_to_hrdf_with_warnings(
     """Parse an MJCF; ``options`` are the fields of :class:`~robotwright.parsers.mjcf.MJCFOptions`."""
     from robotwright.parsers.mjcf import MJCFOptions, parse_mjcf
 
-    opts = MJCFOptions(**options)
-    return _confined(parse_mjcf, path, opts, strict, _path(path).resolve().parent, options)
+    return _confined(parse_mjcf, path, MJCFOptions(**options), strict, "mjcf", options)
 
 
 def mjcf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any) -> HRDF:
@@ -52,22 +47,18 @@ def mjcf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: An
     return mjcf_to_hrdf_with_warnings(path, strict=strict, **options).hrdf
 
 
-def _path(path: str | os.PathLike) -> Path:
-    return Path(os.fspath(path))
-
-
 def _confined(
-    parse: Any, path: str | os.PathLike, opts: Any, strict: bool, root: Path, options: dict
+    parse: Any, path: str | os.PathLike, opts: Any, strict: bool, kind: str, options: dict
 ) -> ParseResult:
-    """``parse(path, opts, strict=strict)`` in a confined reader that may read ``root``
-    and the folders ``options`` trusts, and write its ``work_dir``."""
+    """``parse(path, opts, strict=strict)`` in a confined reader that may read the
+    source's root and the folders ``options`` trusts, and write its ``work_dir``."""
     from robotwright._confine import run_confined
     from robotwright._mesh_reader import reading_root
+    from robotwright.parsers.packages import source_read_roots
 
-    roots = [root, *(options.get("asset_roots") or ())]
-    roots += list((options.get("package_map") or {}).values())
+    roots = source_read_roots(path, kind, options)
     work = options.get("work_dir")
-    with reading_root(root):
+    with reading_root(roots[0]):
         return run_confined(
             parse,
             path,

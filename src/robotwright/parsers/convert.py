@@ -111,6 +111,7 @@ def _convert(
     from robotwright._confine import run_confined
     from robotwright.hrdf.compiles import require_compiles
     from robotwright.parsers.collision import pop_config
+    from robotwright.parsers.packages import source_read_roots
 
     options = dict(options)
     repairs = pop_config(options)  # opt-in collision-mesh repairs, after the parse
@@ -125,7 +126,7 @@ def _convert(
         options,
         repairs,
         proof,
-        roots=_source_roots(src_p, options),
+        roots=source_read_roots(src_p, file_kind(src_p, existing=True), options),
         writable=[work] if work else [],
         what=str(src_p),
     )
@@ -158,22 +159,6 @@ def _convert(
             ) from exc
     messages += [str(w.message) for w in caught]
     return messages
-
-
-def _source_roots(src_p: Path, options: dict[str, Any]) -> list[Path]:
-    """The folders the source may read (its folder, or a URDF's ROS package), and those
-    the options trust."""
-    from robotwright.parsers.packages import robot_root
-
-    kind = file_kind(src_p, existing=True)
-    if kind == "hrdf":
-        root = src_p.resolve()
-    elif kind == "mjcf":
-        root = src_p.resolve().parent
-    else:
-        root = robot_root(src_p)
-    trusted = [Path(p) for p in options.get("asset_roots") or ()]
-    return [root, *trusted, *(Path(p) for p in (options.get("package_map") or {}).values())]
 
 
 def _read_and_prove(

@@ -47,6 +47,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 from urllib.parse import unquote, urlparse
 
 from robotwright._assets import check_asset_file
@@ -195,21 +196,12 @@ def _in_python_installation(folder: Path) -> bool:
     """Whether ``folder`` is an installed Python package's: strictly inside a
     site-packages folder of this interpreter (where pip installs), never a shared
     folder itself."""
-    import site
-    import sysconfig
+    from robotwright._confine import site_package_folders
 
-    places = {sysconfig.get_paths().get(k) for k in ("purelib", "platlib")}
-    with contextlib.suppress(AttributeError):
-        places.update(site.getsitepackages())
-    with contextlib.suppress(AttributeError):
-        places.add(site.getusersitepackages())
-    for place in places:
-        if not place:
-            continue
-        base = Path(place).resolve()
-        if folder != base and folder.is_relative_to(base) and base not in _shared_folders():
-            return True
-    return False
+    return any(
+        folder != base and folder.is_relative_to(base) and base not in _shared_folders()
+        for base in site_package_folders()
+    )
 
 
 def robot_root(urdf_path: Path) -> Path:
@@ -228,6 +220,25 @@ def robot_root(urdf_path: Path) -> Path:
         if (ancestor / "package.xml").is_file():
             return ancestor
     return resolved.parent
+
+
+def source_read_roots(
+    path: str | os.PathLike[str], kind: str, options: Mapping[str, Any] | None = None
+) -> list[Path]:
+    """The folders a reader of the source ``path`` may read (the roots of its confined
+    reader, see :mod:`robotwright._confine`): first the source's own root (an HRDF
+    folder; an MJCF file's folder; a URDF or xacro file's :func:`robot_root`), then the
+    folders ``options`` trusts (``asset_roots``, ``package_map``)."""
+    path = Path(path)
+    if kind == "hrdf":
+        root = path.resolve()
+    elif kind == "mjcf":
+        root = path.resolve().parent
+    else:
+        root = robot_root(path)
+    options = options or {}
+    trusted = [*(options.get("asset_roots") or ()), *(options.get("package_map") or {}).values()]
+    return [root, *(Path(p) for p in trusted)]
 
 
 #: Folders searched for a URDF's ``package.xml``, its own first (ROS keeps robot files a

@@ -781,7 +781,7 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
     prove against). The parser has checked the file's paths already; MuJoCo reads the
     file in a confined reader (:mod:`robotwright._confine`)."""
     from robotwright._confine import run_confined
-    from robotwright.parsers.packages import robot_root
+    from robotwright.parsers.packages import source_read_roots
 
     # MuJoCo caches the meshes it decodes by file name, in the process that decodes
     # them: the output is read through the source's names only where the source was
@@ -795,12 +795,10 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
             if here:
                 _SOURCE_MESHES[id(model)] = _mesh_files(folder, meshdir, files)
             return model
-    root = Path(path).resolve().parent if kind == "mjcf" else robot_root(Path(path))
-    extra = [Path(p) for p in (options.get("package_map") or {}).values()]
-    extra += [Path(p) for p in options.get("asset_roots") or ()]
+    roots = source_read_roots(path, kind, options)
     try:
         compiled = run_confined(
-            _compile_source, Path(path), kind, options, roots=[root, *extra], what=str(path)
+            _compile_source, Path(path), kind, options, roots=roots, what=str(path)
         )
     except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
         return None

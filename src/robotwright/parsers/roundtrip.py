@@ -854,12 +854,11 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
     """The reference of ``path`` (see :func:`reference_view`), prepared to be loaded."""
     _check_reference(reference)
     from robotwright._confine import start_confined
-    from robotwright.parsers.packages import robot_root
+    from robotwright.parsers.packages import source_read_roots
 
-    trusted = [*(options.get("asset_roots") or ()), *(options.get("package_map") or {}).values()]
+    roots = source_read_roots(path, source_kind(path), options)
     if source_kind(path) == "mjcf":
         root = options.get("root_body")
-        roots = [Path(path).resolve().parent, *trusted]
 
         def start_mjcf() -> Callable[[], RobotView]:
             call = start_confined(_model_from_path, str(path), roots=roots, what=str(path))
@@ -889,7 +888,6 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
             raise
         return ReferenceLoader(functools.partial(fallback, exc))  # yourdfpy's from the start
     density = options.get("density")  # of links without <inertial>, as the parser's
-    roots = [robot_root(Path(path)), *trusted]
 
     def start_urdf() -> Callable[[], RobotView]:
         call = start_confined(compile_urdf, text, density, roots=roots, what=str(path))

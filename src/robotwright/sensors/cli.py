@@ -112,9 +112,10 @@ def load_scene(path: Path) -> mujoco.MjModel:
         UnsafePathError: a file it names leaves its folder or is not a regular file.
     """
     from robotwright._confine import run_confined
-    from robotwright._paths import trusted_roots
+    from robotwright.parsers.packages import source_read_roots
 
-    roots = [path.resolve().parent, *trusted_roots(())]
+    # The folders trusted with --asset-root are readable by every confined reader.
+    roots = source_read_roots(path, "mjcf")
     return run_confined(_load_scene_here, path, roots=roots, what=str(path))
 
 

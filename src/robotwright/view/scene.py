@@ -216,9 +216,9 @@ def _compile_mjcf(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjM
     entities, and every file it names (includes, meshes, textures) inside its folder or
     a trusted one; MuJoCo reads it in a confined reader (:mod:`robotwright._confine`)."""
     from robotwright._confine import run_confined
-    from robotwright._paths import trusted_roots
+    from robotwright.parsers.packages import source_read_roots
 
-    roots = [path.resolve().parent, *trusted_roots(asset_roots)]
+    roots = source_read_roots(path, "mjcf", {"asset_roots": asset_roots})
     return run_confined(_compile_mjcf_here, path, asset_roots, roots=roots, what=str(path))
 
 
