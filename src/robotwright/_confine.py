@@ -8,9 +8,10 @@ file that the checks did not foresee would be a way out. :func:`run_confined` ru
 reading step in a forked copy of this process that the kernel confines with Landlock
 (:mod:`robotwright._landlock`) before the step starts: it may read only
 
-- the roots the step is given (the robot's folder or ROS package),
-- the folders the user named (``--asset-root``, ``--package``, ``package_map``,
-  ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``),
+- the roots the step is given (the robot's folder or ROS package, and the packages
+  the user named: ``--package``, ``package_map``, ``ROS_PACKAGE_PATH``,
+  ``AMENT_PREFIX_PATH``; see :func:`robotwright.parsers.packages.source_read_roots`),
+- the folders the user trusted (``--asset-root``),
 - the Python installation and the shared libraries it loads,
 
 writes only into a staging folder of its own (and a work folder the caller names), and
@@ -177,16 +178,12 @@ def confinement() -> str:
 
 
 def _user_roots() -> list[Path]:
-    """The folders the user named for this run: trusted asset roots, given packages,
-    ROS_PACKAGE_PATH and AMENT_PREFIX_PATH entries."""
+    """The folders the user trusted for this run (``--asset-root``,
+    ``trusted_asset_roots``); the packages they named come with a source's roots
+    (:func:`robotwright.parsers.packages.source_read_roots`)."""
     from robotwright._paths import trusted_roots
-    from robotwright.parsers.packages import given_package_map
 
-    roots = [Path(p) for p in trusted_roots(())]
-    roots += [Path(p) for p in given_package_map().values()]
-    for variable in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"):
-        roots += [Path(p) for p in os.environ.get(variable, "").split(os.pathsep) if p]
-    return roots
+    return [Path(p) for p in trusted_roots(())]
 
 
 def site_package_folders() -> list[Path]:

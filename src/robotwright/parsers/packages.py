@@ -228,7 +228,8 @@ def source_read_roots(
     """The folders a reader of the source ``path`` may read (the roots of its confined
     reader, see :mod:`robotwright._confine`): first the source's own root (an HRDF
     folder; an MJCF file's folder; a URDF or xacro file's :func:`robot_root`), then the
-    folders ``options`` trusts (``asset_roots``, ``package_map``)."""
+    folders ``options`` trusts (``asset_roots``, ``package_map``) and the packages the
+    user named (:func:`given_packages`, ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``)."""
     path = Path(path)
     if kind == "hrdf":
         root = path.resolve()
@@ -237,7 +238,10 @@ def source_read_roots(
     else:
         root = robot_root(path)
     options = options or {}
-    trusted = [*(options.get("asset_roots") or ()), *(options.get("package_map") or {}).values()]
+    trusted = [*(options.get("asset_roots") or ())]
+    trusted += given_package_map(options.get("package_map")).values()
+    for variable in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"):
+        trusted += [p for p in os.environ.get(variable, "").split(os.pathsep) if p]
     return [root, *(Path(p) for p in trusted)]
 
 
