@@ -44,7 +44,10 @@ import isaaclab_scenes as scenes  # noqa: E402
 
 BASE = "{ENV_REGEX_NS}/Robot/base"
 IL_PATTERN = LidarPatternCfg(
-    channels=16, vertical_fov_range=(-35.0, 15.0), horizontal_fov_range=(-180.0, 180.0), horizontal_res=2.0
+    channels=16,
+    vertical_fov_range=(-35.0, 15.0),
+    horizontal_fov_range=(-180.0, 180.0),
+    horizontal_res=2.0,
 )
 
 
@@ -78,9 +81,13 @@ SENSORS = {
     "multi_mesh": MultiMeshRayCasterCfg(
         prim_path=BASE,
         mesh_prim_paths=[
-            MultiMeshRayCasterCfg.RaycastTargetCfg(prim_expr="/World/ground", track_mesh_transforms=False),
+            MultiMeshRayCasterCfg.RaycastTargetCfg(
+                prim_expr="/World/ground", track_mesh_transforms=False
+            ),
             MultiMeshRayCasterCfg.RaycastTargetCfg(prim_expr="{ENV_REGEX_NS}/cracker_box_0"),
-            MultiMeshRayCasterCfg.RaycastTargetCfg(prim_expr="/World/SM_Sofa_1", track_mesh_transforms=False),
+            MultiMeshRayCasterCfg.RaycastTargetCfg(
+                prim_expr="/World/SM_Sofa_1", track_mesh_transforms=False
+            ),
         ],
         pattern_cfg=IL_PATTERN,
         update_mesh_ids=True,
@@ -165,8 +172,12 @@ def _reference(sensor, seen: np.ndarray, classes: np.ndarray, max_distance: floa
         out_s = wp.empty(active.size, dtype=wp.int32, device=model.device)
         newton.intersect_ray(
             model,
-            ray_origins=wp.array(origin[active].astype(np.float32), dtype=wp.vec3, device=model.device),
-            ray_directions=wp.array(dirs[active].astype(np.float32), dtype=wp.vec3, device=model.device),
+            ray_origins=wp.array(
+                origin[active].astype(np.float32), dtype=wp.vec3, device=model.device
+            ),
+            ray_directions=wp.array(
+                dirs[active].astype(np.float32), dtype=wp.vec3, device=model.device
+            ),
             ray_worlds=wp.array(worlds[active], dtype=wp.int32, device=model.device),
             out_dist=out_d,
             out_shape_id=out_s,
@@ -272,7 +283,9 @@ def test_livox_window_advances_with_each_environments_simulated_time(world):
     table = torch.as_tensor(pattern.ray_table().directions, dtype=torch.float32)
     n = sensor.num_rays
     for env, frame in enumerate(frames):
-        torch.testing.assert_close(local[env], table[frame * n : (frame + 1) * n], atol=1e-6, rtol=0)
+        torch.testing.assert_close(
+            local[env], table[frame * n : (frame + 1) * n], atol=1e-6, rtol=0
+        )
 
 
 def test_own_robot_has_its_class_or_is_see_through(world):
@@ -318,7 +331,10 @@ def test_getters_follow_isaac_lab_conventions_and_the_seed(world):
     # Every hit point lies at its distance along its ray.
     starts, dirs = sensor.ray_starts_w.torch, sensor.ray_directions_w.torch
     torch.testing.assert_close(
-        cloud[hit], (starts + dirs * sensor.data.ray_distances.torch[..., None])[hit], atol=1e-4, rtol=0
+        cloud[hit],
+        (starts + dirs * sensor.data.ray_distances.torch[..., None])[hit],
+        atol=1e-4,
+        rtol=0,
     )
     ids = sensor.get_mesh_ids()
     for shape_id in torch.unique(ids[hit]).tolist():
@@ -333,7 +349,12 @@ def test_getters_follow_isaac_lab_conventions_and_the_seed(world):
 def test_parent_internals_the_sensor_relies_on_are_still_there(world):
     """Isaac Lab's private parts that robotwright's sensor uses (see sensor.py)."""
     _, scene = world
-    for name in ("_launch_raycast", "_update_ray_infos", "_initialize_rays_impl", "_initialize_impl"):
+    for name in (
+        "_launch_raycast",
+        "_update_ray_infos",
+        "_initialize_rays_impl",
+        "_initialize_impl",
+    ):
         assert callable(getattr(NewtonRaycastSensor, name))
     sensor = scene["seed"]
     e, n = sensor.num_instances, sensor.num_rays
@@ -370,3 +391,54 @@ def test_plain_lidar_config_has_no_classes():
     cfg = LidarCfg(prim_path=BASE)
     assert cfg.validate() == []
     assert cfg.class_type.__name__ == "LidarSensor" or str(cfg.class_type).endswith("LidarSensor")
+
+
+def test_observation_terms_in_isaac_lab_style(world):
+    from types import SimpleNamespace
+
+    from isaaclab.managers import SceneEntityCfg
+
+    from robotwright.sensors.isaaclab.observations import (
+        lidar_distances_normalized,
+        lidar_point_cloud,
+        lidar_range_image,
+        lidar_semantic_obs,
+    )
+
+    sim, scene = world
+    _step(sim, scene, 2)
+    env = SimpleNamespace(scene=scene)
+    cfg = SceneEntityCfg("seed")
+    sensor = scene["seed"]
+    e, n, c = scene.num_envs, sensor.num_rays, len(sensor.class_names)
+    obs = lidar_semantic_obs(env, cfg).view(e, n, 2)
+    torch.testing.assert_close(obs[..., 0], sensor.get_distances())
+    torch.testing.assert_close(obs[..., 1], sensor.get_semantic_labels().float())
+    assert torch.isfinite(obs).all()
+    norm = lidar_distances_normalized(env, cfg)
+    assert float(norm.max()) <= 1.0 + 1e-6
+    image = lidar_range_image(env, cfg, width=64, height=16)
+    assert image.shape == (e, 1 + c, 16, 64)
+    assert float(image[:, 0].min()) >= 0.0 and float(image[:, 0].max()) <= 1.0
+    assert float(image[:, 1:].sum(dim=1).max()) <= 1.0 + 1e-5
+    # The nearest hit of the whole scan is the darkest cell of the image.
+    hit = sensor.get_hit_mask()
+    nearest = torch.where(hit, sensor.data.ray_distances.torch, torch.inf).min(dim=1).values
+    torch.testing.assert_close(image[:, 0].flatten(1).min(dim=1).values, nearest / 40.0)
+    assert lidar_range_image(env, cfg, width=8, height=4, flatten=True).shape == (e, (1 + c) * 32)
+    cloud = lidar_point_cloud(env, cfg, max_points=256, frame="sensor")
+    assert cloud.shape == (e, 256, 3 + c)
+    used = cloud[..., 3:].sum(-1) > 0
+    counts = hit.sum(dim=1).clamp(max=256)
+    assert torch.equal(used.sum(dim=1), counts)
+    # Rays start at the sensor: a point's norm in the sensor frame is its ray's distance.
+    dist = sensor.data.ray_distances.torch[hit]
+    radii = cloud[..., :3][used].norm(dim=-1)
+    assert float(radii.min()) >= float(dist.min()) - 1e-3
+    assert float(radii.max()) <= float(dist.max()) + 1e-3
+    world_cloud = lidar_point_cloud(env, cfg, max_points=256, frame="world")
+    assert torch.isfinite(world_cloud).all()
+    with pytest.raises(SensorError, match="max_points"):
+        lidar_point_cloud(env, cfg, max_points=0)
+    with pytest.raises(SensorError, match="not a robotwright"):
+        lidar_semantic_obs(env, SceneEntityCfg("multi_mesh"))

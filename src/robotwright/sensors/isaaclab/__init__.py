@@ -18,7 +18,12 @@ This package imports Isaac Lab; ``robotwright.sensors`` never imports it.
 
 from __future__ import annotations
 
-from robotwright.sensors.isaaclab.config import LidarCfg, ResolvedLidarCfg, SemanticLidarCfg, resolve
+from robotwright.sensors.isaaclab.config import (
+    LidarCfg,
+    ResolvedLidarCfg,
+    SemanticLidarCfg,
+    resolve,
+)
 from robotwright.sensors.isaaclab.sensor import (
     LidarSensor,
     LidarSensorData,

@@ -111,9 +111,7 @@ class SemanticLidarCfg(LidarCfg):
             on a miss).
     """
 
-    class_type: type[SemanticLidarSensor] | str = (
-        "{DIR}.sensor:SemanticLidarSensor"
-    )
+    class_type: type[SemanticLidarSensor] | str = "{DIR}.sensor:SemanticLidarSensor"
     semantic_class_mapping: dict[str, list[str]] | None = None
     terrain_class: str | None = "terrain"
     self_class: str | None = "robot"
@@ -211,7 +209,11 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
     if not _number(miss) or not math.isfinite(miss):
         raise SensorError(f"{name}.miss_distance: expected None or a finite number [m]")
     passes = cfg.max_pass_through
-    if not isinstance(passes, int) or isinstance(passes, bool) or not 0 <= passes <= MAX_PASS_THROUGH:
+    if (
+        not isinstance(passes, int)
+        or isinstance(passes, bool)
+        or not 0 <= passes <= MAX_PASS_THROUGH
+    ):
         raise SensorError(
             f"{name}.max_pass_through: expected an integer in [0, {MAX_PASS_THROUGH}], got {passes!r}"
         )
@@ -223,7 +225,11 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
     for flag in ("return_semantic_labels", "return_mesh_ids"):
         if not isinstance(getattr(cfg, flag), bool):
             raise SensorError(f"{name}.{flag}: expected True or False")
-    raw = DEFAULT_SEMANTIC_CLASS_MAPPING if cfg.semantic_class_mapping is None else cfg.semantic_class_mapping
+    raw = (
+        DEFAULT_SEMANTIC_CLASS_MAPPING
+        if cfg.semantic_class_mapping is None
+        else cfg.semantic_class_mapping
+    )
     check_class_mapping(raw, f"{name}.semantic_class_mapping")
     mapping = {k: list(v) for k, v in raw.items()}
     names: tuple[str, ...] = (UNKNOWN_CLASS, *mapping)

@@ -94,9 +94,7 @@ def _recover_labels(
     unlabelled = np.array(
         [not lb.startswith("/") and w == -1 for lb, w in zip(labels, shape_world)], dtype=bool
     )
-    hfields = [
-        s for s in np.flatnonzero(unlabelled) if shape_type[s] == int(newton.GeoType.HFIELD)
-    ]
+    hfields = [s for s in np.flatnonzero(unlabelled) if shape_type[s] == int(newton.GeoType.HFIELD)]
     if hfields and len(hfields) == len(found):
         for s, path in zip(hfields, found):
             out[s] = path

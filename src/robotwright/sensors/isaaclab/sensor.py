@@ -38,8 +38,14 @@ from isaaclab.utils.warp import ProxyArray
 from isaaclab_newton.sensors import NewtonRaycastSensor, NewtonRaycastSensorData
 
 from robotwright.errors import SensorError
+from robotwright.sensors import learning_obs
 from robotwright.sensors.isaaclab import _kernels as k
-from robotwright.sensors.isaaclab.config import LidarCfg, ResolvedLidarCfg, SemanticLidarCfg, resolve
+from robotwright.sensors.isaaclab.config import (
+    LidarCfg,
+    ResolvedLidarCfg,
+    SemanticLidarCfg,
+    resolve,
+)
 from robotwright.sensors.isaaclab.scene_shapes import SceneShapes, scene_shapes
 from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
 from robotwright.sensors.semantic import classify_path
@@ -228,8 +234,12 @@ class LidarSensor(NewtonRaycastSensor):
         self._table_starts = wp.array(carrier_starts.astype(np.float32), dtype=wp.vec3f, device=dev)
         self._table_dirs = wp.array(carrier_dirs.astype(np.float32), dtype=wp.vec3f, device=dev)
         self._table_local = wp.array(dirs.astype(np.float32), dtype=wp.vec3f, device=dev)
+        self._bounds = learning_obs.direction_bounds(torch.as_tensor(dirs))
         first = np.broadcast_to(dirs[:n].astype(np.float32), (self._view_count, n, 3))
-        wp.copy(self._data._local_dirs, wp.array(np.ascontiguousarray(first), dtype=wp.vec3f, device=dev))
+        wp.copy(
+            self._data._local_dirs,
+            wp.array(np.ascontiguousarray(first), dtype=wp.vec3f, device=dev),
+        )
 
     def _initialize_lidar(self) -> None:
         model = self.backend.model
@@ -241,8 +251,12 @@ class LidarSensor(NewtonRaycastSensor):
         )
         e, n = self._view_count, self.num_rays
         count = e * n
-        self._shape_visible = wp.array(self.shapes.visible.astype(np.int32), dtype=wp.int32, device=dev)
-        self._shape_class = wp.array(self.shapes.classes.astype(np.int32), dtype=wp.int32, device=dev)
+        self._shape_visible = wp.array(
+            self.shapes.visible.astype(np.int32), dtype=wp.int32, device=dev
+        )
+        self._shape_class = wp.array(
+            self.shapes.classes.astype(np.int32), dtype=wp.int32, device=dev
+        )
         self._hit_shape = wp.empty(count, dtype=wp.int32, device=dev)
         self._total = wp.empty(count, dtype=wp.float32, device=dev)
         self._final_shape = wp.empty(count, dtype=wp.int32, device=dev)
@@ -290,7 +304,12 @@ class LidarSensor(NewtonRaycastSensor):
                     self._table_dirs,
                     self._table_local,
                 ],
-                outputs=[self.ray_starts.warp, self.ray_directions.warp, data._local_dirs, data._frame],
+                outputs=[
+                    self.ray_starts.warp,
+                    self.ray_directions.warp,
+                    data._local_dirs,
+                    data._frame,
+                ],
                 device=dev,
             )
         self._update_ray_infos(self._is_outdated)
@@ -406,6 +425,11 @@ class LidarSensor(NewtonRaycastSensor):
             ],
             device=dev,
         )
+
+    def direction_bounds(self) -> tuple[float, float, float, float, bool]:
+        """Azimuth and elevation bounds [rad] of every ray of the pattern (all windows),
+        in the sensor frame, as :func:`~robotwright.sensors.learning_obs.direction_bounds`."""
+        return self._bounds
 
     # -- the seed's getters -----------------------------------------------------------
     def get_distances(self, env_ids: EnvIds = None) -> torch.Tensor:

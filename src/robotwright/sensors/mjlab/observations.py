@@ -16,12 +16,12 @@ Which to use:
 
 from __future__ import annotations
 
-import math
 from typing import Any, Literal
 
 import torch
 
 from robotwright.errors import SensorError
+from robotwright.sensors import learning_obs
 from robotwright.sensors.mjlab.sensor import MjlabSemanticLidarSensor
 
 __all__ = [
@@ -60,9 +60,8 @@ def lidar_class_ids(env: Any, sensor_name: str) -> torch.Tensor:
 def lidar_one_hot_classes(env: Any, sensor_name: str) -> torch.Tensor:
     """``(E, N * C)`` one-hot classes, ray-major, class 0 included. Fixed patterns only."""
     s = _sensor(env, sensor_name)
-    labels = s.data.semantic_labels.long()
-    one_hot = torch.nn.functional.one_hot(labels, num_classes=len(s.class_names))
-    return one_hot.float().reshape(labels.shape[0], -1)
+    labels = s.data.semantic_labels
+    return learning_obs.one_hot_classes(labels, len(s.class_names)).reshape(labels.shape[0], -1)
 
 
 def lidar_semantic_obs(env: Any, sensor_name: str) -> torch.Tensor:
@@ -78,14 +77,7 @@ def lidar_semantic_obs(env: Any, sensor_name: str) -> torch.Tensor:
     Misses read ``miss_distance`` (default ``max_distance``).
     """
     s = _sensor(env, sensor_name)
-    distances = s.get_distances()
-    semantic_labels = s.get_semantic_labels()
-    obs = torch.stack([distances, semantic_labels.float()], dim=-1)
-    return obs.reshape(distances.shape[0], -1)
-
-
-def _one_hot(labels: torch.Tensor, classes: int) -> torch.Tensor:
-    return torch.nn.functional.one_hot(labels.long().clamp(0, classes - 1), classes).float()
+    return learning_obs.semantic_obs(s.get_distances(), s.get_semantic_labels())
 
 
 def lidar_point_cloud(
@@ -108,35 +100,23 @@ def lidar_point_cloud(
     (3 GiB of PPO rollout at 24 steps); flattened into an MLP it is as hard to learn as
     per-ray terms (slot ``j`` is not a direction), so pair it with an encoder.
     """
-    if not isinstance(max_points, int) or isinstance(max_points, bool) or max_points < 1:
-        raise SensorError(
-            f"lidar_point_cloud: max_points must be an integer >= 1, got {max_points!r}"
-        )
-    if frame not in ("sensor", "base", "world"):
-        raise SensorError(
-            f"lidar_point_cloud: frame must be 'sensor', 'base' or 'world', got {frame!r}"
-        )
+    learning_obs.check_point_cloud_args(max_points, frame, ("sensor", "base", "world"))
     s = _sensor(env, sensor_name)
     data = s.data
-    hit = data.hit_mask
-    e, n = hit.shape
-    dev = hit.device
-    count = hit.sum(dim=1, keepdim=True)  # (E, 1)
-    slots = torch.arange(max_points, device=dev).expand(e, max_points)
-    rank = torch.where(count > max_points, (slots * count) // max_points, slots)
-    valid = slots < count
-    cumsum = hit.to(torch.int64).cumsum(dim=1)  # (E, N): hits up to and including i
-    idx = torch.searchsorted(cumsum, (rank + 1).contiguous()).clamp(max=n - 1)
-    points = torch.gather(data.hit_pos_w, 1, idx[..., None].expand(e, max_points, 3))
+    origin = rot = None
     if frame == "sensor":
         origin, rot = data.sensor_pos_w, s._sensor_mat
     elif frame == "base":
         origin, rot = data.pos_w, s._frame_mat
-    if frame != "world":
-        points = torch.einsum("eji,epj->epi", rot, points - origin[:, None])
-    labels = torch.gather(data.semantic_labels, 1, idx)
-    out = torch.cat([points, _one_hot(labels, len(s.class_names))], dim=-1)
-    return out * valid[..., None]
+    return learning_obs.point_cloud(
+        data.hit_mask,
+        data.hit_pos_w,
+        data.semantic_labels,
+        len(s.class_names),
+        max_points,
+        origin,
+        rot,
+    )
 
 
 def _image_bounds(s: MjlabSemanticLidarSensor) -> tuple[float, float, float, float, bool]:
@@ -144,19 +124,7 @@ def _image_bounds(s: MjlabSemanticLidarSensor) -> tuple[float, float, float, flo
     ray frame; a pattern spanning nearly the full circle wraps around at +-pi."""
     key = "range_image_bounds"
     if key not in s._obs_cache:
-        d = torch.as_tensor(s.table.directions)
-        az = torch.atan2(d[:, 1], d[:, 0])
-        el = torch.atan2(d[:, 2], torch.hypot(d[:, 0], d[:, 1]))
-        az0, az1 = float(az.min()), float(az.max())
-        full = az1 - az0 > 2 * math.pi * 0.95
-        if full:
-            az0, az1 = -math.pi, math.pi
-        el0, el1 = float(el.min()), float(el.max())
-        if el1 - el0 < 1e-6:  # one elevation: a one-row band around it
-            el0, el1 = el0 - 1e-3, el1 + 1e-3
-        if az1 - az0 < 1e-6:
-            az0, az1 = az0 - 1e-3, az1 + 1e-3
-        s._obs_cache[key] = (az0, az1, el0, el1, full)
+        s._obs_cache[key] = learning_obs.direction_bounds(torch.as_tensor(s.table.directions))
     return s._obs_cache[key]
 
 
@@ -179,35 +147,22 @@ def lidar_range_image(
     ``flatten=True`` returns it as ``(E, (1 + C) * height * width)`` (channel-major), the
     form an MLP actor (rsl_rl's) and mjlab's term concatenation take.
     """
-    for what, v in (("width", width), ("height", height)):
-        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 4096:
-            raise SensorError(
-                f"lidar_range_image: {what} must be an integer in [1, 4096], got {v!r}"
-            )
+    learning_obs.check_image_size(width, height)
     s = _sensor(env, sensor_name)
     data = s.data
-    e, n = data.hit_mask.shape
-    classes = len(s.class_names)
-    az0, az1, el0, el1, _ = _image_bounds(s)
     # The rays in the ray frame: R^T d (R = this step's ray rotation).
     local = torch.einsum("eji,enj->eni", s._ray_rot, data.ray_directions_w)
-    az = torch.atan2(local[..., 1], local[..., 0])
-    el = torch.atan2(local[..., 2], torch.hypot(local[..., 0], local[..., 1]))
-    col = ((az - az0) / (az1 - az0) * width).floor().long().clamp(0, width - 1)
-    row = ((el1 - el) / (el1 - el0) * height).floor().long().clamp(0, height - 1)
-    cell = row * width + col  # (E, N)
-    cells = height * width
-    hit = data.hit_mask
-    scaled = torch.where(hit, data.distances / float(s.cfg.max_distance), 1.0).clamp(0.0, 1.0)
-    depth = torch.ones(e, cells, device=hit.device)
-    depth.scatter_reduce_(1, cell, scaled, reduce="amin", include_self=True)
-    rays = torch.zeros(e, cells, device=hit.device)
-    rays.scatter_add_(1, cell, torch.ones_like(scaled))
-    per_class = torch.zeros(e, classes * cells, device=hit.device)
-    slot = data.semantic_labels.long().clamp(0, classes - 1) * cells + cell
-    per_class.scatter_add_(1, slot, hit.float())
-    occupancy = per_class.view(e, classes, cells) / rays.clamp(min=1.0)[:, None]
-    out = torch.cat([depth[:, None], occupancy], dim=1)
+    out = learning_obs.range_image(
+        local,
+        data.hit_mask,
+        data.distances,
+        float(s.cfg.max_distance),
+        data.semantic_labels,
+        len(s.class_names),
+        _image_bounds(s),
+        width,
+        height,
+    )
     if flatten:
-        return out.reshape(e, -1)
-    return out.view(e, 1 + classes, height, width)
+        return out.reshape(out.shape[0], -1)
+    return out

@@ -1,0 +1,153 @@
+"""Observations a policy can learn from a LiDAR, as torch functions of the scan.
+
+Framework-free (torch only): the mjlab and Isaac Lab observation terms
+(:mod:`robotwright.sensors.mjlab.observations`,
+:mod:`robotwright.sensors.isaaclab.observations`) gather the tensors from their sensor and
+call these. Shapes use ``E`` environments, ``N`` rays and ``C`` classes (class 0,
+"unknown", included).
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+
+from robotwright.errors import SensorError
+
+__all__ = [
+    "check_image_size",
+    "check_point_cloud_args",
+    "direction_bounds",
+    "one_hot_classes",
+    "point_cloud",
+    "range_image",
+    "semantic_obs",
+]
+
+
+def semantic_obs(distances: torch.Tensor, labels: torch.Tensor) -> torch.Tensor:
+    """The seed's stacked observation ``(E, 2 N)``: per ray (distance [m], class id)."""
+    obs = torch.stack([distances, labels.float()], dim=-1)
+    return obs.reshape(distances.shape[0], -1)
+
+
+def one_hot_classes(labels: torch.Tensor, classes: int) -> torch.Tensor:
+    """``(..., C)`` one-hot of class ids (ids outside ``[0, C)`` clamped)."""
+    return torch.nn.functional.one_hot(labels.long().clamp(0, classes - 1), classes).float()
+
+
+def check_point_cloud_args(max_points: object, frame: object, frames: tuple[str, ...]) -> None:
+    """Refuse a bad ``max_points`` or ``frame`` of a point-cloud term, naming it."""
+    if not isinstance(max_points, int) or isinstance(max_points, bool) or max_points < 1:
+        raise SensorError(
+            f"lidar_point_cloud: max_points must be an integer >= 1, got {max_points!r}"
+        )
+    if frame not in frames:
+        raise SensorError(
+            f"lidar_point_cloud: frame must be one of {', '.join(map(repr, frames))}, got {frame!r}"
+        )
+
+
+def point_cloud(
+    hit: torch.Tensor,
+    points: torch.Tensor,
+    labels: torch.Tensor,
+    classes: int,
+    max_points: int,
+    origin: torch.Tensor | None = None,
+    rot: torch.Tensor | None = None,
+) -> torch.Tensor:
+    """``(E, max_points, 3 + C)`` an even, deterministic sample of the hit points.
+
+    Per env the hits (ray order) are sampled evenly: all of them when there are at most
+    ``max_points``, else hit ``floor(j * hits / max_points)`` for slot ``j``. Columns
+    0..2: the point [m], in the frame whose world position is ``origin`` ``(E, 3)`` and
+    rotation ``rot`` ``(E, 3, 3)`` (both ``None``: the world frame); columns 3..: the
+    one-hot class. Slots past the hits are zero (the padding mask: their one-hot sums
+    to 0). ``points`` may hold anything (``inf``, NaN) where ``hit`` is False.
+    """
+    e, n = hit.shape
+    dev = hit.device
+    count = hit.sum(dim=1, keepdim=True)
+    slots = torch.arange(max_points, device=dev).expand(e, max_points)
+    rank = torch.where(count > max_points, (slots * count) // max_points, slots)
+    valid = slots < count
+    cumsum = hit.to(torch.int64).cumsum(dim=1)  # hits up to and including ray i
+    idx = torch.searchsorted(cumsum, (rank + 1).contiguous()).clamp(max=n - 1)
+    chosen = torch.gather(points, 1, idx[..., None].expand(e, max_points, 3))
+    chosen = torch.where(valid[..., None], chosen, torch.zeros((), device=dev))
+    if rot is not None and origin is not None:
+        chosen = torch.einsum("eji,epj->epi", rot, chosen - origin[:, None])
+    out = torch.cat([chosen, one_hot_classes(torch.gather(labels, 1, idx), classes)], dim=-1)
+    return out * valid[..., None]
+
+
+def direction_bounds(directions: torch.Tensor) -> tuple[float, float, float, float, bool]:
+    """Azimuth and elevation bounds [rad] of a set of ray directions ``(M, 3)``; a set
+    spanning nearly the full circle wraps at +-pi (the last value says so)."""
+    d = directions.double()
+    az = torch.atan2(d[:, 1], d[:, 0])
+    el = torch.atan2(d[:, 2], torch.hypot(d[:, 0], d[:, 1]))
+    az0, az1 = float(az.min()), float(az.max())
+    full = az1 - az0 > 2 * math.pi * 0.95
+    if full:
+        az0, az1 = -math.pi, math.pi
+    el0, el1 = float(el.min()), float(el.max())
+    if el1 - el0 < 1e-6:  # one elevation: a one-row band around it
+        el0, el1 = el0 - 1e-3, el1 + 1e-3
+    if az1 - az0 < 1e-6:
+        az0, az1 = az0 - 1e-3, az1 + 1e-3
+    return az0, az1, el0, el1, full
+
+
+def check_image_size(width: object, height: object) -> None:
+    """Refuse a range-image width or height outside [1, 4096], naming it."""
+    for what, v in (("width", width), ("height", height)):
+        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 4096:
+            raise SensorError(
+                f"lidar_range_image: {what} must be an integer in [1, 4096], got {v!r}"
+            )
+
+
+def range_image(
+    local_dirs: torch.Tensor,
+    hit: torch.Tensor,
+    distances: torch.Tensor,
+    max_distance: float,
+    labels: torch.Tensor,
+    classes: int,
+    bounds: tuple[float, float, float, float, bool],
+    width: int,
+    height: int,
+) -> torch.Tensor:
+    """``(E, 1 + C, height, width)`` nearest distance and class occupancy per direction cell.
+
+    Each ray falls in the cell of its azimuth (columns, left to right from the smallest
+    azimuth of ``bounds``) and elevation (rows, top = highest), from ``local_dirs``
+    ``(E, N, 3)`` in the sensor's ray frame. Channel 0: the nearest hit in the cell /
+    ``max_distance``, 1 where the cell has no hit this step, also a cell no ray of
+    this step fell in (so "no return" and "not scanned" read alike, as a real range
+    image with no return does); channels 1..C: the fraction of the cell's rays this
+    step that hit each class, 0 in a cell no ray fell in. ``distances`` may hold
+    anything where ``hit`` is False.
+    """
+    e = hit.shape[0]
+    az0, az1, el0, el1, _ = bounds
+    az = torch.atan2(local_dirs[..., 1], local_dirs[..., 0])
+    el = torch.atan2(local_dirs[..., 2], torch.hypot(local_dirs[..., 0], local_dirs[..., 1]))
+    col = ((az - az0) / (az1 - az0) * width).floor().long().clamp(0, width - 1)
+    row = ((el1 - el) / (el1 - el0) * height).floor().long().clamp(0, height - 1)
+    cell = row * width + col
+    cells = height * width
+    dev = hit.device
+    scaled = torch.where(hit, distances / float(max_distance), 1.0).clamp(0.0, 1.0)
+    depth = torch.ones(e, cells, device=dev)
+    depth.scatter_reduce_(1, cell, scaled, reduce="amin", include_self=True)
+    rays = torch.zeros(e, cells, device=dev)
+    rays.scatter_add_(1, cell, torch.ones_like(scaled))
+    per_class = torch.zeros(e, classes * cells, device=dev)
+    slot = labels.long().clamp(0, classes - 1) * cells + cell
+    per_class.scatter_add_(1, slot, hit.float())
+    occupancy = per_class.view(e, classes, cells) / rays.clamp(min=1.0)[:, None]
+    return torch.cat([depth[:, None], occupancy], dim=1).view(e, 1 + classes, height, width)
