@@ -39,7 +39,10 @@ def scene_cfg(num_envs: int):
     from robotwright.sensors.isaaclab import LidarCfg, LivoxPatternCfg, SemanticLidarCfg
 
     pattern = LidarPatternCfg(
-        channels=16, vertical_fov_range=(-30.0, 10.0), horizontal_fov_range=(-180.0, 180.0), horizontal_res=1.0
+        channels=16,
+        vertical_fov_range=(-30.0, 10.0),
+        horizontal_fov_range=(-180.0, 180.0),
+        horizontal_res=1.0,
     )
     above = NewtonRaycastSensorCfg.OffsetCfg(pos=(0.0, 0.0, 0.2))  # outside the carrier
     common = dict(prim_path="{ENV_REGEX_NS}/Carrier", max_distance=20.0)
@@ -67,7 +70,9 @@ def scene_cfg(num_envs: int):
                 num_rows=1,
                 num_cols=1,
                 use_cache=False,
-                sub_terrains={"w": terrain_gen.HfWaveTerrainCfg(amplitude_range=(0.05, 0.05), num_waves=2)},
+                sub_terrains={
+                    "w": terrain_gen.HfWaveTerrainCfg(amplitude_range=(0.05, 0.05), num_waves=2)
+                },
             ),
         )
         carrier = cube("{ENV_REGEX_NS}/Carrier", (0.4, 0.3, 0.1), (0.0, 0.0, 0.6))
@@ -99,7 +104,9 @@ def bench(num_envs: int, device: str, rounds: int) -> None:
     from isaaclab_newton.physics import MJWarpSolverCfg, NewtonCfg
 
     cfg = sim_utils.SimulationCfg(
-        dt=0.01, device=device, physics=NewtonCfg(solver_cfg=MJWarpSolverCfg(), use_cuda_graph=False)
+        dt=0.01,
+        device=device,
+        physics=NewtonCfg(solver_cfg=MJWarpSolverCfg(), use_cuda_graph=False),
     )
     with sim_utils.build_simulation_context(sim_cfg=cfg) as sim:
         sim._app_control_on_stop_handle = None
