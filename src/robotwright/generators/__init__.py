@@ -20,6 +20,8 @@ if TYPE_CHECKING:
     from robotwright.generators.tasks import compose_scene, export_robot
     from robotwright.generators.urdf import URDFHumanoidGenerator
     from robotwright.generators.urdf_base import URDFGeneratorBase
+    from robotwright.generators.usd import UsdExport, to_usd
+    from robotwright.generators.usd_proof import UsdProof, prove_usd
 
 __all__ = [
     "DEFAULT_SCENE",
@@ -33,8 +35,12 @@ __all__ = [
     "URDFGeneratorBase",
     "URDFGeneratorComposite",
     "URDFHumanoidGenerator",
+    "UsdExport",
+    "UsdProof",
     "compose_scene",
     "export_robot",
+    "prove_usd",
+    "to_usd",
 ]
 
 attach(__name__, __file__)

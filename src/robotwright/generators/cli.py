@@ -11,17 +11,26 @@ from robotwright.errors import GeneratorError
 from robotwright.generators.placement import Placement
 
 _FORMAT_HELP = "mjcf or urdf (default: from the -o file name: .urdf is URDF, .xml or .mjcf is MJCF)"
+_EXPORT_FORMAT_HELP = (
+    "mjcf, urdf or usd (default: from the -o file name: .urdf is URDF, .xml or .mjcf is "
+    "MJCF, .usd, .usda or .usdc is OpenUSD for Isaac Lab and Newton)"
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "export",
-        help="write a robot as MJCF or URDF",
-        description="Write a robot (bundled name or HRDF folder) as MJCF or URDF. Mesh "
-        "paths are written relative to the output file, so it loads as is.",
+        help="write a robot as MJCF, URDF or USD",
+        description="Write a robot (bundled name or HRDF folder) as MJCF, URDF or OpenUSD. "
+        "Mesh paths are written relative to the output file, so it loads as is. USD (for "
+        "Isaac Lab and Newton) goes through mujoco-usd-converter with joint drives and "
+        "velocity limits added, and is read back by Newton and compared with the robot "
+        "(Isaac Lab's environment, Python 3.12).",
     )
     p.add_argument("robot", help="bundled robot name (arm6, mini_humanoid) or HRDF folder")
-    p.add_argument("--format", choices=("mjcf", "urdf"), default=None, help=_FORMAT_HELP)
+    p.add_argument(
+        "--format", choices=("mjcf", "urdf", "usd"), default=None, help=_EXPORT_FORMAT_HELP
+    )
     p.add_argument(
         "--prefix",
         default=None,
@@ -40,7 +49,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--strict", action="store_true", help="fail instead of writing when a value is lost"
     )
-    p.add_argument("-o", "--output", required=True, help="output file (.xml, .mjcf or .urdf)")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="output file (.xml, .mjcf, .urdf, .usd, .usda or .usdc)",
+    )
     add_overwrite_flag(p)
     p.set_defaults(func=_export)
 
@@ -74,7 +88,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 #: File name endings accepted per output format (URDF is often saved as .xml too).
-_EXTENSIONS = {"mjcf": (".xml", ".mjcf"), "urdf": (".urdf", ".xml")}
+_EXTENSIONS = {
+    "mjcf": (".xml", ".mjcf"),
+    "urdf": (".urdf", ".xml"),
+    "usd": (".usd", ".usda", ".usdc"),
+}
 
 
 def output_format(output: str, fmt: str | None) -> str:
@@ -86,6 +104,8 @@ def output_format(output: str, fmt: str | None) -> str:
             return "urdf"
         if suffix in (".xml", ".mjcf"):
             return "mjcf"
+        if suffix in _EXTENSIONS["usd"]:
+            return "usd"
         raise GeneratorError(
             f"{output}: cannot tell the format from '{suffix or '(no extension)'}': "
             "expected a file name ending in .xml or .mjcf (MJCF) or .urdf (URDF), or --format"
@@ -112,6 +132,18 @@ def _export(args: argparse.Namespace) -> int:
     require_compiles(hrdf, f"cannot write {out}")
     if args.format == "urdf":
         _prove_urdf(hrdf, out, args.strict)
+    if args.format == "usd":
+        from robotwright.generators.usd import to_usd
+
+        done = to_usd(hrdf, out, overwrite=args.overwrite, strict=args.strict)
+        proof = done.proof
+        print(
+            f"wrote {out} (usd, robot '{hrdf.name}', root {done.root}, {len(done.drives)} "
+            f"drives); proof: {proof.bodies} bodies, {proof.joints} joints, {proof.drives} "
+            f"drives, {proof.poses} poses compared (largest body offset "
+            f"{proof.max_pose_error:.2g} m), {len(proof.differences)} difference(s)"
+        )
+        return 0
     if args.format == "mjcf":
         MJCFHumanoidGenerator.from_hrdf(hrdf).export(
             out,
@@ -172,6 +204,11 @@ def _compose(args: argparse.Namespace) -> int:
     from robotwright.generators.tasks import compose_scene, load_robot
 
     args.format = output_format(args.output, args.format)
+    if args.format == "usd":
+        raise GeneratorError(
+            f"{args.output}: compose writes MJCF or URDF; export one robot to USD with "
+            "`robotwright export ROBOT -o robot.usd`"
+        )
     check_overwrite(args.output, args.overwrite)
     robots: list[tuple[str, object]] = []
     placements: dict[str, Placement] = {}

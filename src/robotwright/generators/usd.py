@@ -1,0 +1,224 @@
+"""HRDF -> OpenUSD for Isaac Lab and Newton, on the maintained converter.
+
+The robot goes out as our MJCF (robot only: no floor, light or sky), which
+``mujoco-usd-converter`` (the library behind Isaac Lab 3's kit-less MJCF importer) turns
+into USD; then usd-core's API authors what the converter leaves out:
+
+* joint drives (``UsdPhysics.DriveAPI``, ``angular`` or ``linear``) from the HRDF
+  actuators: stiffness from ``p_gain`` and damping from ``d_gain`` (USD's angular drive
+  units are per degree: N m/deg, N m s/deg), max force from ``peak_torque`` (else the
+  force range);
+* the velocity limit MJCF cannot hold, ``peak_velocity``, as Newton's
+  ``newton:velocityLimit`` (deg/s or m/s) and PhysX's ``physxJoint:maxJointVelocity``
+  (deg/s);
+* the robot's name: the articulation's root prim is named after the robot.
+
+The written file is one flattened layer (``.usd``, ``.usda`` or ``.usdc``): meshes are
+in it, nothing refers back to the temporary conversion folder.
+
+Needs the converter (Python 3.12, Isaac Lab's environment: ``pip install
+"isaacsim-asset-isolated==6.2.0.0" "tinyobjloader==2.0.0rc13"``, which brings
+mujoco-usd-converter 0.6.1 beside MuJoCo 3.12).
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from robotwright.errors import GeneratorError
+from robotwright.hrdf.model import HRDF
+
+__all__ = ["USD_SUFFIXES", "UsdExport", "to_usd"]
+
+USD_SUFFIXES = (".usd", ".usda", ".usdc")
+_MISSING = (
+    "USD export needs mujoco-usd-converter and usd-core (Isaac Lab's environment, Python "
+    '3.12: pip install "isaacsim-asset-isolated==6.2.0.0" "tinyobjloader==2.0.0rc13"); '
+    "not importable here: {error}"
+)
+
+
+@dataclass
+class UsdExport:
+    """What :func:`to_usd` wrote.
+
+    Attributes:
+        path: the USD file.
+        root: prim path of the articulation's root prim (``/<robot name>``).
+        drives: joint name -> (stiffness, damping, max force) as authored, in USD units
+            (angular: N m/deg, N m s/deg, N m).
+        velocity_limits: joint name -> velocity limit authored (rad/s or m/s).
+        joint_prims: joint name -> prim path.
+        notes: what was not carried, one line each.
+        proof: the read-back comparison (:class:`~robotwright.generators.usd_proof.UsdProof`),
+            ``None`` when not asked for.
+    """
+
+    path: Path
+    root: str
+    drives: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    velocity_limits: dict[str, float] = field(default_factory=dict)
+    joint_prims: dict[str, str] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    proof: object | None = None
+
+
+def _converter():
+    try:
+        import mujoco_usd_converter
+        from pxr import Usd, UsdPhysics  # noqa: F401
+    except ImportError as exc:
+        raise GeneratorError(_MISSING.format(error=exc)) from None
+    return mujoco_usd_converter
+
+
+def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
+    """Our MJCF of the robot alone, meshes copied beside it, and the values the MJCF could
+    not hold that the USD does not get either (``peak_velocity`` it does get)."""
+    import warnings
+
+    from robotwright.generators.mjcf import MJCFHumanoidGenerator
+
+    path = folder / "mjcf" / f"{hrdf.name}.xml"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        MJCFHumanoidGenerator.from_hrdf(hrdf).export(path, copy_meshes=True, add_scene=False)
+    lost = []
+    for w in caught:
+        lines = str(w.message).splitlines()
+        items = [ln.strip()[2:] for ln in lines[1:] if ln.strip().startswith("- ")] or lines
+        lost += [ln for ln in items if "'peak_velocity'" not in ln]
+    return path, lost
+
+
+def _joint_kinds(mjcf: Path) -> dict[str, str]:
+    """Joint name -> "angular" (hinge) or "linear" (slide), from MuJoCo's compile."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    kinds = {}
+    for j in range(model.njnt):
+        kind = {mujoco.mjtJoint.mjJNT_HINGE: "angular", mujoco.mjtJoint.mjJNT_SLIDE: "linear"}
+        if int(model.jnt_type[j]) in kind:
+            kinds[mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)] = kind[
+                int(model.jnt_type[j])
+            ]
+    return kinds
+
+
+def _author_drives(stage, hrdf: HRDF, kinds: dict[str, str], out: UsdExport) -> None:
+    from pxr import Sdf, UsdPhysics
+
+    joints = {p.GetName(): p for p in stage.Traverse() if p.IsA(UsdPhysics.Joint)}
+    out.joint_prims = {name: str(p.GetPath()) for name, p in joints.items()}
+    for act in hrdf.actuators:
+        prim = joints.get(act.joint)
+        kind = kinds.get(act.joint)
+        if prim is None or kind is None:
+            out.notes.append(
+                f"actuator {act.name or act.joint!r}: joint {act.joint!r} is not a hinge or "
+                "slide joint prim of the USD; no drive written"
+            )
+            continue
+        per = math.pi / 180.0 if kind == "angular" else 1.0  # USD angular units: degrees
+        stiffness = (act.p_gain or 0.0) * per
+        damping = (act.d_gain or 0.0) * per
+        if act.peak_torque is not None:
+            max_force = float(act.peak_torque)
+        elif act.force_range is not None:
+            max_force = float(max(abs(act.force_range[0]), abs(act.force_range[1])))
+        else:
+            max_force = math.inf
+        drive = UsdPhysics.DriveAPI.Apply(prim, kind)
+        drive.CreateTypeAttr("force")
+        drive.CreateStiffnessAttr(stiffness)
+        drive.CreateDampingAttr(damping)
+        drive.CreateMaxForceAttr(max_force)
+        out.drives[act.joint] = (stiffness, damping, max_force)
+        if act.peak_velocity is not None:
+            v = float(act.peak_velocity)
+            shown = v * 180.0 / math.pi if kind == "angular" else v
+            prim.CreateAttribute("newton:velocityLimit", Sdf.ValueTypeNames.Float).Set(shown)
+            prim.CreateAttribute("physxJoint:maxJointVelocity", Sdf.ValueTypeNames.Float).Set(shown)
+            out.velocity_limits[act.joint] = v
+
+
+def to_usd(
+    hrdf: HRDF,
+    output: str | Path,
+    *,
+    overwrite: bool = False,
+    prove: bool = True,
+    strict: bool = False,
+) -> UsdExport:
+    """Write ``hrdf`` as one USD file (see the module docstring for what is authored).
+
+    With ``prove`` (the default), Newton reads the file back and it is compared with
+    MuJoCo's compile of the same MJCF (:func:`~robotwright.generators.usd_proof.prove_usd`):
+    each difference and each note is a :class:`~robotwright.errors.ConversionWarning`,
+    under ``strict`` a :class:`~robotwright.errors.ConversionError` before the file is
+    put in place.
+
+    Raises:
+        GeneratorError: the converter is missing, the suffix is not a USD one, or the
+            output exists without ``overwrite``.
+        ConversionError: ``strict`` and the proof or a note found a difference.
+    """
+    out_path = Path(output)
+    if out_path.suffix.lower() not in USD_SUFFIXES:
+        raise GeneratorError(
+            f"{out_path}: expected a file name ending in {', '.join(USD_SUFFIXES)}"
+        )
+    if out_path.exists() and not overwrite:
+        raise GeneratorError(f"{out_path} exists (pass overwrite=True / --overwrite)")
+    converter = _converter()
+    from pxr import Usd
+
+    with tempfile.TemporaryDirectory(prefix="robotwright-usd-") as tmp:
+        mjcf, lost = _robot_mjcf(hrdf, Path(tmp))
+        asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
+        stage = Usd.Stage.Open(asset.path)
+        root = stage.GetDefaultPrim()
+        result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost)
+        _author_drives(stage, hrdf, _joint_kinds(mjcf), result)
+        flat = stage.Flatten()
+        out_path.parent.mkdir(parents=True, exist_ok=True)
+        partial = out_path.with_name(f".{out_path.name}.partial{out_path.suffix}")
+        try:
+            if not flat.Export(str(partial)):
+                raise GeneratorError(f"{out_path}: usd-core could not write the file")
+            found = list(result.notes)
+            if prove:
+                result.proof = _prove(partial, mjcf, hrdf)
+                found += result.proof.differences
+            _report(found, out_path, strict)
+            partial.replace(out_path)
+        finally:
+            partial.unlink(missing_ok=True)
+    return result
+
+
+def _prove(usd: Path, mjcf: Path, hrdf: HRDF):
+    import mujoco
+
+    from robotwright.generators.usd_proof import prove_usd
+
+    return prove_usd(usd, mujoco.MjModel.from_xml_path(str(mjcf)), hrdf)
+
+
+def _report(found: list[str], out_path: Path, strict: bool) -> None:
+    import warnings
+
+    from robotwright.errors import ConversionError, ConversionWarning, Problem
+
+    if strict and found:
+        raise ConversionError(
+            [Problem(str(out_path), line) for line in found],
+            summary=f"strict USD export of {out_path}: {len(found)} difference(s) between "
+            "the USD read back by Newton and the robot",
+        )
+    for line in found:
+        warnings.warn(f"{out_path}: {line}", ConversionWarning, stacklevel=3)
