@@ -59,6 +59,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_export)
 
     p = sub.add_parser(
+        "isaaclab-cfg",
+        help="write an Isaac Lab ArticulationCfg module and the robot's USD",
+        description="Write a Python module with an Isaac Lab ArticulationCfg (ROBOT_CFG: "
+        "USD spawn, initial state, ImplicitActuatorCfg groups from the robot's actuators) "
+        "and the robot's USD beside it (as `export -o ROBOT.usd`). Isaac Lab's environment "
+        "(Python 3.12).",
+        epilog="Example: robotwright isaaclab-cfg mini_humanoid -o robots/mini_humanoid_cfg.py",
+    )
+    p.add_argument("robot", help="a robot: bundled name, HRDF folder, MJCF or URDF file")
+    p.add_argument(
+        "--strict", action="store_true", help="fail instead of writing when the USD's proof differs"
+    )
+    p.add_argument("-o", "--output", required=True, help="the module to write (.py)")
+    add_overwrite_flag(p)
+    p.set_defaults(func=_isaaclab_cfg)
+    p = sub.add_parser(
         "compose",
         help="put several robots in one scene file",
         description="Compose robots into one MJCF (or URDF) scene. Each ROBOT is "
@@ -162,6 +178,21 @@ def _export(args: argparse.Namespace) -> int:
             strict=args.strict,
         )
     print(f"wrote {out} ({args.format}, robot '{hrdf.name}', {len(hrdf.bodies)} bodies)")
+    return 0
+
+
+def _isaaclab_cfg(args: argparse.Namespace) -> int:
+    from robotwright.generators.isaaclab_cfg import write_articulation_cfg
+    from robotwright.generators.tasks import load_robot
+
+    if Path(args.output).suffix != ".py":
+        raise GeneratorError(f"{args.output}: expected a Python module file name ending in .py")
+    check_overwrite(args.output, args.overwrite)
+    hrdf = load_robot(args.robot)
+    module, usd = write_articulation_cfg(
+        hrdf, args.output, overwrite=args.overwrite, strict=args.strict
+    )
+    print(f"wrote {module} (ROBOT_CFG) and {usd}")
     return 0
 
 

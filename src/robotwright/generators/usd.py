@@ -109,6 +109,19 @@ def _joint_kinds(mjcf: Path) -> dict[str, str]:
     return kinds
 
 
+def _zero_inertia_bodies(mjcf: Path) -> list[str]:
+    """Bodies with mass but an all-zero inertia: USD reads a zero ``diagonalInertia`` as
+    "not given" and readers compute one from the colliders instead."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    return [
+        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
+        for b in range(1, model.nbody)
+        if model.body_mass[b] > 0 and not model.body_inertia[b].any()
+    ]
+
+
 def _author_drives(stage, hrdf: HRDF, kinds: dict[str, str], out: UsdExport) -> None:
     from pxr import Sdf, UsdPhysics
 
@@ -183,6 +196,18 @@ def to_usd(
         stage = Usd.Stage.Open(asset.path)
         root = stage.GetDefaultPrim()
         result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost)
+        for body in _zero_inertia_bodies(mjcf):
+            result.notes.append(
+                f"body {body!r}: mass with zero inertia; USD reads a zero diagonalInertia as "
+                "'not given', so Newton and PhysX compute one from the body's colliders"
+            )
+        if hrdf.sensors:
+            names = ", ".join(sn.name for sn in hrdf.sensors[:5])
+            result.notes.append(
+                f"{len(hrdf.sensors)} sensor(s) not carried ({names}"
+                f"{', ...' if len(hrdf.sensors) > 5 else ''}): mujoco-usd-converter writes no "
+                "sensors; add Isaac Lab sensors in the scene config"
+            )
         _author_drives(stage, hrdf, _joint_kinds(mjcf), result)
         flat = stage.Flatten()
         out_path.parent.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,198 @@
+"""An Isaac Lab ``ArticulationCfg`` for a robot, written as a Python module.
+
+``write_articulation_cfg(hrdf, "robot_cfg.py")`` exports the robot to USD beside the
+module (:func:`~robotwright.generators.usd.to_usd`) and writes::
+
+    ROBOT_CFG = ArticulationCfg(
+        spawn=sim_utils.UsdFileCfg(usd_path=USD_PATH),
+        init_state=ArticulationCfg.InitialStateCfg(pos=..., joint_pos={...}),
+        actuators={"group_0": ImplicitActuatorCfg(joint_names_expr=[...], stiffness=...,
+                   damping=..., joint_effort_limit=..., joint_velocity_limit=...), ...},
+    )
+
+one ``ImplicitActuatorCfg`` per set of equal values (stiffness and damping from
+``p_gain``/``d_gain`` [N m/rad, N m s/rad], effort from ``peak_torque`` or the force
+range, velocity from ``peak_velocity``; a gain the HRDF lacks is ``None``, which Isaac
+Lab reads as "the USD drive's", a limit it lacks is left out; Isaac Lab 3's
+``joint_effort_limit``/``joint_velocity_limit``, of which ``effort_limit_sim`` and
+``velocity_limit_sim`` are deprecated aliases). Every name is written as a Python string literal (``repr``) and, in a
+joint expression, as an escaped regular expression matching exactly that joint; every
+number as a float literal. The module imports only Isaac Lab and ``pathlib``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import mujoco
+
+from robotwright.errors import GeneratorError
+from robotwright.hrdf.model import HRDF
+
+__all__ = ["articulation_cfg_source", "write_articulation_cfg"]
+
+
+def _num(value: float) -> str:
+    value = float(value)
+    if not math.isfinite(value):
+        raise GeneratorError(f"cannot write a non-finite value {value!r} into the Isaac Lab config")
+    return repr(value)
+
+
+def _groups(hrdf: HRDF) -> list[tuple[dict[str, float], list[str]]]:
+    """Actuated joints grouped by equal drive values (in first-seen order)."""
+    groups: dict[tuple, tuple[dict[str, float], list[str]]] = {}
+    for act in hrdf.actuators:
+        values: dict[str, float] = {}
+        if act.p_gain is not None:
+            values["stiffness"] = float(act.p_gain)
+        if act.d_gain is not None:
+            values["damping"] = float(act.d_gain)
+        if act.peak_torque is not None:
+            values["joint_effort_limit"] = float(act.peak_torque)
+        elif act.force_range is not None:
+            values["joint_effort_limit"] = float(max(abs(v) for v in act.force_range))
+        if act.peak_velocity is not None:
+            values["joint_velocity_limit"] = float(act.peak_velocity)
+        key = tuple(sorted(values.items()))
+        groups.setdefault(key, (values, []))[1].append(act.joint)
+    return list(groups.values())
+
+
+def _initial_state(
+    model: mujoco.MjModel,
+) -> tuple[tuple[float, float, float], dict[str, float], list[str]]:
+    """Root position [m] and joint positions (the MJCF's reference pose, clamped into
+    the joint ranges Isaac Lab checks), with a line per clamped joint."""
+    pos = (0.0, 0.0, 0.0)
+    joint_pos: dict[str, float] = {}
+    clamped = []
+    for j in range(model.njnt):
+        adr = int(model.jnt_qposadr[j])
+        kind = int(model.jnt_type[j])
+        if kind == int(mujoco.mjtJoint.mjJNT_FREE):
+            pos = tuple(float(v) for v in model.qpos0[adr : adr + 3])  # type: ignore[assignment]
+            continue
+        if kind not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+            continue
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        q = float(model.qpos0[adr])
+        if model.jnt_limited[j]:
+            lo, hi = (float(v) for v in model.jnt_range[j])
+            if not lo <= q <= hi:
+                new = min(max(q, lo), hi)
+                clamped.append(
+                    f"{name}: reference position {q:g} outside [{lo:g}, {hi:g}], written as {new:g}"
+                )
+                q = new
+        joint_pos[name] = q
+    if not model.njnt or int(model.jnt_type[0]) != int(mujoco.mjtJoint.mjJNT_FREE):
+        pos = tuple(float(v) for v in model.body_pos[1])  # type: ignore[assignment]
+    else:
+        pos = (pos[0], pos[1], pos[2] + _floor_clearance(model, joint_pos))
+    return pos, joint_pos, clamped
+
+
+def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> float:
+    """How far [m] to raise a free-base robot (at its initial joint positions) so that
+    the lowest corner of its collision geoms' bounding boxes is on z = 0."""
+    data = mujoco.MjData(model)
+    for name, q in joint_pos.items():
+        data.joint(name).qpos[0] = q
+    mujoco.mj_kinematics(model, data)
+    lowest = math.inf
+    signs = [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+    for g in range(model.ngeom):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        center, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
+        rot = data.geom_xmat[g].reshape(3, 3)
+        for sign in signs:
+            corner = data.geom_xpos[g] + rot @ (center + half * sign)
+            lowest = min(lowest, float(corner[2]))
+    return 0.0 if not math.isfinite(lowest) else -lowest
+
+
+def articulation_cfg_source(
+    hrdf: HRDF, model: mujoco.MjModel, usd_name: str
+) -> tuple[str, list[str]]:
+    """The module's text and the notes (joints whose reference pose was clamped)."""
+    pos, joint_pos, clamped = _initial_state(model)
+    lines = [
+        f'"""Isaac Lab ArticulationCfg of the robot {hrdf.name!r}, written by robotwright.',
+        "",
+        "The USD beside this file holds the robot with its joint drives; the actuator",
+        "groups below repeat the drive values (stiffness N m/rad, damping N m s/rad,",
+        "effort N m, velocity rad/s) so that Isaac Lab applies them.",
+    ]
+    if clamped:
+        lines += ["", "Joint positions clamped into their ranges (Isaac Lab checks them):"]
+        lines += [f"  {c}" for c in clamped]
+    lines += [
+        '"""',
+        "",
+        "from pathlib import Path",
+        "",
+        "import isaaclab.sim as sim_utils",
+        "from isaaclab.actuators import ImplicitActuatorCfg",
+        "from isaaclab.assets import ArticulationCfg",
+        "",
+        f"USD_PATH = str(Path(__file__).with_name({usd_name!r}))",
+        "",
+        "ROBOT_CFG = ArticulationCfg(",
+        "    spawn=sim_utils.UsdFileCfg(usd_path=USD_PATH),",
+        "    init_state=ArticulationCfg.InitialStateCfg(",
+        f"        pos=({', '.join(_num(v) for v in pos)}),",
+        "        joint_pos={",
+    ]
+    lines += [f"            {re.escape(name)!r}: {_num(q)}," for name, q in joint_pos.items()]
+    lines += ["        },", "    ),", "    actuators={"]
+    for k, (values, joints) in enumerate(_groups(hrdf)):
+        exprs = ", ".join(repr(re.escape(j)) for j in joints)
+        lines.append(f"        {f'group_{k}'!r}: ImplicitActuatorCfg(")
+        lines.append(f"            joint_names_expr=[{exprs}],")
+        for key in ("stiffness", "damping"):  # None: Isaac Lab takes the USD drive's
+            lines.append(f"            {key}={_num(values[key]) if key in values else None},")
+        for key in ("joint_effort_limit", "joint_velocity_limit"):
+            if key in values:
+                lines.append(f"            {key}={_num(values[key])},")
+        lines.append("        ),")
+    lines += ["    },", ")", ""]
+    return "\n".join(lines), clamped
+
+
+def write_articulation_cfg(
+    hrdf: HRDF, output: str | Path, *, overwrite: bool = False, strict: bool = False
+) -> tuple[Path, Path]:
+    """Write ``<output>`` (the module) and ``<robot name>.usd`` beside it.
+
+    Returns:
+        (module path, USD path).
+    """
+    import tempfile
+
+    from robotwright.generators.mjcf import MJCFHumanoidGenerator
+    from robotwright.generators.usd import to_usd
+
+    out = Path(output)
+    if out.suffix != ".py":
+        raise GeneratorError(f"{out}: expected a Python module file name ending in .py")
+    if out.exists() and not overwrite:
+        raise GeneratorError(f"{out} exists (pass overwrite=True / --overwrite)")
+    usd = out.with_name(f"{hrdf.name}.usd")
+    with tempfile.TemporaryDirectory(prefix="robotwright-cfg-") as tmp:
+        mjcf = Path(tmp) / "robot.xml"
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # to_usd reports what the export loses
+            MJCFHumanoidGenerator.from_hrdf(hrdf).export(mjcf, copy_meshes=True, add_scene=False)
+        model = mujoco.MjModel.from_xml_path(str(mjcf))
+    text, _ = articulation_cfg_source(hrdf, model, usd.name)
+    to_usd(hrdf, usd, overwrite=overwrite, strict=strict)
+    partial = out.with_name(f".{out.name}.partial")
+    partial.write_text(text, encoding="utf-8")
+    partial.replace(out)
+    return out, usd
