@@ -186,11 +186,10 @@ def test_articulation_cfg_spawns_and_a_free_base_robot_does_not_explode(tmp_path
             assert math.isfinite(z) and z < start + 0.05, f"base flew to z = {z}"
             low = min(low, z)
         assert low > 0.02, f"base sank through the floor: z = {low}"
-        effort = (
-            robot.data.joint_effort_limits.torch[0]
-            if hasattr(robot.data, "joint_effort_limits")
-            else None
-        )
-        if effort is not None:
-            want = torch.tensor([a.peak_torque for a in hrdf.actuators], dtype=effort.dtype)
-            assert torch.allclose(effort.sort().values, want.sort().values, rtol=1e-5)
+        # The drives' limits arrive in Isaac Lab (joint order may differ: compare sorted).
+        effort = robot.data.joint_effort_limits.torch[0]
+        want = torch.tensor([a.peak_torque for a in hrdf.actuators], dtype=effort.dtype)
+        assert torch.allclose(effort.sort().values, want.sort().values, rtol=1e-5)
+        vel = robot.data.joint_vel_limits.torch[0]
+        want = torch.tensor([a.peak_velocity for a in hrdf.actuators], dtype=vel.dtype)
+        assert torch.allclose(vel.sort().values, want.sort().values, rtol=1e-5)
