@@ -27,10 +27,16 @@ from robotwright.catalog import find_entry  # noqa: E402
 from robotwright.generators.usd import to_usd  # noqa: E402
 from robotwright.sources import load_robot  # noqa: E402
 
-ROBOTS = ["arm6", "mini_humanoid", "go2", "talos"]
+ROBOTS = ["arm6", "mini_humanoid", "go2", "talos", "g1"]
+#: The hurodes G1 fixture (HRDF made from mjlab's G1 by tools/fetch_test_data.py).
+G1 = Path(__file__).resolve().parents[2] / ".testdata" / "hurodes-fixtures" / "g1_29"
 
 
 def _robot(name: str):
+    if name == "g1":
+        if not (G1 / "meta.yaml").is_file():
+            pytest.skip("the G1 fixture comes from tools/fetch_test_data.py (not fetched)")
+        return load_robot(str(G1))
     if name in ("go2", "talos") and find_entry(name) is None:
         pytest.skip(f"{name} comes from example-robot-data (not installed)")
     if name in ("go2", "talos"):
