@@ -3,7 +3,7 @@
 The converter registers its schema plugins (MjcPhysics) when imported; USD's schema
 registry does not take plugins registered after a stage has been made, and the LiDAR
 tests make Isaac Lab stages. So the converter is imported before any test runs (a user's
-process that both simulates and exports imports ``robotwright.generators.usd`` first).
+process that both simulates and exports does the same; docs/generators.md).
 """
 
 from __future__ import annotations
