@@ -46,10 +46,9 @@ class SceneShapes:
     unlabelled_terrain: np.ndarray
 
 
-def articulation_bodies(model: newton.Model, body: int) -> set[int]:
-    """Bodies of the articulation holding ``body`` (just ``body`` when it has none)."""
-    child = model.joint_child.numpy()
-    art = model.joint_articulation.numpy()
+def articulation_bodies(child: np.ndarray, art: np.ndarray, body: int) -> set[int]:
+    """Bodies of the articulation holding ``body`` (just ``body`` when it has none), from
+    Newton's ``joint_child`` and ``joint_articulation`` arrays."""
     joints = np.flatnonzero(child == body)
     if joints.size == 0 or art[joints[0]] < 0:
         return {int(body)}
@@ -129,8 +128,9 @@ def scene_shapes(
     )
     carrier_bodies = {int(b) for b in carriers if b >= 0}
     robot_bodies: set[int] = set()
+    child, art = model.joint_child.numpy(), model.joint_articulation.numpy()
     for b in carrier_bodies:
-        robot_bodies |= articulation_bodies(model, b)
+        robot_bodies |= articulation_bodies(child, art, b)
     carrier = np.isin(shape_body, list(carrier_bodies)) & (shape_body >= 0)
     own = np.isin(shape_body, list(robot_bodies)) & (shape_body >= 0)
     visible = collides.copy()
