@@ -171,9 +171,6 @@ def write_articulation_cfg(
     Returns:
         (module path, USD path).
     """
-    import tempfile
-
-    from robotwright.generators.mjcf import MJCFHumanoidGenerator
     from robotwright.generators.usd import to_usd
 
     out = Path(output)
@@ -182,16 +179,12 @@ def write_articulation_cfg(
     if out.exists() and not overwrite:
         raise GeneratorError(f"{out} exists (pass overwrite=True / --overwrite)")
     usd = out.with_name(f"{hrdf.name}.usd")
-    with tempfile.TemporaryDirectory(prefix="robotwright-cfg-") as tmp:
-        mjcf = Path(tmp) / "robot.xml"
-        import warnings
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # to_usd reports what the export loses
-            MJCFHumanoidGenerator.from_hrdf(hrdf).export(mjcf, copy_meshes=True, add_scene=False)
-        model = mujoco.MjModel.from_xml_path(str(mjcf))
-    text, _ = articulation_cfg_source(hrdf, model, usd.name)
-    to_usd(hrdf, usd, overwrite=overwrite, strict=strict)
+    done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict)
+    try:  # the initial state comes from the MJCF the USD was made from
+        text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name)
+    except GeneratorError:
+        usd.unlink(missing_ok=True)  # no half of the pair without the other
+        raise
     partial = out.with_name(f".{out.name}.partial")
     partial.write_text(text, encoding="utf-8")
     partial.replace(out)

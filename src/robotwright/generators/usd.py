@@ -28,6 +28,8 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import mujoco
+
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
 
@@ -55,6 +57,8 @@ class UsdExport:
         notes: what was not carried, one line each.
         proof: the read-back comparison (:class:`~robotwright.generators.usd_proof.UsdProof`),
             ``None`` when not asked for.
+        mjcf_model: MuJoCo's compile of the MJCF the USD was converted from (what the
+            proof compares against).
     """
 
     path: Path
@@ -64,6 +68,7 @@ class UsdExport:
     joint_prims: dict[str, str] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     proof: object | None = None
+    mjcf_model: mujoco.MjModel | None = None
 
 
 def _converter():
@@ -94,27 +99,19 @@ def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
     return path, lost
 
 
-def _joint_kinds(mjcf: Path) -> dict[str, str]:
+def _joint_kinds(model: mujoco.MjModel) -> dict[str, str]:
     """Joint name -> "angular" (hinge) or "linear" (slide), from MuJoCo's compile."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_path(str(mjcf))
-    kinds = {}
-    for j in range(model.njnt):
-        kind = {mujoco.mjtJoint.mjJNT_HINGE: "angular", mujoco.mjtJoint.mjJNT_SLIDE: "linear"}
-        if int(model.jnt_type[j]) in kind:
-            kinds[mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)] = kind[
-                int(model.jnt_type[j])
-            ]
-    return kinds
+    kind = {int(mujoco.mjtJoint.mjJNT_HINGE): "angular", int(mujoco.mjtJoint.mjJNT_SLIDE): "linear"}
+    return {
+        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j): kind[int(model.jnt_type[j])]
+        for j in range(model.njnt)
+        if int(model.jnt_type[j]) in kind
+    }
 
 
-def _zero_inertia_bodies(mjcf: Path) -> list[str]:
+def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
     """Bodies with mass but an all-zero inertia: USD reads a zero ``diagonalInertia`` as
     "not given" and readers compute one from the colliders instead."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_path(str(mjcf))
     return [
         mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
         for b in range(1, model.nbody)
@@ -195,8 +192,9 @@ def to_usd(
         asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
         stage = Usd.Stage.Open(asset.path)
         root = stage.GetDefaultPrim()
-        result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost)
-        for body in _zero_inertia_bodies(mjcf):
+        model = mujoco.MjModel.from_xml_path(str(mjcf))
+        result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost, mjcf_model=model)
+        for body in _zero_inertia_bodies(model):
             result.notes.append(
                 f"body {body!r}: mass with zero inertia; USD reads a zero diagonalInertia as "
                 "'not given', so Newton and PhysX compute one from the body's colliders"
@@ -208,7 +206,7 @@ def to_usd(
                 f"{', ...' if len(hrdf.sensors) > 5 else ''}): mujoco-usd-converter writes no "
                 "sensors; add Isaac Lab sensors in the scene config"
             )
-        _author_drives(stage, hrdf, _joint_kinds(mjcf), result)
+        _author_drives(stage, hrdf, _joint_kinds(model), result)
         flat = stage.Flatten()
         out_path.parent.mkdir(parents=True, exist_ok=True)
         partial = out_path.with_name(f".{out_path.name}.partial{out_path.suffix}")
@@ -217,21 +215,15 @@ def to_usd(
                 raise GeneratorError(f"{out_path}: usd-core could not write the file")
             found = list(result.notes)
             if prove:
-                result.proof = _prove(partial, mjcf, hrdf)
+                from robotwright.generators.usd_proof import prove_usd
+
+                result.proof = prove_usd(partial, model, hrdf)
                 found += result.proof.differences
             _report(found, out_path, strict)
             partial.replace(out_path)
         finally:
             partial.unlink(missing_ok=True)
     return result
-
-
-def _prove(usd: Path, mjcf: Path, hrdf: HRDF):
-    import mujoco
-
-    from robotwright.generators.usd_proof import prove_usd
-
-    return prove_usd(usd, mujoco.MjModel.from_xml_path(str(mjcf)), hrdf)
 
 
 def _report(found: list[str], out_path: Path, strict: bool) -> None:

@@ -20,6 +20,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from robotwright._rotations import quat_to_mat
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["UsdProof", "prove_usd"]
@@ -55,9 +56,8 @@ def _rel(a: float, b: float) -> float:
 
 
 def _mj_inertia(model: mujoco.MjModel, b: int) -> np.ndarray:
-    rot = np.empty(9)
-    mujoco.mju_quat2Mat(rot, model.body_iquat[b])
-    r = rot.reshape(3, 3)
+    """Body ``b``'s inertia tensor about its centre of mass, in the body frame."""
+    r = quat_to_mat(model.body_iquat[b])
     return r @ np.diag(model.body_inertia[b]) @ r.T
 
 

@@ -55,12 +55,12 @@ def first_pass(
     hit_normal: wp.array(dtype=wp.vec3f),
     shape_visible: wp.array(dtype=wp.int32),
     max_distance: float,
+    num_rays: int,
     total: wp.array(dtype=wp.float32),
     shape: wp.array(dtype=wp.int32),
     normal: wp.array(dtype=wp.vec3f),
     pending: wp.array(dtype=wp.int32),
     pending_count: wp.array(dtype=wp.int32),
-    num_rays: int,
 ):
     """Take the first cast: a hit on a seen shape is final; a hit on a see-through shape
     within range is queued for a re-cast past it. dim=(E * N,)."""

@@ -25,7 +25,6 @@ Parts of the parent relied on (private in Isaac Lab, pinned by a test):
 from __future__ import annotations
 
 import copy
-import math
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -34,9 +33,11 @@ import newton
 import numpy as np
 import torch
 import warp as wp
+from isaaclab.utils.math import matrix_from_quat
 from isaaclab.utils.warp import ProxyArray
 from isaaclab_newton.sensors import NewtonRaycastSensor, NewtonRaycastSensorData
 
+from robotwright._rotations import quat_to_mat
 from robotwright.errors import SensorError
 from robotwright.sensors import learning_obs
 from robotwright.sensors.isaaclab import _kernels as k
@@ -152,18 +153,9 @@ def _pattern_table(pattern: Any) -> tuple[np.ndarray, np.ndarray, int, float | N
 
 
 def _rotate_xyzw(quat: Sequence[float], v: np.ndarray) -> np.ndarray:
-    """Rotate rows of ``v`` by the unit quaternion (x, y, z, w)."""
-    x, y, z, w = (float(c) for c in quat)
-    n = math.sqrt(x * x + y * y + z * z + w * w)
-    x, y, z, w = x / n, y / n, z / n, w / n
-    rot = np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-    return v @ rot.T
+    """Rotate rows of ``v`` by the quaternion (x, y, z, w), Isaac Lab's order."""
+    x, y, z, w = quat
+    return v @ quat_to_mat((w, x, y, z)).T
 
 
 def _rows(tensor: torch.Tensor, env_ids: EnvIds) -> torch.Tensor:
@@ -337,6 +329,7 @@ class LidarSensor(NewtonRaycastSensor):
                 self._hit_normal,
                 self._shape_visible,
                 max_d,
+                n,
             ],
             outputs=[
                 self._total,
@@ -344,7 +337,6 @@ class LidarSensor(NewtonRaycastSensor):
                 self._final_normal,
                 self._pending[queue],
                 self._pending_count[queue],
-                n,
             ],
             device=dev,
         )
@@ -453,9 +445,9 @@ class LidarSensor(NewtonRaycastSensor):
         """The LiDAR's own pose (carrier pose with ``cfg.offset``): positions ``(E, 3)``
         [m] and rotation matrices ``(E, 3, 3)`` (columns: sensor axes in the world)."""
         data = self.data
-        carrier_rot = _quat_xyzw_to_matrix(data.quat_w.torch)
+        carrier_rot = matrix_from_quat(data.quat_w.torch)
         off_pos = torch.tensor(self.cfg.offset.pos, dtype=torch.float32, device=carrier_rot.device)
-        off_rot = _quat_xyzw_to_matrix(
+        off_rot = matrix_from_quat(
             torch.tensor(self.cfg.offset.rot, dtype=torch.float32, device=carrier_rot.device)[None]
         )[0]
         return data.pos_w.torch + carrier_rot @ off_pos, carrier_rot @ off_rot
@@ -463,27 +455,7 @@ class LidarSensor(NewtonRaycastSensor):
     def carrier_pose_w(self) -> tuple[torch.Tensor, torch.Tensor]:
         """The carrier prim's pose: positions ``(E, 3)`` [m], rotations ``(E, 3, 3)``."""
         data = self.data
-        return data.pos_w.torch, _quat_xyzw_to_matrix(data.quat_w.torch)
-
-
-def _quat_xyzw_to_matrix(q: torch.Tensor) -> torch.Tensor:
-    """``(..., 4)`` unit quaternions (x, y, z, w) -> ``(..., 3, 3)`` rotation matrices."""
-    q = q / q.norm(dim=-1, keepdim=True)
-    x, y, z, w = q.unbind(-1)
-    return torch.stack(
-        [
-            1 - 2 * (y * y + z * z),
-            2 * (x * y - z * w),
-            2 * (x * z + y * w),
-            2 * (x * y + z * w),
-            1 - 2 * (x * x + z * z),
-            2 * (y * z - x * w),
-            2 * (x * z - y * w),
-            2 * (y * z + x * w),
-            1 - 2 * (x * x + y * y),
-        ],
-        dim=-1,
-    ).reshape(*q.shape[:-1], 3, 3)
+        return data.pos_w.torch, matrix_from_quat(data.quat_w.torch)
 
 
 class SemanticLidarSensor(LidarSensor):
