@@ -115,23 +115,31 @@ def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> floa
     return 0.0 if not math.isfinite(lowest) else -lowest
 
 
+def _docstring(text: str) -> str:
+    """``text`` as a module docstring. It holds names from the robot file, so it is a
+    plain triple-quoted block only when no character could end or escape it (printable
+    characters and newlines, no quote or backslash); otherwise one escaped literal."""
+    plain = all(c == "\n" or (c.isprintable() and c not in '"\\') for c in text)
+    return f'"""{text}"""' if plain else repr(text)
+
+
 def articulation_cfg_source(
     hrdf: HRDF, model: mujoco.MjModel, usd_name: str
 ) -> tuple[str, list[str]]:
     """The module's text and the notes (joints whose reference pose was clamped)."""
     pos, joint_pos, clamped = _initial_state(model)
-    lines = [
-        f'"""Isaac Lab ArticulationCfg of the robot {hrdf.name!r}, written by robotwright.',
+    doc = [
+        f"Isaac Lab ArticulationCfg of the robot {hrdf.name!r}, written by robotwright.",
         "",
         "The USD beside this file holds the robot with its joint drives; the actuator",
         "groups below repeat the drive values (stiffness N m/rad, damping N m s/rad,",
         "effort N m, velocity rad/s) so that Isaac Lab applies them.",
     ]
     if clamped:
-        lines += ["", "Joint positions clamped into their ranges (Isaac Lab checks them):"]
-        lines += [f"  {c}" for c in clamped]
-    lines += [
-        '"""',
+        doc += ["", "Joint positions clamped into their ranges (Isaac Lab checks them):"]
+        doc += [f"  {c}" for c in clamped]
+    lines = [
+        _docstring("\n".join(doc) + "\n"),
         "",
         "from pathlib import Path",
         "",
