@@ -48,7 +48,15 @@ __all__ = [
 ]
 
 #: Robot file kinds by extension (``.urdf.xacro`` ends in ``.xacro``).
-FILE_KINDS = {".urdf": "urdf", ".xacro": "xacro", ".xml": "mjcf", ".mjcf": "mjcf"}
+FILE_KINDS = {
+    ".urdf": "urdf",
+    ".xacro": "xacro",
+    ".xml": "mjcf",
+    ".mjcf": "mjcf",
+    ".usd": "usd",
+    ".usda": "usd",
+    ".usdc": "usd",
+}
 
 #: Options of the shared group, by the source kinds they apply to.
 URDF_OPTIONS = ("fixed_joints", "bound_mass", "bound_inertia", "inertia_from_geoms", "density")
@@ -203,7 +211,8 @@ def resolve_source(text: str | os.PathLike[str]) -> ResolvedSource:
         if kind is None:
             raise SourceNotFoundError(
                 f"{path}: a '{suffix or 'extensionless'}' file: expected a URDF (.urdf), "
-                "xacro (.xacro), MJCF (.xml, .mjcf) file, an HRDF folder or a robot name"
+                "xacro (.xacro), MJCF (.xml, .mjcf) or USD (.usd, .usda, .usdc) file, an "
+                "HRDF folder or a robot name"
             )
         return ResolvedSource(kind, path, _stem(path))
     if suffix in FILE_KINDS or _looks_like_path(raw):
@@ -277,13 +286,16 @@ def _check_applies(source: ResolvedSource, options: Mapping[str, Any]) -> None:
         "urdf": URDF_OPTIONS,
         "xacro": (*URDF_OPTIONS, *XACRO_OPTIONS),
         "mjcf": MJCF_OPTIONS,
+        "usd": (),
     }[source.kind]
     unknown = sorted(k for k in options if k not in applies and k not in _PASSED)
     if unknown:
         flags = ", ".join(
             "--" + k.replace("_", "-").replace("xacro-args", "xacro-arg") for k in unknown
         )
-        what = {"hrdf": "an HRDF folder", "mjcf": "an MJCF file"}.get(source.kind, "a URDF")
+        what = {"hrdf": "an HRDF folder", "mjcf": "an MJCF file", "usd": "a USD file"}.get(
+            source.kind, "a URDF"
+        )
         raise RobotwrightError(f"{source.path}: {flags} do(es) not apply to {what}")
 
 
@@ -318,6 +330,10 @@ def load_robot_with_notes(
     _check_applies(resolved, opts)
     roots = tuple(asset_roots)
     work = opts.get("work_dir")
+    if resolved.kind == "usd":
+        from robotwright.parsers.usd import prepare_confined_read
+
+        prepare_confined_read()
     return run_confined(
         _read_source,
         resolved,
@@ -348,9 +364,15 @@ def _read_source(
             if not issubclass(w.category, HRDFWarning):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return hrdf, notes
-    from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
+    from robotwright.parsers.api import (
+        mjcf_to_hrdf_with_warnings,
+        urdf_to_hrdf_with_warnings,
+        usd_to_hrdf_with_warnings,
+    )
 
-    parse = mjcf_to_hrdf_with_warnings if resolved.kind == "mjcf" else urdf_to_hrdf_with_warnings
+    parse = {"mjcf": mjcf_to_hrdf_with_warnings, "usd": usd_to_hrdf_with_warnings}.get(
+        resolved.kind, urdf_to_hrdf_with_warnings
+    )
     if roots:
         opts = {**opts, "asset_roots": roots}
     with _quiet_parser_log():

@@ -11,7 +11,9 @@ into USD; then usd-core's API authors what the converter leaves out:
 * the velocity limit MJCF cannot hold, ``peak_velocity``, as Newton's
   ``newton:velocityLimit`` (deg/s or m/s) and PhysX's ``physxJoint:maxJointVelocity``
   (deg/s);
-* the robot's name: the articulation's root prim is named after the robot.
+* the robot's name: the articulation's root prim is named after the robot;
+* a floating body's free joint name (USD has no prim for it) as the custom attribute
+  ``robotwright:freeJointName`` on the body's prim.
 
 The written file is one flattened layer (``.usd``, ``.usda`` or ``.usdc``): meshes are
 in it, nothing refers back to the temporary conversion folder.
@@ -156,6 +158,22 @@ def _author_drives(stage, hrdf: HRDF, kinds: dict[str, str], out: UsdExport) -> 
             out.velocity_limits[act.joint] = v
 
 
+def _author_free_joint_names(stage, model: mujoco.MjModel) -> None:
+    from pxr import Sdf, UsdPhysics
+
+    from robotwright.parsers.usd import FREE_JOINT_ATTR  # the reader's contract
+
+    bodies = {p.GetName(): p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)}
+    for j in range(model.njnt):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE or not name:
+            continue
+        body = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, int(model.jnt_bodyid[j]))
+        if body in bodies:
+            attr = bodies[body].CreateAttribute(FREE_JOINT_ATTR, Sdf.ValueTypeNames.String)
+            attr.Set(name)
+
+
 def to_usd(
     hrdf: HRDF,
     output: str | Path,
@@ -207,6 +225,7 @@ def to_usd(
                 "sensors; add Isaac Lab sensors in the scene config"
             )
         _author_drives(stage, hrdf, _joint_kinds(model), result)
+        _author_free_joint_names(stage, model)
         flat = stage.Flatten()
         out_path.parent.mkdir(parents=True, exist_ok=True)
         partial = out_path.with_name(f".{out_path.name}.partial{out_path.suffix}")

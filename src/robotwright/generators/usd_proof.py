@@ -89,8 +89,10 @@ def prove_usd(
         tol: relative tolerance of masses/inertias, absolute of positions [m], angles [rad].
         seed: seed of the random poses.
     """
+    from robotwright._warp import quiet_warp
+
+    wp = quiet_warp()  # before Newton initialises warp
     import newton
-    import warp as wp
 
     builder = newton.ModelBuilder()
     builder.add_usd(str(usd))

@@ -47,6 +47,21 @@ def mjcf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: An
     return mjcf_to_hrdf_with_warnings(path, strict=strict, **options).hrdf
 
 
+def usd_to_hrdf_with_warnings(
+    path: str | os.PathLike, *, strict: bool = False, **options: Any
+) -> ParseResult:
+    """Read an OpenUSD robot (``.usd``, ``.usda``, ``.usdc``) with Newton's USD importer;
+    ``options`` are the fields of :class:`~robotwright.parsers.usd.USDOptions`."""
+    from robotwright.parsers.usd import USDOptions, parse_usd
+
+    return _confined(parse_usd, path, USDOptions(**options), strict, "usd", options)
+
+
+def usd_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any) -> HRDF:
+    """Read an OpenUSD robot into an HRDF (see :func:`usd_to_hrdf_with_warnings`)."""
+    return usd_to_hrdf_with_warnings(path, strict=strict, **options).hrdf
+
+
 def _confined(
     parse: Any, path: str | os.PathLike, opts: Any, strict: bool, kind: str, options: dict
 ) -> ParseResult:
@@ -58,6 +73,10 @@ def _confined(
 
     roots = source_read_roots(path, kind, options)
     work = options.get("work_dir")
+    if kind == "usd":
+        from robotwright.parsers.usd import prepare_confined_read
+
+        prepare_confined_read()
     with reading_root(roots[0]):
         return run_confined(
             parse,

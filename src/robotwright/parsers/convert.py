@@ -1,4 +1,6 @@
-"""Convert between MJCF, URDF and HRDF folders (type by extension, or folder = HRDF).
+"""Convert between MJCF, URDF and HRDF folders (type by extension, or folder = HRDF); a
+USD file (``.usd``, ``.usda``, ``.usdc``) is read too (:mod:`robotwright.parsers.usd`),
+and written by ``robotwright export`` (:func:`robotwright.generators.to_usd`).
 
 Outputs are written atomically by the writers (HRDF folder: all or nothing; MJCF/URDF:
 temporary file then rename) with meshes copied next to the output, so the result loads
@@ -24,12 +26,16 @@ def file_kind(path: Path, *, existing: bool) -> str:
         return "urdf"
     if ext in (".xml", ".mjcf"):
         return "mjcf"
+    if existing and ext in (".usd", ".usda", ".usdc"):
+        return "usd"
     if (existing and path.is_dir()) or (not existing and ext == ""):
         return "hrdf"
     raise ConversionError(
         [
             Problem(
-                str(path), "expected a .urdf or .xacro file, a .xml (MJCF) file or an HRDF folder"
+                str(path),
+                "expected a .urdf or .xacro file, a .xml (MJCF) file or an HRDF folder"
+                + ("" if existing else " (USD is written by 'robotwright export')"),
             )
         ]
     )
@@ -37,13 +43,21 @@ def file_kind(path: Path, *, existing: bool) -> str:
 
 def load_any(path: Path, *, strict: bool = False, **options: Any) -> tuple[HRDF, list[Problem]]:
     """Read a robot from any supported source; returns it and the parse warnings."""
-    from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
+    from robotwright.parsers.api import (
+        mjcf_to_hrdf_with_warnings,
+        urdf_to_hrdf_with_warnings,
+        usd_to_hrdf_with_warnings,
+    )
 
     kind = file_kind(path, existing=True)
     if kind == "hrdf":
         return HRDF.from_dir(path, asset_roots=options.get("asset_roots")), []
     _check_options(path, kind, options)
-    parse = urdf_to_hrdf_with_warnings if kind == "urdf" else mjcf_to_hrdf_with_warnings
+    parse = {
+        "urdf": urdf_to_hrdf_with_warnings,
+        "mjcf": mjcf_to_hrdf_with_warnings,
+        "usd": usd_to_hrdf_with_warnings,
+    }[kind]
     result = parse(path, strict=strict, **options)
     return result.hrdf, result.warnings
 
@@ -55,8 +69,9 @@ def _check_options(path: Path, kind: str, options: dict[str, Any]) -> None:
 
     from robotwright.parsers.mjcf import MJCFOptions
     from robotwright.parsers.urdf import URDFOptions
+    from robotwright.parsers.usd import USDOptions
 
-    cls = URDFOptions if kind == "urdf" else MJCFOptions
+    cls = {"urdf": URDFOptions, "usd": USDOptions}.get(kind, MJCFOptions)
     known = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(options) - known)
     if unknown:
@@ -118,6 +133,10 @@ def _convert(
     # Reading, repairs and the proof in one confined reader: the proof compiles the
     # source and the output where MuJoCo has just decoded the source's meshes.
     work = options.get("work_dir")
+    if file_kind(src_p, existing=True) == "usd":
+        from robotwright.parsers.usd import prepare_confined_read
+
+        prepare_confined_read()
     hrdf, messages, proved = run_confined(
         _read_and_prove,
         src_p,
@@ -210,6 +229,8 @@ def _proof(
         from robotwright.parsers.proof_urdf import prove_urdf_output
 
         found = prove_urdf_output(hrdf, str(src_p), notes)
+    elif kind == "usd":
+        found = _usd_proof(src_p, hrdf, out_kind, options)
     else:
         path, opts = src_p, options
         if is_xacro(src_p):
@@ -225,3 +246,15 @@ def _proof(
             "source and the output, compiled by MuJoCo",
         )
     return [str(p) for p in found]
+
+
+def _usd_proof(src_p: Path, hrdf: HRDF, out_kind: str, options: dict[str, Any]) -> list[Problem]:
+    """A USD source's proof: Newton's reading of the file against MuJoCo's compile of the
+    output (:func:`robotwright.generators.usd_proof.prove_usd`)."""
+    from robotwright.generators.usd_proof import prove_usd
+    from robotwright.parsers.proof import result_model
+
+    work = options.get("work_dir")
+    model, _ = result_model(hrdf, out_kind, Path(work) if work else None)
+    proof = prove_usd(src_p, model, hrdf)
+    return [Problem(str(src_p), line, severity="warning") for line in proof.differences]

@@ -233,7 +233,7 @@ def source_read_roots(
     path = Path(path)
     if kind == "hrdf":
         root = path.resolve()
-    elif kind == "mjcf":
+    elif kind in ("mjcf", "usd"):
         root = path.resolve().parent
     else:
         root = robot_root(path)

@@ -32,13 +32,9 @@ _ALIGN = {"base": 0, "yaw": 1, "world": 2}
 def import_warp() -> tuple[Any, Any]:
     """``(warp, mujoco_warp)``, or a :class:`SensorError` naming the extra to install."""
     try:
-        import warp as wp
+        from robotwright._warp import quiet_warp
 
-        # Before mujoco_warp initialises warp: no banner or module-load lines on stdout
-        # (warp >= 1.19 has log levels; older versions a quiet flag).
-        wp.config.quiet = True
-        if hasattr(wp, "LOG_WARNING"):
-            wp.config.log_level = wp.LOG_WARNING
+        wp = quiet_warp()  # before mujoco_warp initialises warp
         import mujoco_warp as mjw
     except ImportError as exc:
         raise SensorError(
