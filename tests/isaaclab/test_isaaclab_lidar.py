@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
-from pathlib import Path
 
 import pytest
 
@@ -21,6 +19,7 @@ if os.environ.get("ROBOTWRIGHT_REQUIRE_ISAACLAB") != "1":
         "isaaclab_newton", reason="Isaac Lab 3 not installed (the Isaac Lab stage of .ci/run)"
     )
 
+import isaaclab_scenes as scenes  # noqa: E402  (conftest puts this folder on the path)
 import newton  # noqa: E402
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
@@ -38,9 +37,6 @@ from robotwright.sensors.isaaclab import (  # noqa: E402
     SemanticLidarCfg,
     SemanticLidarSensor,
 )
-
-sys.path.insert(0, str(Path(__file__).parent))
-import isaaclab_scenes as scenes  # noqa: E402
 
 BASE = "{ENV_REGEX_NS}/Robot/base"
 IL_PATTERN = LidarPatternCfg(

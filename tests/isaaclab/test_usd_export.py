@@ -22,35 +22,16 @@ import math  # noqa: E402
 
 import mujoco  # noqa: E402
 from pxr import Usd, UsdPhysics  # noqa: E402
+from usd_robots import ROBOTS  # noqa: E402
+from usd_robots import robot as robot_named  # noqa: E402
 
-from robotwright.catalog import find_entry  # noqa: E402
 from robotwright.generators.usd import to_usd  # noqa: E402
 from robotwright.sources import load_robot  # noqa: E402
-
-ROBOTS = ["arm6", "mini_humanoid", "go2", "talos", "g1"]
-#: The hurodes G1 fixture (HRDF made from mjlab's G1 by tools/fetch_test_data.py).
-G1 = Path(__file__).resolve().parents[2] / ".testdata" / "hurodes-fixtures" / "g1_29"
-
-
-def _robot(name: str):
-    if name == "g1":
-        if not (G1 / "meta.yaml").is_file():
-            pytest.skip("the G1 fixture comes from tools/fetch_test_data.py (not fetched)")
-        return load_robot(str(G1))
-    if name in ("go2", "talos") and find_entry(name) is None:
-        pytest.skip(f"{name} comes from example-robot-data (not installed)")
-    if name in ("go2", "talos"):
-        from robotwright.parsers import urdf_to_hrdf
-
-        # Torque motors from the URDF's effort and velocity limits (drives to carry), and
-        # the free base a legged robot has.
-        return urdf_to_hrdf(find_entry(name).path, actuators="motor", floating_base=True)
-    return load_robot(name)
 
 
 @pytest.mark.parametrize("name", ROBOTS)
 def test_export_carries_drives_and_proves_equal(name, tmp_path):
-    hrdf = _robot(name)
+    hrdf = robot_named(name)
     out = tmp_path / f"{name}.usda"
     done = to_usd(hrdf, out)
     proof = done.proof
@@ -149,7 +130,7 @@ def test_articulation_cfg_spawns_and_a_free_base_robot_does_not_explode(tmp_path
 
     from robotwright.generators.isaaclab_cfg import write_articulation_cfg
 
-    hrdf = _robot("go2")
+    hrdf = robot_named("go2")
     module_path, usd = write_articulation_cfg(hrdf, tmp_path / "go2_cfg.py")
     assert usd.is_file()
     robot_cfg = _load_module(module_path).ROBOT_CFG.replace(prim_path="{ENV_REGEX_NS}/Robot")

@@ -967,7 +967,32 @@ def parse_mjcf(
         raise  # a file over the size limit: refused before MuJoCo read it
     except ValueError as exc:
         raise ConversionError([Problem(str(path), f"MuJoCo cannot load it: {exc}")]) from exc
+    return _from_compiled(spec, model, path, opt, rep, strict)
 
+
+def parse_mjcf_spec(
+    spec: mujoco.MjSpec, path: Path, options: MJCFOptions | None = None, *, strict: bool = False
+) -> ParseResult:
+    """An HRDF from a spec built in memory by another reader (its values exactly: an
+    MJCF text would keep 6 digits). ``path`` names the source in notes, and its folder
+    holds the spec's mesh files (``spec.modelfiledir``)."""
+    rep = Reporter(str(path))
+    try:
+        model = spec.compile()
+    except ValueError as exc:
+        raise ConversionError([Problem(str(path), f"MuJoCo cannot compile it: {exc}")]) from exc
+    return _from_compiled(spec, model, Path(path), options or MJCFOptions(), rep, strict)
+
+
+def _from_compiled(
+    spec: mujoco.MjSpec,
+    model: mujoco.MjModel,
+    path: Path,
+    opt: MJCFOptions,
+    rep: Reporter,
+    strict: bool,
+) -> ParseResult:
+    """The HRDF of a compiled spec (the body of :func:`parse_mjcf`)."""
     root_id, keep = _select_robot(model, path, opt, rep)
     kept = set(keep)
     frames = _frames_as_sites(model, keep, root_id, opt)

@@ -32,6 +32,7 @@ on Python 3.12).
 from __future__ import annotations
 
 import functools
+import hashlib
 import os
 import tempfile
 import warnings
@@ -150,9 +151,8 @@ def check_usd_dependencies(path: Path, roots: list[Path]) -> None:
                     f"asset path {text!r} points outside the file's folder ({target}); "
                     "trust its folder with --asset-root to read it",
                 )
-            if asset in sub or asset in refs or asset in payloads:
-                if target.suffix.lower() in (*USD_SUFFIXES, ".usdz"):
-                    todo.append(target)
+            if target.suffix.lower() in (*USD_SUFFIXES, ".usdz"):
+                todo.append(target)  # a layer: its own paths are checked in turn
 
 
 # -- reading --------------------------------------------------------------------------
@@ -189,12 +189,16 @@ class _Names:
         for kind, pairs in self.renamed.items():
             if kind in ("body", "joint", "actuator"):
                 for label, name in pairs:
-                    rep.warn(f"{kind} name {_leaf(label)!r} is used by several prims; {label} "
-                             f"becomes {name!r}")
+                    rep.warn(
+                        f"{kind} name {_leaf(label)!r} is used by several prims; {label} "
+                        f"becomes {name!r}"
+                    )
             elif kind != "mesh":
                 shown = ", ".join(f"{label} -> {name!r}" for label, name in pairs[:3])
-                rep.warn(f"{len(pairs)} {kind}(s) share a prim name with another and get a "
-                         f"suffix: {shown}{', ...' if len(pairs) > 3 else ''}")
+                rep.warn(
+                    f"{len(pairs)} {kind}(s) share a prim name with another and get a "
+                    f"suffix: {shown}{', ...' if len(pairs) > 3 else ''}"
+                )
 
 
 def _pose(t: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -327,7 +331,13 @@ class _Builder:
             kinds = [mujoco.mjtJoint.mjJNT_SLIDE] * lin + [mujoco.mjtJoint.mjJNT_HINGE] * ang
         else:
             raise ConversionError(
-                [Problem(self.rep.file, f"Newton joint type {jtype} has no MuJoCo joint", element=label)]
+                [
+                    Problem(
+                        self.rep.file,
+                        f"Newton joint type {jtype} has no MuJoCo joint",
+                        element=label,
+                    )
+                ]
             )
         for k, kind in enumerate(kinds):
             d = d0 + k
@@ -439,15 +449,16 @@ class _Builder:
 
         src = self.nb.shape_source[s]
         label = self.nb.shape_label[s]
-        key = (id(src), tuple(scale))
-        if key in self.meshes:
-            return self.meshes[key]
-        name = self.names("mesh", label)
         points = _mesh_prim(self.stage, label)
-        if points is None:  # Newton's copy (a collider's may be reduced to its hull)
+        if points is None:  # Newton's copy
             points = (src.vertices, np.asarray(src.indices).reshape(-1, 3))
         vertices = np.asarray(points[0], dtype=np.float64) * scale
         faces = np.asarray(points[1], dtype=np.int64)
+        # One asset per distinct mesh: a flattened USD repeats the points of each use.
+        key = (hashlib.sha1(vertices.tobytes() + faces.tobytes()).hexdigest(),)
+        if key in self.meshes:
+            return self.meshes[key]
+        name = self.names("mesh", label)
         trimesh.Trimesh(vertices, faces, process=False).export(self.mesh_dir / f"{name}.stl")
         self.spec.add_mesh(name=name, file=f"{name}.stl")
         self.meshes[key] = name
@@ -512,7 +523,11 @@ _TOKENS = {
     "biasType": ("biastype", mujoco.mjtBias, "mjBIAS_"),
     "dynType": ("dyntype", mujoco.mjtDyn, "mjDYN_"),
 }
-_LIMITED = {"ctrlLimited": "ctrllimited", "forceLimited": "forcelimited", "actLimited": "actlimited"}
+_LIMITED = {
+    "ctrlLimited": "ctrllimited",
+    "forceLimited": "forcelimited",
+    "actLimited": "actlimited",
+}
 _RANGES = {"ctrlRange": "ctrlrange", "forceRange": "forcerange", "actRange": "actrange"}
 _ARRAYS = {"gainPrm": "gainprm", "biasPrm": "biasprm", "dynPrm": "dynprm", "gear": "gear"}
 
@@ -602,7 +617,7 @@ def parse_usd(
         InputFileError: a layer or asset path outside the file's folder.
     """
     from robotwright._paths import trusted_roots
-    from robotwright.parsers.mjcf import MJCFOptions, parse_mjcf
+    from robotwright.parsers.mjcf import MJCFOptions, parse_mjcf_spec
 
     path = Path(path)
     opt = options or USDOptions()
@@ -634,14 +649,17 @@ def parse_usd(
         _note_unread(stage, rep)
         builder.names.report(rep)
         builder.report_unread()
-        mjcf = folder / f"{spec.modelname}.xml"
         spec.modelfiledir = str(folder)  # mesh files are named relative to it
         try:
-            mjcf.write_text(spec.to_xml())
-        except ValueError as exc:  # MuJoCo's compiler names the element
-            raise InputFileError(path, f"MuJoCo refuses the robot read from it: {exc}") from None
-        parsed = parse_mjcf(mjcf, MJCFOptions(work_dir=opt.work_dir), strict=False)
+            parsed = parse_mjcf_spec(
+                spec, folder / f"{spec.modelname}.xml", MJCFOptions(work_dir=opt.work_dir)
+            )
+        except ConversionError as exc:  # MuJoCo's compiler names the element
+            raise InputFileError(
+                path, f"MuJoCo refuses the robot read from it: {exc.problems[0].message}"
+            ) from None
     hrdf = parsed.hrdf
+    mjcf = folder / f"{spec.modelname}.xml"
     hrdf = _peak_velocities(hrdf, nb, builder)
     for p in parsed.warnings:
         rep.warn(p.message.replace(str(mjcf), str(path)), p.element)
