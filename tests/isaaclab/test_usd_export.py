@@ -180,3 +180,38 @@ def test_articulation_cfg_spawns_and_a_free_base_robot_does_not_explode(tmp_path
         vel = robot.data.joint_vel_limits.torch[0]
         want = torch.tensor([a.peak_velocity for a in hrdf.actuators], dtype=vel.dtype)
         assert torch.allclose(vel.sort().values, want.sort().values, rtol=1e-5)
+
+
+@pytest.mark.parametrize("name", ["go2", "g1"])
+def test_flat_layout_puts_every_body_under_the_robot_and_proves_equal(name, tmp_path):
+    """--usd-layout flat: each body a child of /<robot> (as Isaac Lab's importers write
+    them), joints and actuators pointing at the moved prims, the proof still exact, and
+    the file reads back as the robot."""
+    from robotwright.parsers.api import usd_to_hrdf_with_warnings
+
+    hrdf = robot_named(name)
+    out = tmp_path / f"{name}.usda"
+    done = to_usd(hrdf, out, layout="flat")
+    assert not done.proof.differences and done.proof.bodies == len(hrdf.bodies)
+    stage = Usd.Stage.Open(str(out))
+    root = stage.GetDefaultPrim().GetPath()
+    bodies = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)]
+    assert {p.GetName() for p in bodies} == {b.name for b in hrdf.bodies}
+    assert all(p.GetPath().GetParentPath() == root for p in bodies)
+    assert not stage.GetPrimAtPath(root.AppendChild("Geometry"))
+    for prim in stage.Traverse():  # nothing points at a prim that moved away
+        for rel in prim.GetRelationships():
+            assert all(stage.GetPrimAtPath(t) for t in rel.GetTargets()), rel.GetPath()
+    assert all(stage.GetPrimAtPath(p) for p in done.joint_prims.values())
+    back, _ = usd_to_hrdf_with_warnings(out, work_dir=tmp_path / "w")
+    assert {b.name for b in back.bodies} == {b.name for b in hrdf.bodies}
+    assert [a.joint for a in back.actuators] == [a.joint for a in hrdf.actuators]
+    parents = {b.name: hrdf.bodies[b.parent].name if b.parent >= 0 else None for b in hrdf.bodies}
+    got = {b.name: back.bodies[b.parent].name if b.parent >= 0 else None for b in back.bodies}
+    assert got == parents  # the kinematic tree comes from the joints, not the prim nesting
+
+
+def test_usd_layout_applies_to_usd_only(tmp_path):
+    run = _cli(tmp_path, "export", "arm6", "-o", "a.xml", "--usd-layout", "flat")
+    assert run.returncode == 2 and "--usd-layout applies to USD" in run.stderr
+    assert not (tmp_path / "a.xml").exists()

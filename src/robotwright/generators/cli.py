@@ -17,6 +17,17 @@ _EXPORT_FORMAT_HELP = (
 )
 
 
+def _add_usd_layout(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--usd-layout",
+        choices=("nested", "flat"),
+        default="nested",
+        help="USD: bodies nested as the kinematic tree (default, the converter's) or flat, "
+        "each a child of the robot's prim as Isaac Lab's importers write them (its body "
+        "expressions and PhysX contact sensors expect that)",
+    )
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "export",
@@ -49,6 +60,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--strict", action="store_true", help="fail instead of writing when a value is lost"
     )
+    _add_usd_layout(p)
     p.add_argument(
         "-o",
         "--output",
@@ -71,6 +83,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--strict", action="store_true", help="fail instead of writing when the USD's proof differs"
     )
+    _add_usd_layout(p)
     p.add_argument("-o", "--output", required=True, help="the module to write (.py)")
     add_overwrite_flag(p)
     p.set_defaults(func=_isaaclab_cfg)
@@ -141,6 +154,8 @@ def _export(args: argparse.Namespace) -> int:
     from robotwright.hrdf.compiles import require_compiles
 
     args.format = output_format(args.output, args.format)
+    if args.usd_layout != "nested" and args.format != "usd":
+        raise GeneratorError(f"--usd-layout applies to USD output, not {args.format.upper()}")
     check_overwrite(args.output, args.overwrite)
     hrdf = load_robot(args.robot)
     out = Path(args.output)
@@ -151,7 +166,9 @@ def _export(args: argparse.Namespace) -> int:
     if args.format == "usd":
         from robotwright.generators.usd import to_usd
 
-        done = to_usd(hrdf, out, overwrite=args.overwrite, strict=args.strict)
+        done = to_usd(
+            hrdf, out, overwrite=args.overwrite, strict=args.strict, layout=args.usd_layout
+        )
         proof = done.proof
         print(
             f"wrote {out} (usd, robot '{hrdf.name}', root {done.root}, {len(done.drives)} "
@@ -190,7 +207,7 @@ def _isaaclab_cfg(args: argparse.Namespace) -> int:
     check_overwrite(args.output, args.overwrite)
     hrdf = load_robot(args.robot)
     module, usd = write_articulation_cfg(
-        hrdf, args.output, overwrite=args.overwrite, strict=args.strict
+        hrdf, args.output, overwrite=args.overwrite, strict=args.strict, layout=args.usd_layout
     )
     print(f"wrote {module} (ROBOT_CFG) and {usd}")
     return 0

@@ -172,9 +172,15 @@ def articulation_cfg_source(
 
 
 def write_articulation_cfg(
-    hrdf: HRDF, output: str | Path, *, overwrite: bool = False, strict: bool = False
+    hrdf: HRDF,
+    output: str | Path,
+    *,
+    overwrite: bool = False,
+    strict: bool = False,
+    layout: str = "nested",
 ) -> tuple[Path, Path]:
-    """Write ``<output>`` (the module) and ``<robot name>.usd`` beside it.
+    """Write ``<output>`` (the module) and ``<robot name>.usd`` beside it (``layout``: see
+    :func:`~robotwright.generators.usd.to_usd`).
 
     Returns:
         (module path, USD path).
@@ -187,7 +193,7 @@ def write_articulation_cfg(
     if out.exists() and not overwrite:
         raise GeneratorError(f"{out} exists (pass overwrite=True / --overwrite)")
     usd = out.with_name(f"{hrdf.name}.usd")
-    done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict)
+    done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout)
     try:  # the initial state comes from the MJCF the USD was made from
         text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name)
     except GeneratorError:

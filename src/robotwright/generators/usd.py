@@ -35,7 +35,7 @@ import mujoco
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
 
-__all__ = ["USD_SUFFIXES", "UsdExport", "to_usd"]
+__all__ = ["USD_LAYOUTS", "USD_SUFFIXES", "UsdExport", "to_usd"]
 
 USD_SUFFIXES = (".usd", ".usda", ".usdc")
 _MISSING = (
@@ -174,6 +174,66 @@ def _author_free_joint_names(stage, model: mujoco.MjModel) -> None:
             attr.Set(name)
 
 
+USD_LAYOUTS = ("nested", "flat")
+
+
+def _flatten_bodies(stage) -> None:
+    """Move every rigid body to a direct child of the default prim (``/<robot>/<body>``)
+    at its pose relative to it, and point every relationship (joint bodies, actuator
+    targets) at the moved prims. The
+    converter nests bodies as the kinematic tree (``/<robot>/Geometry/base/hip/...``);
+    Isaac Lab's importers write them flat, which its body expressions and PhysX contact
+    sensors expect."""
+    from pxr import Gf, Sdf, UsdGeom, UsdPhysics
+
+    root = stage.GetDefaultPrim()
+    layer = stage.GetRootLayer()
+    bodies = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)]
+    cache = UsdGeom.XformCache()
+    poses = {p.GetPath(): cache.ComputeRelativeTransform(p, root)[0] for p in bodies}
+    moved = {p.GetPath(): root.GetPath().AppendChild(p.GetName()) for p in bodies}
+    taken = {c.GetName() for c in root.GetChildren()}
+    clash = sorted(taken & {p.GetName() for p in bodies})
+    if clash:
+        raise GeneratorError(
+            f"--usd-layout flat: body name(s) {clash} equal a prim of the robot's own "
+            f"(/{root.GetName()}/{clash[0]}); rename the body or use the nested layout"
+        )
+    for old, new in moved.items():
+        Sdf.CopySpec(layer, old, layer, new)
+        spec = layer.GetPrimAtPath(new)
+        for child in list(spec.nameChildren):
+            if old.AppendChild(child.name) in moved:  # a body of its own: moved itself
+                del spec.nameChildren[child.name]
+    tops = [old for old in moved if old.GetParentPath() not in moved]
+    for old in tops:
+        parent = layer.GetPrimAtPath(old.GetParentPath())
+        del parent.nameChildren[old.name]
+        if parent.path != root.GetPath() and not parent.nameChildren:
+            del layer.GetPrimAtPath(parent.path.GetParentPath()).nameChildren[parent.name]
+    for old, new in moved.items():
+        xf = UsdGeom.Xformable(stage.GetPrimAtPath(new))
+        m = poses[old]
+        xf.ClearXformOpOrder()
+        xf.AddTranslateOp().Set(m.ExtractTranslation())
+        xf.AddOrientOp().Set(Gf.Quatf(m.ExtractRotationQuat()))
+        xf.AddScaleOp().Set(Gf.Vec3f(1.0, 1.0, 1.0))
+    by_depth = sorted(moved, key=lambda p: -p.pathElementCount)
+
+    def retarget(path):
+        for old in by_depth:  # the deepest body holding the path
+            if path.HasPrefix(old):
+                return path.ReplacePrefix(old, moved[old])
+        return path
+
+    for prim in stage.Traverse():
+        for rel in prim.GetRelationships():
+            targets = rel.GetTargets()
+            new_targets = [retarget(t) for t in targets]
+            if new_targets != targets:
+                rel.SetTargets(new_targets)
+
+
 def to_usd(
     hrdf: HRDF,
     output: str | Path,
@@ -181,6 +241,7 @@ def to_usd(
     overwrite: bool = False,
     prove: bool = True,
     strict: bool = False,
+    layout: str = "nested",
 ) -> UsdExport:
     """Write ``hrdf`` as one USD file (see the module docstring for what is authored).
 
@@ -190,9 +251,13 @@ def to_usd(
     under ``strict`` a :class:`~robotwright.errors.ConversionError` before the file is
     put in place.
 
+    ``layout``: ``"nested"`` (the converter's: bodies nested as the kinematic tree under
+    ``/<robot>/Geometry``) or ``"flat"`` (every body a child of ``/<robot>``, as Isaac
+    Lab's importers write and its PhysX contact sensors expect).
+
     Raises:
-        GeneratorError: the converter is missing, the suffix is not a USD one, or the
-            output exists without ``overwrite``.
+        GeneratorError: the converter is missing, the suffix is not a USD one, the
+            layout is unknown, or the output exists without ``overwrite``.
         ConversionError: ``strict`` and the proof or a note found a difference.
     """
     out_path = Path(output)
@@ -202,6 +267,8 @@ def to_usd(
         )
     if out_path.exists() and not overwrite:
         raise GeneratorError(f"{out_path} exists (pass overwrite=True / --overwrite)")
+    if layout not in USD_LAYOUTS:
+        raise GeneratorError(f"layout={layout!r}: expected one of {', '.join(USD_LAYOUTS)}")
     converter = _converter()
     from pxr import Usd
 
@@ -227,6 +294,16 @@ def to_usd(
         _author_drives(stage, hrdf, _joint_kinds(model), result)
         _author_free_joint_names(stage, model)
         flat = stage.Flatten()
+        if layout == "flat":
+            from pxr import UsdPhysics
+
+            flat_stage = Usd.Stage.Open(flat)
+            _flatten_bodies(flat_stage)
+            result.joint_prims = {
+                p.GetName(): str(p.GetPath())
+                for p in flat_stage.Traverse()
+                if p.IsA(UsdPhysics.Joint) and p.GetName() in result.joint_prims
+            }
         out_path.parent.mkdir(parents=True, exist_ok=True)
         partial = out_path.with_name(f".{out_path.name}.partial{out_path.suffix}")
         try:

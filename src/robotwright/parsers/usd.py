@@ -75,7 +75,7 @@ class USDOptions:
     asset_roots: tuple[str | os.PathLike, ...] = ()
 
 
-def _newton() -> Any:
+def _newton(file: str = "") -> Any:
     try:
         from robotwright._warp import quiet_warp
 
@@ -83,7 +83,7 @@ def _newton() -> Any:
         import newton
         from pxr import Sdf, Usd  # noqa: F401
     except ImportError as exc:
-        raise ConversionError([Problem("", _MISSING.format(error=exc))]) from None
+        raise ConversionError([Problem(file, _MISSING.format(error=exc))]) from None
     return newton
 
 
@@ -621,7 +621,7 @@ def parse_usd(
 
     path = Path(path)
     opt = options or USDOptions()
-    newton = _newton()
+    newton = _newton(str(path))
     from pxr import Usd
 
     rep = Reporter(str(path))
