@@ -1,4 +1,4 @@
-"""Parsers: MJCF and URDF files into the in-memory HRDF model.
+"""Parsers: MJCF, URDF and USD files into the in-memory HRDF model.
 
 >>> from robotwright.parsers import urdf_to_hrdf, mjcf_to_hrdf
 >>> robot = urdf_to_hrdf("panda.urdf")                      # HRDF; warnings are logged
@@ -15,6 +15,8 @@ if TYPE_CHECKING:
         mjcf_to_hrdf_with_warnings,
         urdf_to_hrdf,
         urdf_to_hrdf_with_warnings,
+        usd_to_hrdf,
+        usd_to_hrdf_with_warnings,
     )
     from robotwright.parsers.report import ParseResult
     from robotwright.parsers.urdf import URDFOptions
@@ -26,6 +28,8 @@ __all__ = [
     "mjcf_to_hrdf_with_warnings",
     "urdf_to_hrdf",
     "urdf_to_hrdf_with_warnings",
+    "usd_to_hrdf",
+    "usd_to_hrdf_with_warnings",
 ]
 
 attach(__name__, __file__)

@@ -140,13 +140,14 @@ def load_source(
     _no_scene(scene, f"'{text}'")
     if path.is_dir() and (path / "design.txt").is_file():
         return _design_scene(path, asset_roots)
-    if path.is_file() and suffix not in (".xml", ".mjcf", ".urdf", ".xacro"):
+    robot_files = (".xml", ".mjcf", ".urdf", ".xacro", ".usd", ".usda", ".usdc")
+    if path.is_file() and suffix not in robot_files:
         raise ViewError(
             f"{path}: cannot show a '{suffix or 'extensionless'}' file; expected an MJCF "
-            "(.xml), a URDF (.urdf) or xacro (.xacro) file, a scan (.npz), an HRDF or design "
-            "folder, or a robot name"
+            "(.xml), a URDF (.urdf), xacro (.xacro) or USD (.usd, .usda, .usdc) file, a scan "
+            "(.npz), an HRDF or design folder, or a robot name"
         )
-    if not path.exists() and suffix in (".xml", ".mjcf", ".urdf", ".xacro"):
+    if not path.exists() and suffix in robot_files:
         raise ViewError(f"{path}: no such file")
     return _robot_scene(text, asset_roots)
 
