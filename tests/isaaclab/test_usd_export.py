@@ -237,3 +237,39 @@ def test_usd_layout_applies_to_usd_only(tmp_path):
     run = _cli(tmp_path, "export", "arm6", "-o", "a.xml", "--usd-layout", "flat")
     assert run.returncode == 2 and "--usd-layout applies to USD" in run.stderr
     assert not (tmp_path / "a.xml").exists()
+
+
+QUADRUPED_MASS_FROM_GEOMS = """<mujoco model="q">
+  <worldbody>
+    <body name="base" pos="0 0 0.4">
+      <freejoint name="root"/>
+      <geom type="box" size="0.2 0.1 0.05" mass="6"/>
+      <body name="leg" pos="0.2 0.1 0">
+        <joint name="hip" axis="0 1 0" range="-1 1"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="0.5"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("layout", ["nested", "flat"])
+def test_masses_from_geoms_read_back_per_body(tmp_path, layout):
+    """The reported 'parents' masses with their children's added' (docs/generators.md):
+    bodies whose mass comes from their geoms. Our export writes each body's own mass,
+    centre of mass and inertia on the body, so Newton reads 6 and 0.5 kg, not 6.5."""
+    from robotwright.parsers import mjcf_to_hrdf
+
+    (tmp_path / "q.xml").write_text(QUADRUPED_MASS_FROM_GEOMS)
+    hrdf = mjcf_to_hrdf(tmp_path / "q.xml")
+    done = to_usd(hrdf, tmp_path / "q.usda", layout=layout)
+    assert not done.proof.differences, done.proof.differences
+    assert done.proof.bodies == 2
+    stage = Usd.Stage.Open(str(tmp_path / "q.usda"))
+    masses = {
+        p.GetName(): UsdPhysics.MassAPI(p).GetMassAttr().Get()
+        for p in stage.Traverse()
+        if p.HasAPI(UsdPhysics.RigidBodyAPI)
+    }
+    assert masses == pytest.approx({"base": 6.0, "leg": 0.5})
