@@ -177,8 +177,9 @@ def test_articulation_cfg_spawns_and_a_free_base_robot_stands(tmp_path):
         assert sim.stage.GetPrimAtPath("/World/envs/env_0/Robot/base").IsValid()
         start = float(robot.data.root_pos_w.torch[0, 2])
         heights = []
+        stand = robot.data.default_joint_pos.torch.clone()
         for _ in range(600):  # 3 s
-            robot.set_joint_position_target(robot.data.default_joint_pos.torch)
+            robot.actuators.target_command.set_position_index(value=stand)
             scene.write_data_to_sim()
             sim.step()
             scene.update(sim.get_physics_dt())
