@@ -243,10 +243,11 @@ class _Builder:
         self.joint_names: dict[int, str] = {}  # Newton joint -> first MJCF joint
         self.dof_joint: dict[int, str] = {}  # Newton dof -> MJCF joint
         self.meshes: dict[tuple, str] = {}
+        self.by_child: dict[int, int] = {}  # Newton body -> the joint whose child it is
 
     def build(self) -> mujoco.MjSpec:
         nb = self.nb
-        by_child = {int(c): j for j, c in enumerate(nb.joint_child)}
+        self.by_child = by_child = {int(c): j for j, c in enumerate(nb.joint_child)}
         children: dict[int, list[int]] = {}
         for b in range(nb.body_count):
             j = by_child.get(b)
@@ -294,13 +295,7 @@ class _Builder:
         ):  # prim order (Newton reads colliders before visuals): contact order is kept
             self._shape(body, s)
         for child in children.get(b, []):
-            self._body(body, child, self._joint_of(child), children)
-
-    def _joint_of(self, b: int) -> int | None:
-        for j, c in enumerate(self.nb.joint_child):
-            if int(c) == b:
-                return j
-        return None
+            self._body(body, child, self.by_child.get(child), children)
 
     def _joints(self, body: Any, j: int, jtype: int) -> None:
         nb, JT = self.nb, self.newton.JointType
