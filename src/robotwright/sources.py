@@ -8,8 +8,9 @@ description packages; ``SOURCE:NAME`` picks one source). :func:`load_robot` read
 into an :class:`~robotwright.hrdf.model.HRDF` with the project's readers.
 
 The command line adds one option group to every command that reads a robot
-(:func:`add_source_options`: ``--root-body``, ``--fixed-joints``, ``--bound-mass``,
-``--bound-inertia``, ``--inertia-from-geoms``, ``--density``, ``--xacro-arg``; with
+(:func:`add_source_options`: ``--root-body``, ``--fixed-joints``, ``--floating-base``,
+``--bound-mass``, ``--bound-inertia``, ``--inertia-from-geoms``, ``--density``,
+``--xacro-arg``; with
 ``--asset-root`` and ``--package``, which ``robotwright.cli`` adds) and hands the
 options to the readers for the command's run with :func:`given_source_options`, as
 ``--package`` is handed with :func:`robotwright.parsers.packages.given_packages`. An
@@ -59,7 +60,14 @@ FILE_KINDS = {
 }
 
 #: Options of the shared group, by the source kinds they apply to.
-URDF_OPTIONS = ("fixed_joints", "bound_mass", "bound_inertia", "inertia_from_geoms", "density")
+URDF_OPTIONS = (
+    "fixed_joints",
+    "bound_mass",
+    "bound_inertia",
+    "inertia_from_geoms",
+    "density",
+    "floating_base",
+)
 MJCF_OPTIONS = ("root_body",)
 XACRO_OPTIONS = ("xacro_args",)
 
@@ -154,6 +162,14 @@ def add_source_options(p: argparse.ArgumentParser) -> None:
         type=_float_arg("density > 0 [kg/m^3]", positive=True),
         metavar="KG_M3",
         help="URDF, --inertia-from-geoms auto: density of those collision geoms (default 1000)",
+    )
+    add(
+        "--floating-base",
+        action="store_const",
+        const=True,
+        default=None,
+        help="URDF: give the root link a free joint (a legged robot's base; URDF has none); "
+        "render, view and lidar then stand it on the floor",
     )
     add(
         "--xacro-arg",

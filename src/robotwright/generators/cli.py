@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import argparse
 import re
+import warnings
 from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag, check_overwrite
-from robotwright.errors import GeneratorError
+from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.placement import Placement
 
 _FORMAT_HELP = "mjcf or urdf (default: from the -o file name: .urdf is URDF, .xml or .mjcf is MJCF)"
@@ -185,6 +186,13 @@ def _export(args: argparse.Namespace) -> int:
             add_scene=not args.no_scene,
             strict=args.strict,
         )
+        if not args.no_scene:  # said, so that nobody takes the floor for the robot's
+            warnings.warn(
+                f"{out}: scene added: a floor plane 'floor', a light and a sky, not part of "
+                "the robot (--no-scene leaves them out)",
+                ConversionWarning,
+                stacklevel=1,
+            )
     else:
         if args.prefix:
             raise GeneratorError("--prefix applies to MJCF; URDF composites prefix by robot")

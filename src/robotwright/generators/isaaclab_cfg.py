@@ -98,20 +98,13 @@ def _initial_state(
 def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> float:
     """How far [m] to raise a free-base robot (at its initial joint positions) so that
     the lowest corner of its collision geoms' bounding boxes is on z = 0."""
+    from robotwright._mjmodel import lowest_collision_point
+
     data = mujoco.MjData(model)
     for name, q in joint_pos.items():
         data.joint(name).qpos[0] = q
     mujoco.mj_kinematics(model, data)
-    lowest = math.inf
-    signs = [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
-    for g in range(model.ngeom):
-        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
-            continue
-        center, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
-        rot = data.geom_xmat[g].reshape(3, 3)
-        for sign in signs:
-            corner = data.geom_xpos[g] + rot @ (center + half * sign)
-            lowest = min(lowest, float(corner[2]))
+    lowest = lowest_collision_point(model, data)
     return 0.0 if not math.isfinite(lowest) else -lowest
 
 

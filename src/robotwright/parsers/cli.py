@@ -31,6 +31,8 @@ def _options(args: argparse.Namespace) -> dict:
             opts[name] = True
     if getattr(args, "actuators", None):
         opts["actuators"] = args.actuators
+    if getattr(args, "floating_base", None):
+        opts["floating_base"] = True
     if getattr(args, "inertia_from_geoms", None):
         opts["inertia_from_geoms"] = args.inertia_from_geoms
     if getattr(args, "xacro_arg", None):
@@ -161,6 +163,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     _source_args(p)
     p.add_argument("--strict", action="store_true", help="fail instead of dropping anything")
+    p.add_argument(
+        "--scene",
+        action="store_true",
+        help="MJCF output: add a floor, a light and a sky (default: the robot alone, as read)",
+    )
     add_overwrite_flag(p)
     _repair_args(p)
     p.add_argument(
@@ -266,7 +273,12 @@ def _convert(args: argparse.Namespace) -> int:
     # An existing empty folder holds nothing to lose: the rule lets it be written into.
     overwrite = args.overwrite or Path(args.output).is_dir()
     messages = convert(
-        source, args.output, strict=args.strict, overwrite=overwrite, **_options(args)
+        source,
+        args.output,
+        strict=args.strict,
+        overwrite=overwrite,
+        scene=args.scene,
+        **_options(args),
     )
     # Reported like every command's losses: one summary line, each with -v.
     for m in messages:

@@ -88,9 +88,13 @@ def convert(
     strict: bool = False,
     overwrite: bool = False,
     proof: bool = True,
+    scene: bool = False,
     **options: Any,
 ) -> list[str]:
     """Convert ``src`` to ``dst``; returns every warning (parser and writer) as text.
+
+    An MJCF output holds the robot and nothing else; ``scene=True`` adds a floor, a light
+    and a sky (one note names them: they are not the source's).
 
     With ``proof`` (the default), an MJCF or URDF source that MuJoCo compiles is compared
     with the output, compiled, field by field (:mod:`robotwright.parsers.proof`): each
@@ -105,12 +109,14 @@ def convert(
     out_kind = file_kind(dst_p, existing=False)
     if dst_p.exists() and not overwrite:
         raise OutputExistsError(f"{dst_p} exists (pass overwrite=True / --overwrite)")
+    if scene and out_kind != "mjcf":
+        raise ConversionError([Problem(str(dst_p), "scene=True / --scene applies to MJCF output")])
     if "work_dir" in options or file_kind(src_p, existing=True) == "hrdf":
-        return _convert(src_p, dst_p, out_kind, strict, overwrite, options, proof)
+        return _convert(src_p, dst_p, out_kind, strict, overwrite, options, proof, scene)
     # The output gets its own copies of the meshes: staging lives only for the call.
     with tempfile.TemporaryDirectory(prefix="robotwright-convert-") as tmp:
         return _convert(
-            src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp}, proof
+            src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp}, proof, scene
         )
 
 
@@ -122,6 +128,7 @@ def _convert(
     overwrite: bool,
     options: dict[str, Any],
     proof: bool = True,
+    scene: bool = False,
 ) -> list[str]:
     from robotwright._confine import run_confined
     from robotwright.hrdf.compiles import require_compiles
@@ -163,8 +170,20 @@ def _convert(
             else:
                 from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
 
-                gen_cls = MJCFHumanoidGenerator if out_kind == "mjcf" else URDFHumanoidGenerator
-                gen_cls.from_hrdf(hrdf).export(dst_p, copy_meshes=True, strict=strict)
+                if out_kind == "mjcf":
+                    # The robot alone, as the proof compiled it; a scene only when asked.
+                    MJCFHumanoidGenerator.from_hrdf(hrdf).export(
+                        dst_p, copy_meshes=True, strict=strict, add_scene=scene
+                    )
+                    if scene:
+                        messages.append(
+                            f"{dst_p}: scene added (asked for with --scene): a floor plane "
+                            "'floor', a light and a sky; not part of the source robot"
+                        )
+                else:
+                    URDFHumanoidGenerator.from_hrdf(hrdf).export(
+                        dst_p, copy_meshes=True, strict=strict
+                    )
         except HRDFError as exc:
             massless = any(p.column in ("mass", "diag_inertia") for p in exc.problems)
             hint = (

@@ -207,6 +207,14 @@ def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
         return ViewScene(model, resolved.title, "mjcf", text)
     hrdf, notes = load_robot_with_notes(text, asset_roots=tuple(asset_roots))
     model, more, shown = _hrdf_model(hrdf)
+    from robotwright._mjmodel import stand_on_floor
+
+    shift = stand_on_floor(model)
+    if shift:  # a floating base: on the floor, not at its root's height
+        more.append(
+            f"robot '{hrdf.name}' floats: placed {'up' if shift > 0 else 'down'} by "
+            f"{abs(shift):.3g} m so that its lowest collision geom touches the floor (z = 0)"
+        )
     kind = "robot" if resolved.kind == "hrdf" else resolved.kind.replace("xacro", "urdf")
     title = hrdf.name if resolved.kind == "hrdf" else resolved.title
     return ViewScene(model, title, kind, text, notes=notes + more, warnings=shown)
