@@ -65,7 +65,7 @@ REFERENCE_ATTRS: frozenset[str] = frozenset(
         "site", "site1", "site2", "refsite", "cranksite", "slidersite", "sidesite",
         "tendon", "tendon1", "tendon2",
         "geom", "geom1", "geom2",
-        "actuator", "objname", "refname",
+        "actuator", "objname", "refname", "instance",
         "mesh", "material", "texture", "hfield", "camera", "target", "flex",
     }
 )  # fmt: skip
@@ -81,7 +81,7 @@ BODY_NAMESPACES: dict[str, str] = {
 
 #: Top-level sections in the order they are written.
 SECTION_ORDER: tuple[str, ...] = (
-    "compiler", "option", "size", "visual", "statistic", "asset", "worldbody",
+    "compiler", "option", "size", "extension", "visual", "statistic", "asset", "worldbody",
     "contact", "equality", "tendon", "actuator", "sensor", "keyframe",
 )  # fmt: skip
 

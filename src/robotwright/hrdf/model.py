@@ -94,6 +94,7 @@ INTEGRATORS: tuple[str, ...] = ("Euler", "RK4", "implicit", "implicitfast")
 GROUND_TYPES: tuple[str, ...] = ("plane",)
 #: Top-level sections ``extra.xml`` (``HRDF.mjcf_extra``) may hold.
 EXTRA_SECTIONS: tuple[str, ...] = (
+    "extension",
     "tendon",
     "equality",
     "contact",

@@ -311,14 +311,66 @@ def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
     return ET.Element("general", attrs)
 
 
+def _plugin_elem(model: mujoco.MjModel, spec: mujoco.MjSpec, i: int) -> ET.Element:
+    """A plugin actuator (``mujoco.pid``, ...) as its ``<plugin>`` element: the plugin,
+    its instance (or its own ``<config>`` lines), the transmission, ranges and the
+    activation count the plugin keeps."""
+    attrs: dict[str, str] = {}
+    if model.actuator(i).name:
+        attrs["name"] = model.actuator(i).name
+    attr, target = _actuator_target(model, i)
+    attrs[attr] = target
+    plugin = spec.actuators[i].plugin
+    attrs["plugin"] = plugin.plugin_name
+    if plugin.name:
+        attrs["instance"] = plugin.name
+    if model.actuator_group[i]:
+        attrs["group"] = str(int(model.actuator_group[i]))
+    attrs["gear"] = _fmt(model.actuator_gear[i])
+    for flag, rng in (("ctrl", "ctrlrange"), ("force", "forcerange"), ("act", "actrange")):
+        limited = bool(getattr(model, f"actuator_{flag}limited")[i])
+        attrs[f"{flag}limited"] = "true" if limited else "false"
+        if limited:
+            attrs[rng] = _fmt(getattr(model, f"actuator_{rng}")[i])
+    attrs["actdim"] = str(int(model.actuator_actnum[i]))
+    elem = ET.Element("plugin", attrs)
+    if not plugin.name:
+        for key, value in sorted(plugin.config.items()):
+            ET.SubElement(elem, "config", {"key": key, "value": value})
+    return elem
+
+
+def _plugin_instances(spec: mujoco.MjSpec, used: set[str]) -> ET.Element | None:
+    """``<extension>`` declaring the plugin instances the carried actuators name, with
+    their configuration."""
+    by_type: dict[str, ET.Element] = {}
+    for instance in spec.plugins:
+        if instance.name not in used:
+            continue
+        kind = by_type.get(instance.plugin_name)
+        if kind is None:
+            kind = by_type[instance.plugin_name] = ET.Element(
+                "plugin", {"plugin": instance.plugin_name}
+            )
+        elem = ET.SubElement(kind, "instance", {"name": instance.name})
+        for key, value in sorted(instance.config.items()):
+            ET.SubElement(elem, "config", {"key": key, "value": value})
+    if not by_type:
+        return None
+    section = ET.Element("extension")
+    section.extend(by_type.values())
+    return section
+
+
 def _actuators(
-    model: mujoco.MjModel, names: dict[str, set[str]], rep: Reporter
+    model: mujoco.MjModel, spec: mujoco.MjSpec, names: dict[str, set[str]], rep: Reporter
 ) -> tuple[list[Actuator], list[ET.Element], list[int]]:
-    """Table actuators, and the rest as exact ``<general>`` elements for ``mjcf_extra``.
+    """Table actuators, and the rest as exact ``<general>`` elements for ``mjcf_extra``
+    (a plugin actuator as its ``<plugin>`` element).
 
     From the first actuator the table cannot hold exactly (tendon or site transmission,
-    activation dynamics, general gains, ...), every later actuator goes to ``mjcf_extra``
-    too, so that actuator order (and ``ctrl`` layout) is kept."""
+    activation dynamics, general gains, a plugin, ...), every later actuator goes to
+    ``mjcf_extra`` too, so that actuator order (and ``ctrl`` layout) is kept."""
     table: list[Actuator] = []
     carried: list[ET.Element] = []
     kept: list[int] = []
@@ -331,17 +383,19 @@ def _actuators(
             rep.warn(f"actuator dropped: its transmission {target} is not part of the robot", where)
             continue
         kept.append(i)
-        record = None if carried else _actuator_record(model, i)
+        plugin = int(model.actuator_plugin[i]) >= 0
+        record = None if carried or plugin else _actuator_record(model, i)
         if record is not None:
             table.append(record)
             continue
         if not carried:
             rep.warn(
                 "actuator not expressible as an HRDF motor/position/velocity record: it and "
-                "every later actuator are carried exactly as <general> in mjcf_extra",
+                "every later actuator are carried exactly (as <general>, a plugin actuator "
+                "as <plugin>) in mjcf_extra",
                 where,
             )
-        carried.append(_general_elem(model, i))
+        carried.append(_plugin_elem(model, spec, i) if plugin else _general_elem(model, i))
     return table, carried, kept
 
 
@@ -907,15 +961,23 @@ def _sensors(
     return sensors, extra_sensors
 
 
-def _report_scene(model: mujoco.MjModel, rep: Reporter) -> None:
-    """Warnings for the model parts HRDF has no place for."""
+def _carried_instances(carried: list[ET.Element]) -> int:
+    """Plugin instances the carried actuators use (one per actuator configured inline)."""
+    named = {e.get("instance") for e in carried if e.tag == "plugin" and e.get("instance")}
+    inline = sum(1 for e in carried if e.tag == "plugin" and not e.get("instance"))
+    return len(named) + inline
+
+
+def _report_scene(model: mujoco.MjModel, rep: Reporter, carried_plugins: int = 0) -> None:
+    """Warnings for the model parts HRDF has no place for (``carried_plugins``: plugin
+    instances that travel with their actuators)."""
     for what, count in (("camera", model.ncam), ("light", model.nlight)):
         if count:
             rep.warn(f"{count} {what}(s) dropped (HRDF has no {what}s)")
     for what, count in (
         ("flex", model.nflex),
         ("skin", model.nskin),
-        ("plugin instance", model.nplugin),
+        ("plugin instance (of a sensor or passive force)", model.nplugin - carried_plugins),
         ("custom numeric", model.nnumeric),
         ("custom text", model.ntext),
         ("custom tuple", model.ntuple),
@@ -1017,7 +1079,7 @@ def _from_compiled(
     ):
         if section is not None:
             extra_parts.append(section)
-    actuators, carried_actuators, kept_actuators = _actuators(model, names, rep)
+    actuators, carried_actuators, kept_actuators = _actuators(model, spec, names, rep)
     option, flag, option_unheld = options_from_model(model)
     if option_unheld:
         rep.warn(f"<option> fields {option_unheld} dropped (no HRDF key)")
@@ -1032,9 +1094,13 @@ def _from_compiled(
     }
     in_extra = {"actuator": {e.get("name") for e in carried_actuators if e.get("name")}}
     sensors, extra_sensors = _sensors(model, kept_names, rep, in_extra)
-    _report_scene(model, rep)
+    _report_scene(model, rep, _carried_instances(carried_actuators))
 
     if carried_actuators:
+        used = {e.get("instance") for e in carried_actuators if e.tag == "plugin"}
+        instances = _plugin_instances(spec, used - {None})
+        if instances is not None:
+            extra_parts.insert(0, instances)
         section = ET.Element("actuator")
         section.extend(carried_actuators)
         extra_parts.append(section)

@@ -31,6 +31,7 @@ zero). Integers and flags must be equal.
 
 from __future__ import annotations
 
+import hashlib
 import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -121,6 +122,9 @@ _TRN_FAMILY = {0: "jnt", 1: "jnt", 2: "site", 3: "tendon", 4: "site", 5: "body"}
 _EQ_FAMILY = {0: "body", 1: "body", 2: "jnt", 3: "tendon"}
 #: bookkeeping that follows from the compared fields (see the module docstring).
 _SKIP_SUFFIX = ("adr", "num", "treeid", "plugin", "dataid", "matid", "mocapid")
+#: physics despite the suffix: an actuator's plugin (compared as the plugin it runs and
+#: that instance's configuration, not as an id) and its activation count.
+_PHYSICS_DESPITE_SUFFIX = {"actuator_plugin", "actuator_actnum"}
 _SKIP_FIELDS = {"body_bvhadr", "body_bvhnum", "actuator_actadr", "key_mpos", "key_mquat",
                 # the compiler's shortcuts for an object whose frames coincide: they follow
                 # from the compared frames (and the axis order of its principal moments)
@@ -184,7 +188,8 @@ def fields(model: mujoco.MjModel) -> dict[str, list[str]]:
         fam = attr.split("_", 1)[0]
         if fam not in FAMILIES or attr in _SKIP_FIELDS:
             continue
-        if attr.endswith(_APPEARANCE) or (attr.endswith(_SKIP_SUFFIX) and attr not in _ID_FIELDS):
+        skipped = attr.endswith(_SKIP_SUFFIX) and attr not in _ID_FIELDS
+        if attr.endswith(_APPEARANCE) or (skipped and attr not in _PHYSICS_DESPITE_SUFFIX):
             continue
         if attr.endswith("id") and attr not in _ID_FIELDS and attr not in _POLY_ID_FIELDS:
             continue  # ids of assets and other bookkeeping (remapped ones are listed)
@@ -497,6 +502,8 @@ def compare_models(
                 # q and -q are the same rotation.
                 flip = (a.reshape(len(a), -1) * b.reshape(len(b), -1)).sum(axis=1) < 0
                 b = np.where(flip.reshape((-1,) + (1,) * (b.ndim - 1)), -b, b)
+            if attr == "actuator_plugin":
+                a, b = _plugin_keys(source, a), _plugin_keys(result, b)
             if attr in ("geom_size", "site_size"):
                 a, b = (
                     _used_sizes(a, getattr(source, attr[:-4] + "type")[si]),
@@ -525,7 +532,13 @@ def compare_models(
                 ]
                 continue
             for row in _bad_rows(a, b):
-                diffs.append(_diff(src, fam, attr, int(si[row]), _fmt(a[row]), _fmt(b[row])))
+                shown = (_fmt(a[row]), _fmt(b[row]))
+                if attr == "actuator_plugin":  # the plugin and its configuration, not a key
+                    shown = (
+                        _plugin_text(source, int(source.actuator_plugin[si[row]])),
+                        _plugin_text(result, int(result.actuator_plugin[ri[row]])),
+                    )
+                diffs.append(_diff(src, fam, attr, int(si[row]), *shown))
     primary = [d for d in diffs if not _stem(d.field).endswith(_DERIVED)]
     # A derived value (a subtree mass, an inverse weight) differs because an input did:
     # that input is the difference to report; derived ones alone are reported as such.
@@ -536,6 +549,33 @@ def compare_models(
 #: in the object's frame (MuJoCo orders and signs principal axes as its eigen-solver
 #: returns them; an import and our writer may differ there and hold the same inertia).
 _INERTIA_PAIRS = {"body_inertia": "body_iquat"}
+
+
+def _plugin_keys(model: mujoco.MjModel, ids: np.ndarray) -> np.ndarray:
+    """Per actuator plugin id: a number standing for the plugin it runs and its
+    instance's configuration (-1: no plugin), equal between two models compiled in one
+    process exactly when both are."""
+    out = np.full(len(ids), -1, dtype=np.int64)
+    for k, pid in enumerate(ids):
+        if pid < 0:
+            continue
+        key = (int(model.plugin[pid]), _plugin_config(model, pid))  # slot: per process
+        out[k] = int.from_bytes(hashlib.sha1(repr(key).encode()).digest()[:7], "big")
+    return out
+
+
+def _plugin_config(model: mujoco.MjModel, pid: int) -> bytes:
+    start = int(model.plugin_attradr[pid])
+    ends = [int(a) for a in model.plugin_attradr if a > start]
+    return bytes(model.plugin_attr[start : min(ends, default=len(model.plugin_attr))])
+
+
+def _plugin_text(model: mujoco.MjModel, pid: int) -> str:
+    """An actuator's plugin as a note shows it: none, or the plugin and its values."""
+    if pid < 0:
+        return "no plugin"
+    values = [v.decode(errors="replace") for v in _plugin_config(model, pid).split(b"\0") if v]
+    return f"plugin #{int(model.plugin[pid])} with configuration values {values}"
 
 
 def _massless(model: mujoco.MjModel, idx: np.ndarray) -> np.ndarray:
