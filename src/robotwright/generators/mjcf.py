@@ -32,6 +32,7 @@ or raised as :class:`ConversionError` with ``strict=True``.
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 import xml.etree.ElementTree as ET
@@ -109,6 +110,10 @@ def _is_file(path: str, listings: dict[str, set[str] | None]) -> bool:
             listings[folder] = None
     names = listings[folder]
     return os.path.isfile(path) if names is None else name in names
+
+
+def _order(geom: Geom) -> float:
+    return math.inf if geom.order is None else float(geom.order)
 
 
 def parse_mjcf_extra(hrdf: HRDF) -> ET.Element | None:
@@ -237,17 +242,23 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         joints: dict[str, list[Joint]] = {}
         for j in hrdf.joints:
             joints.setdefault(j.body, []).append(j)
-        geoms: dict[str, list[ET.Element]] = {}
+        placed: dict[str, list[tuple[float, ET.Element]]] = {}
         for row, m in enumerate(hrdf.meshes):
             el = self._geom_elem(m, prefix, "mesh.csv", row, losses)
             el.set("type", "mesh")
             el.set("mesh", mesh_names[row])
-            geoms.setdefault(m.body, []).append(el)
+            placed.setdefault(m.body, []).append((_order(m), el))
         for row, g in enumerate(hrdf.simple_geoms):
             el = self._geom_elem(g, prefix, "simple_geom.csv", row, losses)
             el.set("type", g.type)
             el.set("size", fmt_vec(g.size[: SIZE_COUNT[g.type]]))
-            geoms.setdefault(g.body, []).append(el)
+            placed.setdefault(g.body, []).append((_order(g), el))
+        # A body's geoms in their ``order`` where given (stable: else meshes, then
+        # primitives, in row order); MuJoCo's contact order follows geom order.
+        geoms = {
+            body: [el for _, el in sorted(items, key=lambda item: item[0])]
+            for body, items in placed.items()
+        }
         sites: dict[str, list[ET.Element]] = {}
         for s in hrdf.sites:
             el = ET.Element("site", {"name": prefixed(prefix, s.name), "pos": fmt_vec(s.pos)})

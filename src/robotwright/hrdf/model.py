@@ -276,6 +276,10 @@ class Geom:
         margin: distance (m) at which contacts are detected.
         gap: contacts within ``margin - gap`` of touching are active (m).
         priority: contact priority (the higher geom's parameters win).
+        order: position among its body's geoms, counting both tables, or ``None``:
+            where a body's mesh and primitive geoms interleave, the order they are
+            written in (MuJoCo's contact order follows it); else meshes first, then
+            primitives, each in row order.
         solmix: weight of this geom's solref/solimp when two geoms of equal priority
             touch.
         user: MuJoCo ``user`` data.
@@ -301,6 +305,7 @@ class Geom:
     gap: float = 0.0
     priority: int = 0
     solmix: float = 1.0
+    order: int | None = None
     user: tuple[float, ...] = ()
 
 

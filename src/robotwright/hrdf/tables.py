@@ -92,6 +92,9 @@ def _geom_ext() -> list[Column]:
         Column("priority", "int", "priority", required=False, default=0),
         Column("solmix", "float", "solmix", required=False, default=1.0),
         _user(),
+        # Position among its body's geoms (both tables), written only where a body
+        # interleaves mesh and primitive geoms (contact order follows geom order).
+        Column("order", "int", "order", required=False, default=None, empty_ok=True),
     ]
 
 

@@ -643,6 +643,20 @@ def _joints(
     return joints
 
 
+def _keep_interleaved_order(
+    in_order: dict[str, list[tuple[str, int]]], meshes: list, simple: list
+) -> None:
+    """Give each geom of a body whose mesh and primitive geoms interleave its position
+    (``order``): written meshes-first, such a body's contacts would come in another order."""
+    for geoms in in_order.values():
+        natural = sorted(geoms, key=lambda kind_row: kind_row[0] != "mesh")  # stable
+        if natural == geoms:
+            continue
+        for position, (kind, row) in enumerate(geoms):
+            table = meshes if kind == "mesh" else simple
+            table[row] = replace(table[row], order=position)
+
+
 def _geoms(
     model: mujoco.MjModel,
     spec: mujoco.MjSpec,
@@ -662,6 +676,7 @@ def _geoms(
     world_geoms = 0
     materials: set[str] = set()
     unheld_geom: dict[str, list[str]] = {}
+    in_order: dict[str, list[tuple[str, int]]] = {}  # body -> its geoms, in model order
     for g in range(model.ngeom):
         b = int(model.geom_bodyid[g])
         if b == 0:
@@ -721,8 +736,6 @@ def _geoms(
                     )
                     if getattr(m_spec, attr) != default
                 ]
-                if np.any(m_spec.refpos != 0) or np.any(m_spec.refquat != [1, 0, 0, 0]):
-                    unheld.append("refpos/refquat")
                 if unheld:
                     rep.warn(
                         f"mesh asset '{model.mesh(mid).name}': {unheld} dropped (no HRDF "
@@ -754,9 +767,19 @@ def _geoms(
             conj = np.array([mq[0], -mq[1], -mq[2], -mq[3]])
             quat = inr.mul_quat(model.geom_quat[g], conj)
             pos = model.geom_pos[g] - inr.quat_to_mat(quat) @ model.mesh_pos[mid]
+            # The mesh's refpos/refquat (the frame its file's vertices are given in)
+            # folded into the geom's pose: HRDF meshes are their files as they are.
+            ref_q = np.asarray(m_spec.refquat, dtype=float)
+            ref_q = ref_q / np.linalg.norm(ref_q)
+            ref_inv = np.array([ref_q[0], -ref_q[1], -ref_q[2], -ref_q[3]])
+            pos = pos - inr.quat_to_mat(quat) @ (
+                inr.quat_to_mat(ref_inv) @ np.asarray(m_spec.refpos)
+            )
+            quat = inr.mul_quat(quat, ref_inv)
             owner, pos, quat = _reparent(model, b, pos, quat, frames)
             common["body"] = body_name(model, owner)
             mode = m_spec.inertia.name.removeprefix("mjMESH_INERTIA_").lower()
+            in_order.setdefault(common["body"], []).append(("mesh", len(meshes)))
             meshes.append(
                 MeshGeom(
                     name=mname,
@@ -771,6 +794,7 @@ def _geoms(
         else:
             owner, pos, quat = _reparent(model, b, model.geom_pos[g], model.geom_quat[g], frames)
             common["body"] = body_name(model, owner)
+            in_order.setdefault(common["body"], []).append(("simple", len(simple)))
             simple.append(
                 SimpleGeom(
                     name="",
@@ -781,6 +805,7 @@ def _geoms(
                     **common,
                 )
             )
+    _keep_interleaved_order(in_order, meshes, simple)
     # SimpleGeom.name is the table key; keep the geom's own name when it has one.
     used: set[str] = set()
     for k, sg in enumerate(simple):

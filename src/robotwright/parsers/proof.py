@@ -539,6 +539,8 @@ def compare_models(
                         _plugin_text(result, int(result.actuator_plugin[ri[row]])),
                     )
                 diffs.append(_diff(src, fam, attr, int(si[row]), *shown))
+    if "geom" in wanted:
+        diffs += _geom_order(src, res, maps["geom"])
     primary = [d for d in diffs if not _stem(d.field).endswith(_DERIVED)]
     # A derived value (a subtree mass, an inverse weight) differs because an input did:
     # that input is the difference to report; derived ones alone are reported as such.
@@ -561,6 +563,25 @@ def _plugin_keys(model: mujoco.MjModel, ids: np.ndarray) -> np.ndarray:
             continue
         key = (int(model.plugin[pid]), _plugin_config(model, pid))  # slot: per process
         out[k] = int.from_bytes(hashlib.sha1(repr(key).encode()).digest()[:7], "big")
+    return out
+
+
+def _geom_order(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[Difference]:
+    """One difference per body whose geoms the result holds in another order (MuJoCo
+    finds and solves contacts in geom order: a reordered body's contacts differ)."""
+    by_body: dict[int, list[tuple[int, int]]] = {}
+    for s, r in geom_map.items():
+        if r >= 0:
+            by_body.setdefault(int(src.m.geom_bodyid[s]), []).append((s, r))
+    out = []
+    for body, pairs in by_body.items():
+        pairs.sort()
+        results = [r for _, r in pairs]
+        if results == sorted(results):
+            continue
+        names = [_object_text(src, "geom", s) for s, _ in pairs]
+        shown = [names[k] for k in sorted(range(len(pairs)), key=lambda k: results[k])]
+        out.append(_diff(src, "body", "geom order", body, ", ".join(names), ", ".join(shown)))
     return out
 
 
