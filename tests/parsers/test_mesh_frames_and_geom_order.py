@@ -69,9 +69,9 @@ def test_order_survives_the_folder(source, tmp_path):
 
 def test_proof_sees_geoms_in_another_order(source):
     src = mujoco.MjModel.from_xml_path(str(source))
-    swapped = REF.replace(
-        '<geom name="sphere" type="sphere" size="0.05"/>\n', ""
-    ).replace('<geom name="box"', '<geom name="sphere" type="sphere" size="0.05"/>\n<geom name="box"')
+    swapped = REF.replace('<geom name="sphere" type="sphere" size="0.05"/>\n', "").replace(
+        '<geom name="box"', '<geom name="sphere" type="sphere" size="0.05"/>\n<geom name="box"'
+    )
     spec = mujoco.MjSpec.from_string(swapped)
     spec.modelfiledir = str(source.parent)
     found = compare_models(src, spec.compile())

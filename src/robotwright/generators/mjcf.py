@@ -46,6 +46,7 @@ from robotwright.hrdf.model import (
     HRDF,
     MUJOCO_SOLIMP,
     MUJOCO_SOLREF,
+    WORLD,
     Actuator,
     Geom,
     Joint,
@@ -284,6 +285,8 @@ class MJCFHumanoidGenerator(HRDFMixin, MJCFGeneratorBase):
         for i, b in enumerate(hrdf.bodies):
             children.setdefault(b.parent, []).append(i)
         worldbody = self.get_elem("worldbody")
+        for k, el in enumerate(sites.get(WORLD, ())):  # sites fixed in the world
+            worldbody.insert(k, el)
         stack: list[tuple[ET.Element, int, int]] = [
             (worldbody, i, 1) for i in reversed(children.get(-1, []))
         ]

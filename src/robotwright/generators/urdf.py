@@ -60,6 +60,7 @@ from robotwright.hrdf.model import (
     HRDF,
     MUJOCO_SOLIMP,
     MUJOCO_SOLREF,
+    WORLD,
     Actuator,
     Body,
     Geom,
@@ -246,7 +247,16 @@ class _RobotWriter:
         for row, g in enumerate(hrdf.simple_geoms):
             geoms.setdefault(g.body, []).append((g, "simple_geom.csv", row))
         frames: dict[str, list[tuple[str, tuple[float, ...], tuple[float, ...]]]] = {}
-        for s in hrdf.sites:
+        for row, s in enumerate(hrdf.sites):
+            if s.body == WORLD:  # a URDF's links all belong to the robot's tree
+                self.losses.append(
+                    Problem(
+                        "site.csv",
+                        f"site '{s.name}' of the world: URDF has no frame outside the robot",
+                        row=row,
+                    )
+                )
+                continue
             frames.setdefault(s.body, []).append((s.name, s.pos, s.quat))
         for imu, (name, new) in zip(hrdf.meta.imu_config_list or [], imu_sites(hrdf), strict=True):
             if new:

@@ -104,6 +104,9 @@ EXTRA_SECTIONS: tuple[str, ...] = (
 )
 #: Deepest element nesting in ``extra.xml`` (``<mujoco><tendon><spatial><site>`` is 4).
 EXTRA_MAX_DEPTH = 8
+#: ``site.csv`` ``body_name`` of a site fixed in the world (not on a robot body): an IMU
+#: frame or a muscle origin of the robot file's world. MuJoCo's name for its body 0.
+WORLD = "world"
 #: The format version this package writes into ``meta.yaml``.
 FORMAT_VERSION = "robotwright-hrdf/1"
 

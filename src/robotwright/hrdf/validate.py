@@ -36,6 +36,7 @@ from robotwright.hrdf.model import (
     SENSOR_OBJTYPES,
     SIMPLE_GEOM_TYPES,
     SITE_TYPES,
+    WORLD,
     MeshGeom,
 )
 
@@ -559,8 +560,16 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
     for name in sorted(_duplicates(s.name for s in hrdf.sites)):
         out.append(Problem("site.csv", f"duplicate site name '{name}'", column="name"))
     for i, s in enumerate(hrdf.sites):
-        if s.body not in body_names:
-            out.append(Problem("site.csv", f"unknown body '{s.body}'", row=i, column="body_name"))
+        if s.body not in body_names and s.body != WORLD:
+            out.append(
+                Problem(
+                    "site.csv",
+                    f"unknown body '{s.body}': expected a body of body.csv, or '{WORLD}' for "
+                    "a site fixed in the world",
+                    row=i,
+                    column="body_name",
+                )
+            )
         if s.type not in SITE_TYPES:
             out.append(
                 Problem(

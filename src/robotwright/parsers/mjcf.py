@@ -30,6 +30,7 @@ from robotwright.errors import ConversionError, InputFileError, Problem, UnsafeP
 from robotwright.hrdf.model import (
     HRDF,
     SENSOR_OBJTYPES,
+    WORLD,
     Actuator,
     Body,
     Joint,
@@ -849,8 +850,9 @@ def _sites(
     model: mujoco.MjModel, kept: set[int], frames: set[int], root_id: int, rep: Reporter
 ) -> list[Site]:
     """Sites of the robot's bodies, and one per frame body turned into a site. A site of
-    the world that a tendon or actuator goes through (muscle origins) is kept on the
-    root body when the root is fixed to the world (the same place, as it never moves)."""
+    the world (an IMU frame, a muscle origin) stays a site of the world (``body`` is
+    ``"world"``), except one a tendon or actuator goes through when the root is fixed to
+    the world: that one is kept on the root body (the same place, as it never moves)."""
     sites: list[Site] = []
     routing = _routing_sites(model) if model.site_bodyid.size else set()
     fixed_root = int(model.body_jntnum[root_id]) == 0 and model.body_parentid[root_id] == 0
@@ -871,23 +873,24 @@ def _sites(
                 f'<site name="{sname}">',
             )
             b, site_pos, site_quat = root_id, pos, quat
-        elif b == 0 or b not in kept:
-            why = (
-                " (a tendon or actuator goes through it, but the robot's root moves)"
-                if b == 0 and s in routing
-                else ""
-            )
-            rep.warn(f"site outside the robot dropped{why}", f'<site name="{sname}">')
+        elif b == 0:  # fixed in the world (an IMU frame, a muscle origin): carried so
+            site_pos, site_quat = model.site_pos[s], model.site_quat[s]
+        elif b not in kept:
+            rep.warn("site outside the robot dropped", f'<site name="{sname}">')
             continue
         else:
             site_pos, site_quat = model.site_pos[s], model.site_quat[s]
         if not model.site(s).name:
             rep.warn(f"unnamed site named '{sname}'", f"site #{s}")
-        owner, pos, quat = _reparent(model, b, site_pos, site_quat, frames)
+        owner, pos, quat = (
+            (0, _t3(site_pos), _t4(site_quat))
+            if b == 0
+            else _reparent(model, b, site_pos, site_quat, frames)
+        )
         sites.append(
             Site(
                 name=sname,
-                body=body_name(model, owner),
+                body=WORLD if owner == 0 else body_name(model, owner),
                 pos=pos,
                 quat=quat,
                 type=_SITE.get(int(model.site_type[s]), "sphere"),

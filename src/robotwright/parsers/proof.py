@@ -239,12 +239,13 @@ class _Side:
             return (
                 np.array(sorted(self.keep), dtype=int) if self.keep is not None else np.arange(1, n)
             )
-        # Objects fixed to the world (a floor, a scene's lights) are scene, not robot.
+        # Objects fixed to the world (a floor, a scene's lights) are scene, not robot;
+        # but sites of the world (an IMU frame, a muscle origin) travel with the robot.
         keep = np.ones(m.nbody, dtype=bool)
         if self.keep is not None:
             keep[:] = False
             keep[list(self.keep)] = True
-        keep[0] = False
+        keep[0] = fam == "site"
         return np.nonzero(keep[owner])[0]
 
 
