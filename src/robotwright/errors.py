@@ -16,6 +16,10 @@ class Problem:
         column: the CSV column or YAML key, or None.
         element: an XML element description (e.g. ``<joint name="knee">``), or None.
         severity: ``"error"`` or ``"warning"``.
+        cosmetic: a note that changes nothing MuJoCo simulates (a name given, a material
+            reduced to its colour, a light or camera dropped, an element carried in
+            another exact form); shown as ``(cosmetic)``. ``strict=True`` fails on the
+            other notes only, ``strict="all"`` on these too (see :func:`strict_failures`).
     """
 
     file: str
@@ -24,6 +28,7 @@ class Problem:
     column: str | None = None
     element: str | None = None
     severity: str = "error"
+    cosmetic: bool = False
 
     def __str__(self) -> str:
         where = [self.file]
@@ -33,7 +38,21 @@ class Problem:
             where.append(f"column '{self.column}'")
         if self.element is not None:
             where.append(self.element)
-        return f"{': '.join(where)}: {self.message}"
+        return f"{': '.join(where)}: {'(cosmetic) ' if self.cosmetic else ''}{self.message}"
+
+
+#: ``strict=`` values: ``False`` (notes only), ``True`` (fail on a note that changes the
+#: physics), ``"all"`` (fail on any note, cosmetic ones too; ``--strict-all``).
+Strictness = bool | str
+
+
+def strict_failures(problems: list[Problem], strict: Strictness) -> list[Problem]:
+    """The notes that fail a conversion under ``strict`` (see :class:`Problem`)."""
+    if strict not in (False, True, "all"):
+        raise ValueError(f"strict={strict!r}: expected False, True or 'all'")
+    if not strict:
+        return []
+    return [p for p in problems if strict == "all" or not p.cosmetic]
 
 
 class RobotwrightError(Exception):

@@ -72,9 +72,14 @@ def test_compiled_roundtrip_is_exact(probe: Path) -> None:
 
 
 def test_strict_raises_listing_drops(probe: Path) -> None:
+    # strict=True: the notes that change the physics (the floor dropped), not the light.
     with pytest.raises(ConversionError) as err:
         mjcf_to_hrdf(probe, strict=True)
-    assert "worldbody" in str(err.value) and "light" in str(err.value)
+    assert "worldbody" in str(err.value) and "light" not in str(err.value)
+    # strict="all": every note, the cosmetic light too, marked so.
+    with pytest.raises(ConversionError) as err:
+        mjcf_to_hrdf(probe, strict="all")
+    assert "worldbody" in str(err.value) and "(cosmetic) 1 light(s)" in str(err.value)
 
 
 def test_several_top_level_bodies_need_root_body(tmp_path: Path) -> None:

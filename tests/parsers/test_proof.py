@@ -78,13 +78,20 @@ def test_same_model_has_no_difference() -> None:
 
 
 def test_reordered_model_matches_by_name_and_structure() -> None:
-    # Bodies, geoms of a body, actuators and sensors in another order: still equal.
-    reordered = ROBOT.replace(
+    # A body's geoms in another order: matched, and the order is the one difference
+    # (MuJoCo finds contacts in geom order).
+    swapped = ROBOT.replace(
         '<geom type="capsule" size="0.03" fromto="0 0 0 0 0 -0.3" mass="0.5"/>\n'
         '        <geom type="sphere" size="0.04" pos="0 0 -0.3" mass="0.1"/>',
         '<geom type="sphere" size="0.04" pos="0 0 -0.3" mass="0.1"/>\n'
         '        <geom type="capsule" size="0.03" fromto="0 0 0 0 0 -0.3" mass="0.5"/>',
-    ).replace(
+    )
+    assert swapped != ROBOT
+    found = proof.compare_models(_model(ROBOT), _model(swapped))
+    assert [d.field for d in found] == ["geom order"]
+    assert proof.compare_models(_model(ROBOT), _model(swapped), geom_order=False) == []
+    # Actuators (and the keyframe's ctrl with them) in another order: still equal.
+    reordered = ROBOT.replace(
         '<motor name="m" joint="shoulder" gear="20" ctrlrange="-1 1" ctrllimited="true"/>\n'
         '    <position name="p" joint="wrist" kp="50"/>',
         '<position name="p" joint="wrist" kp="50"/>\n'

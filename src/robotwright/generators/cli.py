@@ -58,8 +58,20 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="copy meshes into meshes/ next to the output file (default: point at the robot's)",
     )
-    p.add_argument(
-        "--strict", action="store_true", help="fail instead of writing when a value is lost"
+    strictness = p.add_mutually_exclusive_group()
+    strictness.add_argument(
+        "--strict",
+        action="store_const",
+        const=True,
+        default=False,
+        help="fail instead of writing when a value that changes the physics is lost",
+    )
+    strictness.add_argument(
+        "--strict-all",
+        dest="strict",
+        action="store_const",
+        const="all",
+        help="as --strict, and also when a cosmetic value (a name, a colour) is lost",
     )
     _add_usd_layout(p)
     p.add_argument(

@@ -38,7 +38,13 @@ import warnings
 import xml.etree.ElementTree as ET
 
 from robotwright._inputs import MJCF_MAX_BODY_DEPTH
-from robotwright.errors import ConversionError, ConversionWarning, GeneratorError, Problem
+from robotwright.errors import (
+    ConversionError,
+    ConversionWarning,
+    GeneratorError,
+    Problem,
+    strict_failures,
+)
 from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf_base import MJCFGeneratorBase, name_clashes, prefix_tree
 from robotwright.generators.xmlfmt import fmt_float, fmt_vec, prefixed
@@ -553,12 +559,14 @@ def _solver_attrs(attrs: dict[str, str], record: object, fields: tuple) -> None:
             attrs[key] = fmt_vec(value)
 
 
-def _report(hrdf: HRDF, fmt: str, losses: list[Problem], strict: bool) -> None:
-    """One warning (or, with ``strict``, one error) listing what the output cannot hold."""
+def _report(hrdf: HRDF, fmt: str, losses: list[Problem], strict: bool | str) -> None:
+    """One warning (or, with ``strict``, one error) listing what the output cannot hold
+    (``strict``: see :func:`~robotwright.errors.strict_failures`)."""
     if not losses:
         return
-    if strict:
-        raise ConversionError(losses, f"robot '{hrdf.name}': {fmt} cannot hold every value")
+    failing = strict_failures(losses, strict)
+    if failing:
+        raise ConversionError(failing, f"robot '{hrdf.name}': {fmt} cannot hold every value")
     shown = "\n".join(f"  - {p}" for p in losses)
     warnings.warn(
         f"robot '{hrdf.name}' to {fmt}: {len(losses)} value(s) not written:\n{shown}",

@@ -162,7 +162,23 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="output .urdf (URDF), .xml (MJCF) or folder (HRDF); meshes are copied next to it",
     )
     _source_args(p)
-    p.add_argument("--strict", action="store_true", help="fail instead of dropping anything")
+    strictness = p.add_mutually_exclusive_group()
+    strictness.add_argument(
+        "--strict",
+        action="store_const",
+        const=True,
+        default=False,
+        help="fail, writing nothing, when the output would simulate differently from the "
+        "source (a note that changes the physics, or a difference the proof finds)",
+    )
+    strictness.add_argument(
+        "--strict-all",
+        dest="strict",
+        action="store_const",
+        const="all",
+        help="as --strict, and also on cosmetic notes (names given, materials reduced to "
+        "colours, lights or cameras dropped, elements carried in another exact form)",
+    )
     p.add_argument(
         "--scene",
         action="store_true",

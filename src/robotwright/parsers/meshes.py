@@ -237,6 +237,12 @@ def conversion_note(staged: StagedMesh) -> str | None:
     }.get(staged.converted or "")
 
 
+def conversion_is_cosmetic(staged: StagedMesh) -> bool:
+    """Whether :func:`conversion_note`'s change leaves what MuJoCo reads as it was: a new
+    file format with the same triangles (not a join of objects MuJoCo would not read)."""
+    return staged.converted in ("format", "ascii-stl", "heavy-stl")
+
+
 def _objects_note(staged: StagedMesh) -> str | None:
     if not staged.obj_objects:
         return None

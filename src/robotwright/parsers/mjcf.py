@@ -47,6 +47,7 @@ from robotwright.parsers import mjcf_extra
 from robotwright.parsers.meshes import (
     MeshConversionError,
     MeshStore,
+    conversion_is_cosmetic,
     conversion_note,
     mesh_store,
 )
@@ -392,9 +393,10 @@ def _actuators(
         if not carried:
             rep.warn(
                 "actuator not expressible as an HRDF motor/position/velocity record: it and "
-                "every later actuator are carried exactly (as <general>, a plugin actuator "
+                "every later actuator are carried exactly as <general> (a plugin actuator "
                 "as <plugin>) in mjcf_extra",
                 where,
+                cosmetic=True,
             )
         carried.append(_plugin_elem(model, spec, i) if plugin else _general_elem(model, i))
     return table, carried, kept
@@ -546,7 +548,7 @@ def _bodies(
         if model.body_mocapid[b] >= 0:
             rep.warn("mocap flag dropped", f'<body name="{body_name(model, b)}">')
         if not model.body(b).name:
-            rep.warn(f"unnamed body named '{body_name(model, b)}'", f"body #{b}")
+            rep.warn(f"unnamed body named '{body_name(model, b)}'", f"body #{b}", cosmetic=True)
         bodies.append(
             Body(
                 name=body_name(model, b),
@@ -591,7 +593,7 @@ def _joints(
         if name is None:
             # The free joint too: our MJCF and URDF then name it alike (URDF needs a name).
             name = joint_name(model, j)
-            rep.warn(f"unnamed joint named '{name}'", where)
+            rep.warn(f"unnamed joint named '{name}'", where, cosmetic=True)
         if not model.jnt_limited[j] and np.any(model.jnt_range[j]):
             # MuJoCo ignores the range of an unlimited joint (a free joint's always):
             # harmless, but said.
@@ -760,7 +762,8 @@ def _geoms(
                     raise ConversionError([Problem(str(path), str(exc), element=where)]) from exc
                 note = conversion_note(staged)
                 if note:
-                    rep.warn(f"mesh '{m_spec.file}': {note}", where)
+                    cosmetic = conversion_is_cosmetic(staged)
+                    rep.warn(f"mesh '{m_spec.file}': {note}", where, cosmetic=cosmetic)
                 mesh_files[mid] = (model.mesh(mid).name or Path(m_spec.file).stem, staged.rel)
             mname, rel = mesh_files[mid]
             # Undo MuJoCo's mesh re-centring: compiled = authored * mesh frame.
@@ -818,7 +821,8 @@ def _geoms(
     if materials:
         rep.warn(
             f"materials {sorted(materials)} replaced by their colour (their textures, "
-            "specular, shininess, reflectance, emission dropped)"
+            "specular, shininess, reflectance, emission dropped)",
+            cosmetic=True,
         )
     for attr, gnames in unheld_geom.items():
         shown = gnames[:8] + ([f"... {len(gnames) - 8} more"] if len(gnames) > 8 else [])
@@ -881,7 +885,7 @@ def _sites(
         else:
             site_pos, site_quat = model.site_pos[s], model.site_quat[s]
         if not model.site(s).name:
-            rep.warn(f"unnamed site named '{sname}'", f"site #{s}")
+            rep.warn(f"unnamed site named '{sname}'", f"site #{s}", cosmetic=True)
         owner, pos, quat = (
             (0, _t3(site_pos), _t4(site_quat))
             if b == 0
@@ -937,7 +941,7 @@ def _sensors(
             rep.warn("sensor dropped (its type or object type has no HRDF equivalent)", where)
             continue
         if not model.sensor(s).name:
-            rep.warn(f"unnamed sensor named '{sname}'", where)
+            rep.warn(f"unnamed sensor named '{sname}'", where, cosmetic=True)
         oname = mujoco.mj_id2name(model, int(model.sensor_objtype[s]), int(model.sensor_objid[s]))
         reftype = refname = None
         if model.sensor_refid[s] >= 0:
@@ -1001,7 +1005,7 @@ def _report_scene(model: mujoco.MjModel, rep: Reporter, carried_plugins: int = 0
     instances that travel with their actuators)."""
     for what, count in (("camera", model.ncam), ("light", model.nlight)):
         if count:
-            rep.warn(f"{count} {what}(s) dropped (HRDF has no {what}s)")
+            rep.warn(f"{count} {what}(s) dropped (HRDF has no {what}s)", cosmetic=True)
     for what, count in (
         ("flex", model.nflex),
         ("skin", model.nskin),
@@ -1014,7 +1018,10 @@ def _report_scene(model: mujoco.MjModel, rep: Reporter, carried_plugins: int = 0
             rep.warn(f"{count} {what} element(s) dropped (no HRDF equivalent)")
     for what, count in (("height field", model.nhfield), ("texture", model.ntex)):
         if count:
-            rep.warn(f"{count} {what}(s) dropped (HRDF geoms carry a colour only)")
+            rep.warn(
+                f"{count} {what}(s) dropped (HRDF geoms carry a colour only)",
+                cosmetic=what == "texture",
+            )
 
 
 def parse_mjcf(

@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from robotwright.errors import ConversionError, Problem
+from robotwright.errors import ConversionError, Problem, Strictness, strict_failures
 from robotwright.hrdf.model import HRDF
 
 LOG = logging.getLogger("robotwright.parsers")
@@ -45,19 +45,27 @@ class Reporter:
         self.file = file
         self.problems: list[Problem] = []
 
-    def warn(self, message: str, element: str | None = None) -> None:
-        self.problems.append(Problem(self.file, message, element=element, severity="warning"))
+    def warn(self, message: str, element: str | None = None, *, cosmetic: bool = False) -> None:
+        """Record a note; ``cosmetic``: it changes nothing MuJoCo simulates."""
+        self.problems.append(
+            Problem(self.file, message, element=element, severity="warning", cosmetic=cosmetic)
+        )
 
     def error(self, message: str, element: str | None = None) -> Problem:
         return Problem(self.file, message, element=element)
 
-    def finish(self, strict: bool, emit: bool = True) -> list[Problem]:
-        """Raise under ``strict`` when anything was reported; else log each warning
-        on the ``robotwright.parsers`` logger and return them."""
-        if strict and self.problems:
+    def finish(self, strict: Strictness, emit: bool = True) -> list[Problem]:
+        """Raise under ``strict`` when a note fails it (``True``: one that changes the
+        physics; ``"all"``: any, see :func:`~robotwright.errors.strict_failures`); else
+        log each warning on the ``robotwright.parsers`` logger and return them."""
+        failing = strict_failures(self.problems, strict)
+        if failing:
             raise ConversionError(
-                [Problem(p.file, p.message, element=p.element) for p in self.problems],
-                summary=f"strict conversion of {self.file}: {len(self.problems)} element(s) "
+                [
+                    Problem(p.file, p.message, element=p.element, cosmetic=p.cosmetic)
+                    for p in failing
+                ],
+                summary=f"strict conversion of {self.file}: {len(failing)} element(s) "
                 "would be dropped or approximated",
             )
         if emit:

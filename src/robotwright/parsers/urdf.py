@@ -47,6 +47,7 @@ from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
 from robotwright.parsers.geom_pairs import BOTH, merge_visual_collision
 from robotwright.parsers.meshes import (
     MeshConversionError,
+    conversion_is_cosmetic,
     conversion_note,
     mesh_store,
     rewrite_staged,
@@ -378,7 +379,8 @@ class _URDFReader:
                 self.noted.add(staged.rel)
                 note = conversion_note(staged)
                 if note:
-                    self.rep.warn(f"mesh '{uri}': {note}", where)
+                    cosmetic = conversion_is_cosmetic(staged)
+                    self.rep.warn(f"mesh '{uri}': {note}", where, cosmetic=cosmetic)
             fields.update(
                 mesh=True, name=self._mesh_name(staged.rel, scale), file=staged.rel, scale=scale
             )
@@ -948,7 +950,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
             seen_names[g.geom_name] += 1
             if seen_names[g.geom_name] > 1:
                 new_name = f"{g.geom_name}_{seen_names[g.geom_name] - 1}"
-                rep.warn(f"geom name '{g.geom_name}' repeated: renamed '{new_name}'")
+                rep.warn(f"geom name '{g.geom_name}' repeated: renamed '{new_name}'", cosmetic=True)
                 table[i] = _replace_name(g, new_name, "geom_name")
     extra = _mimic_extra(mimics, {j.name for j in hrdf_joints}, rep)
     geoms_mesh, geoms_simple = drop_unbuildable_visuals(
