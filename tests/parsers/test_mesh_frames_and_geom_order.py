@@ -17,7 +17,7 @@ from robotwright.parsers.proof import compare_models
 REF = """<mujoco model="ref">
   <asset>
     <mesh name="part" file="part.stl" refpos="0.1 0.02 -0.05" refquat="0.9238795 0 0.3826834 0"/>
-    <mesh name="plain" file="part.stl"/>
+    <mesh name="plain" file="plain.stl"/>
   </asset>
   <worldbody>
     <body name="b" pos="0 0 1">
@@ -37,6 +37,9 @@ def source(tmp_path):
     part = trimesh.creation.box(extents=(0.3, 0.1, 0.05))
     part.apply_translation((0.2, 0.05, -0.1))  # off its own origin: MuJoCo re-centres it
     part.export(tmp_path / "part.stl")
+    # Another mesh in its own file: MuJoCo 3.11 reuses a processed mesh (its refpos
+    # included) for a mesh of the same file.
+    trimesh.creation.box(extents=(0.1, 0.1, 0.2)).export(tmp_path / "plain.stl")
     (tmp_path / "ref.xml").write_text(REF)
     return tmp_path / "ref.xml"
 

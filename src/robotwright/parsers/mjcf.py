@@ -660,6 +660,50 @@ def _keep_interleaved_order(
             table[row] = replace(table[row], order=position)
 
 
+def _sub_model_dirs(path: Path, meshdir: str) -> list[Path]:
+    """Folders of the sub-models the MJCF ``path`` attaches (``<asset><model file>``,
+    found as MuJoCo finds them: from the file's folder or its mesh folder), nested ones
+    too. Their meshes are named relative to their own folder and ``meshdir``. (The files
+    were checked for containment before MuJoCo read them.)"""
+    if not path.is_file():
+        return []
+    from robotwright.parsers.xmlsafe import parse_xml
+
+    found: list[Path] = []
+    pending = [(path.resolve(), meshdir)]
+    while pending and len(found) < 64:
+        file, folder = pending.pop()
+        for el in parse_xml(file).iter("model"):
+            name = el.get("file")
+            if not name:
+                continue
+            for base in (file.parent, file.parent / folder):
+                sub = (base / name).resolve()
+                if sub.is_file() and sub.parent not in found:
+                    found.append(sub.parent)
+                    sub_meshdir = next(
+                        (c.get("meshdir", "") for c in parse_xml(sub).iter("compiler")), ""
+                    )
+                    pending.append((sub, sub_meshdir))
+                    break
+    return found
+
+
+def _mesh_source(
+    m_spec: mujoco.MjsMesh, meshdir: str, base_dir: Path, sub_dirs: list[Path]
+) -> Path:
+    """The file of mesh ``m_spec`` as MuJoCo finds it: under its own model's mesh folder
+    (a sub-model's meshes keep their ``<compiler meshdir>``), from the main file's folder
+    or the sub-model's."""
+    own = getattr(getattr(m_spec, "compiler", None), "meshdir", None)
+    folder = meshdir if own is None else own
+    for base in (base_dir, *sub_dirs):
+        candidate = (base / folder / m_spec.file).resolve()
+        if candidate.is_file():
+            return candidate
+    return (base_dir / folder / m_spec.file).resolve()
+
+
 def _geoms(
     model: mujoco.MjModel,
     spec: mujoco.MjSpec,
@@ -673,6 +717,7 @@ def _geoms(
     # Relative to the main file's folder (MuJoCo folds <compiler assetdir> into meshdir).
     meshdir = spec.compiler.meshdir or ""
     base_dir = path.resolve().parent
+    sub_dirs = _sub_model_dirs(path, meshdir)
     mesh_files: dict[int, tuple[str, str]] = {}
     meshes: list[MeshGeom] = []
     simple: list[SimpleGeom] = []
@@ -745,7 +790,7 @@ def _geoms(
                         "column); MuJoCo may centre the mesh differently",
                         where,
                     )
-                src = (base_dir / meshdir / m_spec.file).resolve()
+                src = _mesh_source(m_spec, meshdir, base_dir, sub_dirs)
                 signs = tuple(-1.0 if v < 0 else 1.0 for v in m_spec.scale)
                 try:
                     if -1.0 in signs:

@@ -892,7 +892,7 @@ def _compile_source(
         if kind == "mjcf":
             spec = mujoco.MjSpec.from_file(str(path))
             model = spec.compile()
-            files = [m.file for m in spec.meshes]
+            files = _cacheable_mesh_files(spec)
             meshes = _mesh_files(spec.modelfiledir or "", spec.compiler.meshdir or "", files)
             return model, meshes
         compiler = {
@@ -926,6 +926,17 @@ def _file_key(path: str | Path) -> tuple[int, str] | None:
 #: id of a source model compiled by :func:`source_model` -> its mesh files (see
 #: :func:`_mesh_files`); taken by the proof that compiles the output next.
 _SOURCE_MESHES: dict[int, tuple[str, str, dict[tuple[int, str], str]]] = {}
+
+
+def _cacheable_mesh_files(spec: mujoco.MjSpec) -> list[str]:
+    """The mesh files of ``spec`` the result may read by the same name (MuJoCo's cache):
+    not one read with a ``refpos``/``refquat``, which MuJoCo 3.11 keeps in the cached
+    mesh (the result holds that frame in its geoms' poses instead)."""
+    return [
+        m.file
+        for m in spec.meshes
+        if not (np.any(m.refpos != 0) or np.any(np.asarray(m.refquat) != [1, 0, 0, 0]))
+    ]
 
 
 def _mesh_files(
@@ -965,7 +976,7 @@ def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel
     _PARSED.clear()
     key = _stat_key(path)
     if key is not None:
-        files = [m.file for m in spec.meshes]
+        files = _cacheable_mesh_files(spec)
         _PARSED[key] = (model, spec.modelfiledir or "", spec.compiler.meshdir or "", files)
 
 
