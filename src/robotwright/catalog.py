@@ -13,7 +13,12 @@ given to the later ones' robots as ``SOURCE:NAME``):
    ``urdf/``, ``robots/``, ``mjcf/`` folders and those of their ``robots/*/``;
 5. ``robot_descriptions``: the repositories robot_descriptions has already downloaded
    into its cache (``$ROBOT_DESCRIPTIONS_CACHE``, else ``~/.cache/robot_descriptions``);
-   nothing is downloaded.
+   nothing is downloaded;
+6. ``menagerie``: with the ``mujoco-menagerie`` package installed, every robot of its
+   registry by its name there (``unitree_go2``), as its default model file: under
+   ``$MENAGERIE_ROOT/<name>/`` when that is set (a Menagerie checkout), else in the
+   package's download cache. Nothing is downloaded: one not on disk is listed (``robots``
+   says "not downloaded") and loading it says how to fetch it.
 
 A robot file's name is its file name without extension (``solo12``); two files of one
 source with the same name are named ``PACKAGE/NAME`` (the folder under the source
@@ -34,7 +39,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["RobotEntry", "find_entry", "list_robots"]
+__all__ = ["MENAGERIE", "RobotEntry", "find_entry", "list_robots", "not_downloaded"]
 
 #: Sub-folders of a description package that hold robot files.
 _ROBOT_FOLDERS = ("urdf", "robots", "mjcf", "xml")
@@ -138,6 +143,44 @@ def _scan() -> Iterator[RobotEntry]:
     if cache is not None:
         files = [f for repo in _children(cache) for f in _repo_files(repo, _REPO_DEPTH)]
         yield from _named("robot_descriptions", files, None)
+    yield from _menagerie()
+
+
+#: The source name of Menagerie's robots.
+MENAGERIE = "menagerie"
+
+
+def _menagerie() -> Iterator[RobotEntry]:
+    """Menagerie's robots from the mujoco-menagerie package's registry (no download):
+    each the file of its default model, where it is or would be on disk."""
+    import importlib.util
+
+    if importlib.util.find_spec("mujoco_menagerie") is None:
+        return
+    import mujoco_menagerie as menagerie
+
+    cache = menagerie.Cache()
+    for name in menagerie.names():
+        robot = menagerie.get(name)
+        file = robot.entry(robot.default_model).file
+        folder = cache.root / name if cache.root else cache.model_path(robot)
+        yield RobotEntry(name, MENAGERIE, "mjcf", folder / file)
+
+
+def not_downloaded(entry: RobotEntry) -> str | None:
+    """For a Menagerie robot not on disk: one line saying how to fetch it; else None."""
+    if entry.source != MENAGERIE or entry.path.is_file():
+        return None
+    where = os.environ.get("MENAGERIE_ROOT")
+    if where:
+        return (
+            f"Menagerie's robot '{entry.name}' is not under MENAGERIE_ROOT={where} "
+            f"(expected {entry.path})"
+        )
+    return (
+        f"Menagerie's robot '{entry.name}' is not downloaded: `python -m mujoco_menagerie "
+        f"prefetch {entry.name}` fetches it (or set MENAGERIE_ROOT to a Menagerie checkout)"
+    )
 
 
 def _new(path: Path, seen: set[Path]) -> bool:

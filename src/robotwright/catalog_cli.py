@@ -23,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     import json
 
-    from robotwright.catalog import list_robots
+    from robotwright.catalog import list_robots, not_downloaded
 
     robots = [r for r in list_robots() if args.source in (None, r.source)]
     if args.json:
@@ -34,6 +34,7 @@ def _run(args: argparse.Namespace) -> int:
                 "source": r.source,
                 "format": r.format,
                 "path": str(r.path),
+                "on_disk": not_downloaded(r) is None,
             }
             for r in robots
         ]
@@ -43,6 +44,7 @@ def _run(args: argparse.Namespace) -> int:
     swidth = max((len(r.source) for r in robots), default=6)
     print(f"{'name'.ljust(width)}  {'source'.ljust(swidth)}  format  path")
     for r in robots:
-        print(f"{r.ref.ljust(width)}  {r.source.ljust(swidth)}  {r.format.ljust(6)}  {r.path}")
+        where = "(not downloaded)" if not_downloaded(r) else r.path
+        print(f"{r.ref.ljust(width)}  {r.source.ljust(swidth)}  {r.format.ljust(6)}  {where}")
     print(f"{len(robots)} robot(s); any name works in every command (robotwright info NAME)")
     return 0

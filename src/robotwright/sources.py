@@ -276,6 +276,11 @@ def _catalog_entry(text: str) -> RobotEntry | None:
 
 
 def _from_entry(entry: RobotEntry) -> ResolvedSource:
+    from robotwright.catalog import not_downloaded
+
+    missing = not_downloaded(entry)
+    if missing is not None:
+        raise SourceNotFoundError(missing)
     title = entry.path.name if entry.format == "hrdf" else _stem(entry.path)
     return ResolvedSource(entry.format, entry.path, title, entry)
 
