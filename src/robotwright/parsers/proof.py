@@ -544,6 +544,11 @@ def compare_models(
                 diffs.append(_diff(src, fam, attr, int(si[row]), *shown))
     if geom_order and "geom" in wanted:
         diffs += _geom_order(src, res, maps["geom"])
+    if families is None:  # what simulates beyond the per-object arrays
+        diffs += _contacts(src, res, maps)
+        diffs += _tendon_paths(src, res, maps)
+    if "geom" in wanted:
+        diffs += _mesh_data(src, res, maps["geom"])
     primary = [d for d in diffs if not _stem(d.field).endswith(_DERIVED)]
     # A derived value (a subtree mass, an inverse weight) differs because an input did:
     # that input is the difference to report; derived ones alone are reported as such.
@@ -566,6 +571,137 @@ def _plugin_keys(model: mujoco.MjModel, ids: np.ndarray) -> np.ndarray:
             continue
         key = (int(model.plugin[pid]), _plugin_config(model, pid))  # slot: per process
         out[k] = int.from_bytes(hashlib.sha1(repr(key).encode()).digest()[:7], "big")
+    return out
+
+
+def _inverse(mapping: dict[int, int]) -> dict[int, int]:
+    return {r: s for s, r in mapping.items() if r >= 0}
+
+
+def _same_values(a: np.ndarray, b: np.ndarray) -> bool:
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    scale = max(float(np.abs(a).max(initial=0.0)), float(np.abs(b).max(initial=0.0)))
+    return a.shape == b.shape and bool(np.all(np.abs(a - b) <= RTOL * scale + ATOL))
+
+
+_PAIR_FIELDS = ("pair_dim", "pair_friction", "pair_solref", "pair_solreffriction",
+                "pair_solimp", "pair_margin", "pair_gap")  # fmt: skip
+
+
+def _contacts(src: _Side, res: _Side, maps: dict[str, dict[int, int]]) -> list[Difference]:
+    """Contact pairs (by their two geoms, with every parameter) and excludes (by their
+    two bodies), the result's objects seen through the matching."""
+    s, r = src.m, res.m
+    geoms, bodies = _inverse(maps["geom"]), _inverse(maps["body"])
+    out: list[Difference] = []
+
+    def pair_text(g1: int, g2: int) -> str:
+        return (
+            f"contact pair of {_object_text(src, 'geom', g1)} and {_object_text(src, 'geom', g2)}"
+        )
+
+    theirs = {}
+    for p in range(r.npair):
+        key = (geoms.get(int(r.pair_geom1[p]), -1), geoms.get(int(r.pair_geom2[p]), -1))
+        theirs.setdefault(frozenset(key), p)
+    for p in range(s.npair):
+        g1, g2 = int(s.pair_geom1[p]), int(s.pair_geom2[p])
+        text = pair_text(g1, g2)
+        labels = (*_labels(src, "geom", g1), *_labels(src, "geom", g2), "pair")
+        q = theirs.pop(frozenset((g1, g2)), None)
+        if q is None:
+            out.append(Difference("(object)", "pair", text, "present", "absent", labels))
+            continue
+        for field in _PAIR_FIELDS:
+            a, b = getattr(s, field)[p], getattr(r, field)[q]
+            if not _same_values(a, b):
+                out.append(Difference(field, "pair", text, _fmt(a), _fmt(b), labels))
+    for q in theirs.values():
+        out.append(
+            Difference(
+                "(object)", "pair", f"contact pair #{q} of the result", "absent", "present", ()
+            )
+        )
+
+    def excluded(model: mujoco.MjModel, remap: dict[int, int] | None) -> set[frozenset]:
+        found = set()
+        for sig in model.exclude_signature:
+            b1, b2 = int(sig) >> 16, int(sig) & 0xFFFF
+            if remap is not None:
+                b1, b2 = remap.get(b1, -1), remap.get(b2, -1)
+            found.add(frozenset((b1, b2)))
+        return found
+
+    mine, yours = excluded(s, None), excluded(r, bodies)
+    for key in mine ^ yours:
+        names = sorted(_object_text(src, "body", b) if b >= 0 else "a body" for b in key)
+        text = f"contact exclude of {' and '.join(names)}"
+        present = ("present", "absent") if key in mine else ("absent", "present")
+        out.append(Difference("(object)", "exclude", text, *present, ("exclude", *names)))
+    return out
+
+
+#: wrap object type -> the family its id is of (pulleys have none).
+_WRAP_FAMILY = {
+    int(mujoco.mjtWrap.mjWRAP_JOINT): "jnt",
+    int(mujoco.mjtWrap.mjWRAP_SITE): "site",
+    int(mujoco.mjtWrap.mjWRAP_SPHERE): "geom",
+    int(mujoco.mjtWrap.mjWRAP_CYLINDER): "geom",
+}
+
+
+def _tendon_paths(src: _Side, res: _Side, maps: dict[str, dict[int, int]]) -> list[Difference]:
+    """Each matched tendon's path: the kind, object (through the matching) and parameter
+    of every element, in order."""
+    s, r = src.m, res.m
+    out: list[Difference] = []
+    for t, u in maps["tendon"].items():
+        if u < 0:
+            continue
+
+        def path(model: mujoco.MjModel, k: int, remap: bool) -> list[tuple]:
+            steps = []
+            adr, num = int(model.tendon_adr[k]), int(model.tendon_num[k])
+            for w in range(adr, adr + num):
+                kind = int(model.wrap_type[w])
+                fam = _WRAP_FAMILY.get(kind)
+                obj = int(model.wrap_objid[w])
+                if fam is not None and remap:
+                    obj = _inverse(maps[fam]).get(obj, -2)
+                steps.append((kind, obj if fam is not None else -1, float(model.wrap_prm[w])))
+            return steps
+
+        mine, yours = path(s, t, False), path(r, u, True)
+        same = len(mine) == len(yours) and all(
+            a[:2] == b[:2] and _same_values(np.array(a[2]), np.array(b[2]))
+            for a, b in zip(mine, yours, strict=False)
+        )
+        if not same:
+            out.append(_diff(src, "tendon", "tendon path", t, str(mine), str(yours)))
+    return out
+
+
+def _mesh_data(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[Difference]:
+    """For each matched mesh geom: its mesh's vertex count and bounds (in the mesh's own
+    frame, as MuJoCo processed it)."""
+    s, r = src.m, res.m
+    out: list[Difference] = []
+    mesh = int(mujoco.mjtGeom.mjGEOM_MESH)
+
+    def data(model: mujoco.MjModel, g: int) -> tuple[int, np.ndarray]:
+        k = int(model.geom_dataid[g])
+        adr, num = int(model.mesh_vertadr[k]), int(model.mesh_vertnum[k])
+        vert = model.mesh_vert[adr : adr + num]
+        return num, np.concatenate([vert.min(axis=0), vert.max(axis=0)])
+
+    for g, h in geom_map.items():
+        if h < 0 or int(s.geom_type[g]) != mesh or int(r.geom_type[h]) != mesh:
+            continue
+        (n1, box1), (n2, box2) = data(s, g), data(r, h)
+        if n1 != n2:
+            out.append(_diff(src, "geom", "mesh_vertnum", g, str(n1), str(n2)))
+        elif not _same_values(box1, box2):
+            out.append(_diff(src, "geom", "mesh bounds", g, _fmt(box1), _fmt(box2)))
     return out
 
 
