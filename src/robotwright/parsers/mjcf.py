@@ -721,14 +721,14 @@ def _geoms(
     mesh_files: dict[int, tuple[str, str]] = {}
     meshes: list[MeshGeom] = []
     simple: list[SimpleGeom] = []
-    world_geoms = 0
+    world_geoms: list[str] = []
     materials: set[str] = set()
     unheld_geom: dict[str, list[str]] = {}
     in_order: dict[str, list[tuple[str, int]]] = {}  # body -> its geoms, in model order
     for g in range(model.ngeom):
         b = int(model.geom_bodyid[g])
         if b == 0:
-            world_geoms += 1
+            world_geoms.append(model.geom(g).name or f"geom #{g}")
             continue
         if b not in kept:
             continue
@@ -873,7 +873,8 @@ def _geoms(
         shown = gnames[:8] + ([f"... {len(gnames) - 8} more"] if len(gnames) > 8 else [])
         rep.warn(f"geom attribute '{attr}' dropped (no HRDF column) on geoms {shown}")
     if world_geoms:
-        rep.warn(f"{world_geoms} geom(s) of the worldbody dropped (scene, not robot)")
+        shown = ", ".join(world_geoms[:6]) + (", ..." if len(world_geoms) > 6 else "")
+        rep.warn(f"{len(world_geoms)} geom(s) of the worldbody dropped (scene, not robot): {shown}")
 
     return meshes, simple
 
