@@ -58,6 +58,7 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "view",
     "render",
     "lidar",
+    "isaaclab-cfg",
 )
 
 #: Commands that read URDF/xacro files (every command that reads a robot: any takes a

@@ -59,6 +59,13 @@ FILE_KINDS = {
     ".usdc": "usd",
 }
 
+#: What a robot argument of any command takes: the help text every command shows (a test
+#: checks each one does, so that help cannot lag behind what the readers take).
+ROBOT_SOURCE_HELP = (
+    "a robot: a name ('robotwright robots' lists them), an HRDF folder, or a URDF (.urdf), "
+    "xacro (.xacro), MJCF (.xml, .mjcf) or USD (.usd, .usda, .usdc) file"
+)
+
 #: Options of the shared group, by the source kinds they apply to.
 URDF_OPTIONS = (
     "fixed_joints",

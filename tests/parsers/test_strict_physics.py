@@ -72,3 +72,11 @@ def test_strict_and_strict_all_exclude_each_other(tmp_path):
     run = _convert(tmp_path, PHYSICAL, "--strict", "--strict-all")
     assert run.returncode == 2 and "--strict-all" in run.stderr
     assert not (tmp_path / "out.xml").exists()
+
+
+def test_an_output_of_no_kind_is_refused_before_overwrite_is_asked(tmp_path):
+    (tmp_path / "existing.png").write_bytes(b"\x89PNG")
+    run = _convert(tmp_path, PHYSICAL, "-o", "existing.png")
+    assert run.returncode == 2
+    assert "expected a .urdf" in run.stderr and "--overwrite" not in run.stderr
+    assert (tmp_path / "existing.png").read_bytes() == b"\x89PNG"

@@ -10,6 +10,7 @@ from pathlib import Path
 from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.placement import Placement
+from robotwright.sources import ROBOT_SOURCE_HELP
 
 _FORMAT_HELP = "mjcf or urdf (default: from the -o file name: .urdf is URDF, .xml or .mjcf is MJCF)"
 _EXPORT_FORMAT_HELP = (
@@ -39,7 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "velocity limits added, and is read back by Newton and compared with the robot "
         "(Isaac Lab's environment, Python 3.12).",
     )
-    p.add_argument("robot", help="bundled robot name (arm6, mini_humanoid) or HRDF folder")
+    p.add_argument("robot", help=ROBOT_SOURCE_HELP)
     p.add_argument(
         "--format", choices=("mjcf", "urdf", "usd"), default=None, help=_EXPORT_FORMAT_HELP
     )
@@ -92,7 +93,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(Python 3.12).",
         epilog="Example: robotwright isaaclab-cfg mini_humanoid -o robots/mini_humanoid_cfg.py",
     )
-    p.add_argument("robot", help="a robot: bundled name, HRDF folder, MJCF or URDF file")
+    p.add_argument("robot", help=ROBOT_SOURCE_HELP)
     p.add_argument(
         "--strict", action="store_true", help="fail instead of writing when the USD's proof differs"
     )
@@ -113,9 +114,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "robots",
         nargs="+",
         metavar="ROBOT",
-        help="[KEY=]NAME_OR_PATH[@x,y,z[,yaw]]: a bundled robot name or HRDF folder, "
-        "optionally keyed and placed at x, y, z [m] turned by yaw [rad] about z "
-        "(default: where its own description puts it)",
+        help=f"[KEY=]NAME_OR_PATH[@x,y,z[,yaw]]: {ROBOT_SOURCE_HELP}; optionally keyed "
+        "and placed at x, y, z [m] turned by yaw [rad] about z (default: where its own "
+        "description puts it)",
     )
     p.add_argument("--format", choices=("mjcf", "urdf"), default=None, help=_FORMAT_HELP)
     p.add_argument("--no-scene", action="store_true", help="MJCF: no ground, light or sky")

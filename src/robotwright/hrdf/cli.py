@@ -6,6 +6,8 @@ import argparse
 import warnings
 from typing import TYPE_CHECKING
 
+from robotwright.sources import ROBOT_SOURCE_HELP
+
 if TYPE_CHECKING:  # the readers load when a command runs, not with `robotwright --help`
     from robotwright.hrdf.model import HRDF
 
@@ -19,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "when any is an error. A URDF or MJCF is checked as read into HRDF, with the same "
         "checks and MuJoCo compile as a folder.",
     )
-    p.add_argument("path", help="robot name, HRDF folder, or URDF, xacro or MJCF file")
+    p.add_argument("path", help=ROBOT_SOURCE_HELP)
     p.set_defaults(func=_validate)
 
     p = sub.add_parser(
@@ -28,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Print a readable summary of a robot given by name, HRDF folder, or "
         "URDF, xacro or MJCF file.",
     )
-    p.add_argument("robot", help="robot name, HRDF folder, or URDF, xacro or MJCF file")
+    p.add_argument("robot", help=ROBOT_SOURCE_HELP)
     p.set_defaults(func=_info)
 
 

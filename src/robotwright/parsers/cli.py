@@ -12,7 +12,7 @@ from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag, check_overwrite
 from robotwright.errors import ConversionWarning
-from robotwright.sources import parse_xacro_arg
+from robotwright.sources import ROBOT_SOURCE_HELP, parse_xacro_arg
 
 
 def _options(args: argparse.Namespace) -> dict:
@@ -154,7 +154,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Convert SRC to DST; the type comes from the extension (.urdf, .xml = "
         "MJCF) or is an HRDF folder. Every dropped or approximated element is printed.",
     )
-    p.add_argument("src", help="source .urdf, .xml (MJCF), HRDF folder or bundled robot name")
+    p.add_argument("src", help=ROBOT_SOURCE_HELP)
     p.add_argument(
         "-o",
         "--output",
@@ -275,8 +275,10 @@ def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
 
 @_quiet_parser_log
 def _convert(args: argparse.Namespace) -> int:
-    from robotwright.parsers.convert import convert
+    from robotwright.parsers.convert import convert, file_kind
 
+    # What cannot be written at all is said before whether it may be overwritten.
+    file_kind(Path(args.output), existing=False)
     # A name without extension is an HRDF folder: --overwrite replaces only one we wrote.
     folder = Path(args.output).suffix == ""
     check_overwrite(args.output, args.overwrite, kind="hrdf" if folder else None)

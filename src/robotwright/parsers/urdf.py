@@ -914,7 +914,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         rep.warn(
             f"effort/velocity limits of {len(dropped_limits)} joint(s) not kept as motors "
             "(effort is kept as the joint's actuatorfrcrange, velocity dropped; keep both "
-            "on motors with actuators='motor', on the command line --actuators motor): "
+            "on motors with actuators='motor', or convert's --actuators motor): "
             + name_list(dropped_limits)
         )
     clamped = [j.name for j in hrdf_joints if j.actuatorfrcrange is not None]

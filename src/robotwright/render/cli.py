@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag
+from robotwright.sources import ROBOT_SOURCE_HELP
 
 __all__ = ["register", "run"]
 
@@ -86,8 +87,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "source",
-        help="robot name, HRDF folder, MJCF (.xml) or URDF (.urdf) file, grammar design "
-        "folder, or scan (.npz, with --scene)",
+        help=f"{ROBOT_SOURCE_HELP}; a grammar design folder; or a scan (.npz, with --scene)",
     )
     p.add_argument(
         "-o",

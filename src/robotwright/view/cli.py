@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+from robotwright.sources import ROBOT_SOURCE_HELP
+
 #: Geom groups accepted by ``--groups`` (MuJoCo has six).
 _GROUPS = range(6)
 
@@ -58,7 +60,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Prints the URL and runs until Ctrl-C.",
     )
     p.add_argument(
-        "source", help="robot name, HRDF or design folder, .xml, .urdf, .xacro or scan .npz"
+        "source",
+        help=f"{ROBOT_SOURCE_HELP}; a grammar design folder; or a scan (.npz, with --scene)",
     )
     p.add_argument("--scene", type=Path, help="MJCF scene a scan .npz was taken in")
     p.add_argument(
