@@ -274,3 +274,19 @@ def test_primitive_mesh_plane(size, cells, half) -> None:
 def test_primitive_mesh_is_none_for_meshes_and_height_fields() -> None:
     for gtype in (G.mjGEOM_MESH, G.mjGEOM_HFIELD, G.mjGEOM_SDF):
         assert primitive_mesh(gtype, [0.1, 0.1, 0.1], plane_extent=1.0) is None
+
+
+def test_view_says_nothing_of_its_own_floor_texture_without_v() -> None:
+    from robotwright.view.cli import note_lines
+    from robotwright.view.geometry import geom_shapes
+    from robotwright.view.scene import load_source
+
+    scene = load_source("mini_humanoid")  # generated with our floor: a textured plane
+    skipped: list[str] = []
+    geom_shapes(scene.model, skipped=skipped)
+    assert any("'floor'" in s for s in skipped)
+    quiet = note_lines(scene.notes, skipped, verbose=False)
+    assert not any("texture" in line for line in quiet) and len(quiet) <= 1
+    assert any("'floor'" in line for line in note_lines(scene.notes, skipped, verbose=True))
+    # Other notes still make their one line.
+    assert note_lines(["a robot note"], skipped, verbose=False) == ["note: a robot note"]

@@ -145,13 +145,8 @@ def _run(args: argparse.Namespace) -> int:
         f"{scene.title}: {m.nbody - 1} bodies, {m.njnt} joints, {viewer.geom_count} geoms shown"
         + (f", {len(scene.scan.points)} scan points" if scene.scan is not None else "")
     )
-    # What the page cannot draw as MuJoCo would: one line (each with -v).
-    lines = [*viewer.notes, *viewer.skipped]
-    if verbose or len(lines) == 1:
-        for line in lines:
-            print(f"note: {line}", file=sys.stderr)
-    elif lines:
-        print(f"note: {lines[0]} (and {len(lines) - 1} more; -v lists each)", file=sys.stderr)
+    for line in note_lines(viewer.notes, viewer.skipped, verbose):
+        print(line, file=sys.stderr)
     _stop_on_signals()
     try:
         # Inside the try: a Ctrl-C right after the address is printed still stops cleanly.
@@ -163,6 +158,21 @@ def _run(args: argparse.Namespace) -> int:
     finally:
         viewer.stop()
     return 0
+
+
+def note_lines(notes: list[str], skipped: list[str], verbose: bool) -> list[str]:
+    """What the page cannot draw as MuJoCo would: every note with ``verbose``, else one
+    line; a texture drawn as its colour (the scene's own floor has one) only with
+    ``verbose``."""
+    from robotwright.view.geometry import TEXTURE_NOT_DRAWN
+
+    lines = [*notes, *skipped]
+    if verbose:
+        return [f"note: {line}" for line in lines]
+    lines = [line for line in lines if not line.endswith(TEXTURE_NOT_DRAWN)]
+    if len(lines) <= 1:
+        return [f"note: {line}" for line in lines]
+    return [f"note: {lines[0]} (and {len(lines) - 1} more; -v lists each)"]
 
 
 def _stop_on_signals() -> None:

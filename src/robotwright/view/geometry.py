@@ -76,6 +76,10 @@ class SiteFrame:
     quat: np.ndarray
 
 
+#: The note of a textured geom drawn in its colour: a look, not a loss (``-v`` only).
+TEXTURE_NOT_DRAWN = "texture not drawn, only its colour"
+
+
 def geom_rgba(model: mujoco.MjModel, geom_id: int) -> np.ndarray:
     """The colour MuJoCo draws geom ``geom_id`` with: the geom's ``rgba`` when it differs
     from MuJoCo's default (0.5, 0.5, 0.5, 1), else its material's colour, else the
@@ -260,7 +264,7 @@ def geom_shapes(model: mujoco.MjModel, *, skipped: list[str] | None = None) -> l
             continue
         matid = int(model.geom_matid[g])
         if skipped is not None and matid >= 0 and np.max(model.mat_texid[matid]) >= 0:
-            skipped.append(f"geom '{name}': texture not drawn, only its colour")
+            skipped.append(f"geom '{name}': {TEXTURE_NOT_DRAWN}")
         out.append(
             GeomShape(
                 geom_id=g,
