@@ -299,3 +299,26 @@ def test_xacro_file(tmp_path: Path) -> None:
     assert expanded.kind == "urdf"
     _same_model(expanded.model, plain.model)
     np.testing.assert_allclose(expanded.model.geom_size, plain.model.geom_size)
+
+
+def test_a_robot_is_called_by_its_own_name_in_every_command(tmp_path: Path) -> None:
+    """A URDF file named otherwise than its robot (example-robot-data's talos_reduced.urdf
+    holds robot 'talos'): view and render call it what info calls it."""
+    import subprocess
+    import sys
+
+    urdf = (
+        '<robot name="walker"><link name="base"><inertial><mass value="1"/>'
+        '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>'
+    )
+    (tmp_path / "walker_reduced.urdf").write_text(urdf)
+    scene = load_source(str(tmp_path / "walker_reduced.urdf"))
+    info = subprocess.run(
+        [sys.executable, "-m", "robotwright", "info", "walker_reduced.urdf"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert info.returncode == 0, info.stderr
+    assert scene.title == "walker" and "robot walker:" in info.stdout

@@ -216,7 +216,7 @@ def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
             f"{abs(shift):.3g} m so that its lowest collision geom touches the floor (z = 0)"
         )
     kind = "robot" if resolved.kind == "hrdf" else resolved.kind.replace("xacro", "urdf")
-    title = hrdf.name if resolved.kind == "hrdf" else resolved.title
+    title = hrdf.name  # the robot's own name, as info and the outputs call it
     return ViewScene(model, title, kind, text, notes=notes + more, warnings=shown)
 
 
