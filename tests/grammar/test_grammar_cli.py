@@ -203,3 +203,16 @@ def test_long_work_is_announced_and_shows_progress_with_time_left(capsys, monkey
     captured = capsys.readouterr()
     assert "equal to count: True" in captured.out
     assert captured.err.startswith("warning: enumerating 4800 designs will take about")
+
+
+def test_show_and_export_take_the_folder_sample_writes(tmp_path, capsys):
+    assert main(["grammar", "sample", "-n", "1", "--seed", "3", "-o", str(tmp_path / "s"),
+                 "--no-picture"]) == 0  # fmt: skip
+    (folder,) = [p for p in (tmp_path / "s").iterdir() if p.is_dir()]
+    capsys.readouterr()
+    assert main(["grammar", "show", str(folder)]) == 0
+    shown = capsys.readouterr().out
+    assert shown.startswith((folder / "design.txt").read_text().splitlines()[0])
+    assert main(["grammar", "export", str(folder), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "design.txt").read_text() == (folder / "design.txt").read_text()
+    assert main(["grammar", "show", str(tmp_path / "s")]) == 2  # no design.txt: refused

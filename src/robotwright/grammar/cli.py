@@ -259,7 +259,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "modified-DH table (Craig) per branch; --dot prints the tree as Graphviz DOT.",
     )
     common(q)
-    q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
+    q.add_argument(
+        "design", type=Path, help="design file (design.txt or design.json) or design folder"
+    )
     q.add_argument("--dot", action="store_true", help="print the design tree as Graphviz DOT only")
     q.set_defaults(func=_show)
 
@@ -270,7 +272,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "and write its MJCF, URDF, design text/JSON, tree and picture into a folder.",
     )
     common(q)
-    q.add_argument("design", type=Path, help="design file (design.txt or design.json)")
+    q.add_argument(
+        "design", type=Path, help="design file (design.txt or design.json) or design folder"
+    )
     q.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     add_overwrite_flag(q)
     q.set_defaults(func=_export)
@@ -491,9 +495,13 @@ def _ray_executor(args: argparse.Namespace):
 
 
 def _read_design(path: Path):
+    """The design in ``path``: a design.txt or design.json file, or a design folder as
+    ``grammar sample``/``search``/``export`` write it (its design.txt)."""
     from robotwright._inputs import MAX_YAML_BYTES, read_text
     from robotwright.grammar.design import Design
 
+    if path.is_dir() and (path / "design.txt").is_file():
+        path = path / "design.txt"
     try:
         text = read_text(path, MAX_YAML_BYTES)
     except InputFileError as exc:
