@@ -322,3 +322,13 @@ def test_a_robot_is_called_by_its_own_name_in_every_command(tmp_path: Path) -> N
     )
     assert info.returncode == 0, info.stderr
     assert scene.title == "walker" and "robot walker:" in info.stdout
+
+
+def test_a_scan_shown_in_another_scene_says_so(tmp_path: Path) -> None:
+    npz, room = _scan(tmp_path)
+    assert load_source(npz, scene=room).warnings == []
+    other = tmp_path / "other.xml"
+    other.write_text(ROOM.replace("</worldbody>", '<geom name="crate" size="0.2"/></worldbody>'))
+    shown = load_source(npz, scene=other)
+    assert len(shown.warnings) == 1
+    assert "scan.npz was not taken in other.xml" in shown.warnings[0]

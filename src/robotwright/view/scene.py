@@ -302,7 +302,36 @@ def _scan_scene(
             raise ViewError(f"{scene_path}: scene file not found")
         model = _compile_mjcf(scene_path, asset_roots)
         title = f"{path.stem} in {scene_path.stem}"
+        other = _other_scene(path, scene_path, model)
+        if other:
+            return ViewScene(model, title, "scan", str(path), scan=cloud, warnings=[other])
     return ViewScene(model, title, "scan", str(path), scan=cloud)
+
+
+def _other_scene(scan: Path, scene: Path, model: mujoco.MjModel) -> str | None:
+    """A line when ``scene`` is not the scene ``scan`` was taken in: the scan names every
+    geom of its scene (``geom_paths``), which must be this model's; None when they match
+    (or the scan is older and does not say)."""
+    from robotwright._npz import load_npz
+    from robotwright.sensors.lidar import geom_paths
+
+    taken = load_npz(scan, ("geom_paths",)).get("geom_paths")
+    if taken is None:
+        return None
+    here = geom_paths(model)
+    taken = [str(p) for p in taken]
+    if taken == here:
+        return None
+    first = next(
+        (f"geom {g}: {a} in the scan's, {b} here" for g, (a, b) in enumerate(zip(taken, here))
+         if a != b),
+        "",
+    )  # fmt: skip
+    return (
+        f"{scan.name} was not taken in {scene.name}: its scene had {len(taken)} geoms, this "
+        f"one has {len(here)}" + (f" ({first})" if first else "") + "; the points are drawn "
+        "where they were hit, in another scene"
+    )
 
 
 def read_scan(path: Path) -> ScanCloud:
