@@ -12,6 +12,11 @@ from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.placement import Placement
 from robotwright.sources import ROBOT_SOURCE_HELP
 
+#: Meshes that exist only while a source is read are always copied.
+_STAGED_MESHES = (
+    "meshes made while reading a source, such as a URDF's DAE converted to STL, are "
+    "copied, as they last only as long as the command"
+)
 _FORMAT_HELP = "mjcf or urdf (default: from the -o file name: .urdf is URDF, .xml or .mjcf is MJCF)"
 _EXPORT_FORMAT_HELP = (
     "mjcf, urdf or usd (default: from the -o file name: .urdf is URDF, .xml or .mjcf is "
@@ -57,7 +62,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--copy-meshes",
         action="store_true",
-        help="copy meshes into meshes/ next to the output file (default: point at the robot's)",
+        help="copy meshes into meshes/ next to the output file (default: point at the "
+        f"robot's own files; {_STAGED_MESHES})",
     )
     strictness = p.add_mutually_exclusive_group()
     strictness.add_argument(
@@ -123,7 +129,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--copy-meshes",
         action="store_true",
-        help="copy meshes into meshes/ next to the output file (default: point at the robots')",
+        help="copy meshes into meshes/ next to the output file (default: point at the "
+        f"robots' own files; {_STAGED_MESHES})",
     )
     p.add_argument("-o", "--output", required=True, help="output scene file (.xml or .urdf)")
     add_overwrite_flag(p)
