@@ -216,3 +216,20 @@ def test_show_and_export_take_the_folder_sample_writes(tmp_path, capsys):
     assert main(["grammar", "export", str(folder), "-o", str(tmp_path / "again")]) == 0
     assert (tmp_path / "again" / "design.txt").read_text() == (folder / "design.txt").read_text()
     assert main(["grammar", "show", str(tmp_path / "s")]) == 2  # no design.txt: refused
+
+
+def test_sample_piped_into_a_reader_that_stops_early_still_writes_every_design(tmp_path):
+    import subprocess
+    import sys
+
+    run = subprocess.run(
+        f'"{sys.executable}" -m robotwright grammar sample -n 3 --seed 1 --no-picture '
+        f'-o "{tmp_path / "out"}" | head -1',
+        shell=True,
+        capture_output=True,
+        text=True,
+    )
+    assert len(run.stdout.splitlines()) == 1
+    designs = [p for p in (tmp_path / "out").iterdir() if (p / "design.txt").is_file()]
+    assert len(designs) == 3
+    assert run.stdout.split(":")[0] == str(tmp_path / "out" / sorted(p.name for p in designs)[0])

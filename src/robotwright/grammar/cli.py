@@ -359,15 +359,19 @@ def _sample(args: argparse.Namespace) -> int:
     progress = Progress(args.n, "designs written")
     # All or nothing: the designs are written into a temporary folder that becomes
     # args.out at the end (a full disk or Ctrl-C leaves the old output, or none).
+    written = []
     with atomic_dir(args.out, kind="designs") as tmp:
         for k in range(args.n):
             d = sample(g, args.max_links, rng, counter)
             name = f"{k:03d}_{d.hash()}"
             export_design(g, d, tmp / name, picture=not args.no_picture, overwrite=True)
-            print(f"{args.out / name}: {d}", flush=True)
+            written.append(f"{args.out / name}: {d}")
             if k == 0:
                 _warn_long((progress.eta(1) or 0.0), f"writing {args.n} designs")
             progress.update(k + 1)
+    # Announced once they exist: a reader that stops early (| head -1) takes nothing away.
+    for line in written:
+        print(line, flush=True)
     return 0
 
 
