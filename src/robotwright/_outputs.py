@@ -302,3 +302,16 @@ def check_copy_destination(dst: str | os.PathLike[str], src: str | os.PathLike[s
         f"{dst}: {what}; not replacing a file the output copies there (give --overwrite to "
         "replace it, or another output path)"
     )
+
+
+def add_strict_flags(p: argparse.ArgumentParser, *, strict_help: str, all_help: str) -> None:
+    """``--strict`` (``args.strict`` True: fail on a note that changes the physics) and
+    ``--strict-all`` (``"all"``: on every note, cosmetic ones too), one or the other
+    (see :func:`robotwright.errors.strict_failures`)."""
+    strictness = p.add_mutually_exclusive_group()
+    strictness.add_argument(
+        "--strict", action="store_const", const=True, default=False, help=strict_help
+    )
+    strictness.add_argument(
+        "--strict-all", dest="strict", action="store_const", const="all", help=all_help
+    )

@@ -7,7 +7,7 @@ import re
 import warnings
 from pathlib import Path
 
-from robotwright._outputs import add_overwrite_flag, check_overwrite
+from robotwright._outputs import add_overwrite_flag, add_strict_flags, check_overwrite
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.placement import Placement
 from robotwright.sources import ROBOT_SOURCE_HELP
@@ -65,20 +65,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="copy meshes into meshes/ next to the output file (default: point at the "
         f"robot's own files; {_STAGED_MESHES})",
     )
-    strictness = p.add_mutually_exclusive_group()
-    strictness.add_argument(
-        "--strict",
-        action="store_const",
-        const=True,
-        default=False,
-        help="fail instead of writing when a value that changes the physics is lost",
-    )
-    strictness.add_argument(
-        "--strict-all",
-        dest="strict",
-        action="store_const",
-        const="all",
-        help="as --strict, and also when a cosmetic value (a name, a colour) is lost",
+    add_strict_flags(
+        p,
+        strict_help="fail instead of writing when a value that changes the physics is lost",
+        all_help="as --strict, and also when a cosmetic value (a name, a colour) is lost",
     )
     _add_usd_layout(p)
     p.add_argument(

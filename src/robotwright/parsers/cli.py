@@ -10,7 +10,7 @@ import warnings
 from collections.abc import Callable
 from pathlib import Path
 
-from robotwright._outputs import add_overwrite_flag, check_overwrite
+from robotwright._outputs import add_overwrite_flag, add_strict_flags, check_overwrite
 from robotwright.errors import ConversionWarning
 from robotwright.sources import ROBOT_SOURCE_HELP, parse_xacro_arg
 
@@ -162,21 +162,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="output .urdf (URDF), .xml (MJCF) or folder (HRDF); meshes are copied next to it",
     )
     _source_args(p)
-    strictness = p.add_mutually_exclusive_group()
-    strictness.add_argument(
-        "--strict",
-        action="store_const",
-        const=True,
-        default=False,
-        help="fail, writing nothing, when the output would simulate differently from the "
-        "source (a note that changes the physics, or a difference the proof finds)",
-    )
-    strictness.add_argument(
-        "--strict-all",
-        dest="strict",
-        action="store_const",
-        const="all",
-        help="as --strict, and also on cosmetic notes (names given, materials reduced to "
+    add_strict_flags(
+        p,
+        strict_help="fail, writing nothing, when the output would simulate differently from "
+        "the source (a note that changes the physics, or a difference the proof finds)",
+        all_help="as --strict, and also on cosmetic notes (names given, materials reduced to "
         "colours, lights or cameras dropped, elements carried in another exact form)",
     )
     p.add_argument(

@@ -279,8 +279,9 @@ def _actuator_target(model: mujoco.MjModel, i: int) -> tuple[str, str] | None:
     return attr, mujoco.mj_id2name(model, obj, oid) or ""
 
 
-def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
-    """The compiled actuator as a ``<general>`` element, every parameter explicit."""
+def _actuator_attrs(model: mujoco.MjModel, i: int) -> dict[str, str]:
+    """The attributes every carried actuator element has: name, transmission, group,
+    gear and the three ranges, each explicit."""
     attrs: dict[str, str] = {}
     if model.actuator(i).name:
         attrs["name"] = model.actuator(i).name
@@ -296,6 +297,12 @@ def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
         attrs[f"{flag}limited"] = "true" if limited else "false"
         if limited:
             attrs[rng] = _fmt(getattr(model, f"actuator_{rng}")[i])
+    return attrs
+
+
+def _general_elem(model: mujoco.MjModel, i: int) -> ET.Element:
+    """The compiled actuator as a ``<general>`` element, every parameter explicit."""
+    attrs = _actuator_attrs(model, i)
     attrs["dyntype"] = _DYN[int(model.actuator_dyntype[i])]
     attrs["gaintype"] = _GAIN[int(model.actuator_gaintype[i])]
     attrs["biastype"] = _BIAS[int(model.actuator_biastype[i])]
@@ -317,23 +324,11 @@ def _plugin_elem(model: mujoco.MjModel, spec: mujoco.MjSpec, i: int) -> ET.Eleme
     """A plugin actuator (``mujoco.pid``, ...) as its ``<plugin>`` element: the plugin,
     its instance (or its own ``<config>`` lines), the transmission, ranges and the
     activation count the plugin keeps."""
-    attrs: dict[str, str] = {}
-    if model.actuator(i).name:
-        attrs["name"] = model.actuator(i).name
-    attr, target = _actuator_target(model, i)
-    attrs[attr] = target
+    attrs = _actuator_attrs(model, i)
     plugin = spec.actuators[i].plugin
     attrs["plugin"] = plugin.plugin_name
     if plugin.name:
         attrs["instance"] = plugin.name
-    if model.actuator_group[i]:
-        attrs["group"] = str(int(model.actuator_group[i]))
-    attrs["gear"] = _fmt(model.actuator_gear[i])
-    for flag, rng in (("ctrl", "ctrlrange"), ("force", "forcerange"), ("act", "actrange")):
-        limited = bool(getattr(model, f"actuator_{flag}limited")[i])
-        attrs[f"{flag}limited"] = "true" if limited else "false"
-        if limited:
-            attrs[rng] = _fmt(getattr(model, f"actuator_{rng}")[i])
     attrs["actdim"] = str(int(model.actuator_actnum[i]))
     elem = ET.Element("plugin", attrs)
     if not plugin.name:
