@@ -25,9 +25,11 @@ def _listing(capsys) -> list[dict]:
 def test_json_schema_and_bundled_robots(capsys):
     rows = _listing(capsys)
     for row in rows:
-        assert set(row) == {"name", "qualified", "source", "format", "path"}
+        assert set(row) == {"name", "qualified", "source", "format", "path", "on_disk"}
         assert row["format"] in ("hrdf", "urdf", "xacro", "mjcf")
-        assert Path(row["path"]).exists()
+        # every robot is on disk, but a Menagerie one not downloaded (listed, marked so)
+        assert Path(row["path"]).exists() == row["on_disk"]
+        assert row["on_disk"] or row["source"] == "menagerie"
         assert row["qualified"] == f"{row['source']}:{row['qualified'].split(':', 1)[1]}"
     names = [r["name"] for r in rows]
     assert len(names) == len(set(names))  # every name typed picks one robot
@@ -94,7 +96,7 @@ def test_same_name_twice_in_one_source_is_named_by_folder(tmp_path, monkeypatch,
 
 
 def test_unknown_name_suggests_close_ones(capsys):
-    assert main(["info", "arm7"]) == 2
+    assert main(["info", "arm66"]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "arm6" in err and "robotwright robots" in err
 
