@@ -8,6 +8,7 @@ import warnings
 from pathlib import Path
 
 from robotwright._outputs import add_overwrite_flag, add_strict_flags, check_overwrite
+from robotwright._usd_format import USD_SUFFIXES
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.placement import Placement
 from robotwright.sources import ROBOT_SOURCE_HELP
@@ -131,7 +132,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 _EXTENSIONS = {
     "mjcf": (".xml", ".mjcf"),
     "urdf": (".urdf", ".xml"),
-    "usd": (".usd", ".usda", ".usdc"),
+    "usd": USD_SUFFIXES,
 }
 
 

@@ -32,12 +32,12 @@ from pathlib import Path
 
 import mujoco
 
+from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["USD_LAYOUTS", "USD_SUFFIXES", "UsdExport", "to_usd"]
 
-USD_SUFFIXES = (".usd", ".usda", ".usdc")
 _MISSING = (
     "USD export needs mujoco-usd-converter and usd-core (Isaac Lab's environment, Python "
     '3.12: pip install "isaacsim-asset-isolated==6.2.0.0" "tinyobjloader==2.0.0rc13"); '
@@ -160,8 +160,6 @@ def _author_drives(stage, hrdf: HRDF, kinds: dict[str, str], out: UsdExport) -> 
 
 def _author_free_joint_names(stage, model: mujoco.MjModel) -> None:
     from pxr import Sdf, UsdPhysics
-
-    from robotwright.parsers.usd import FREE_JOINT_ATTR  # the reader's contract
 
     bodies = {p.GetName(): p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)}
     for j in range(model.njnt):

@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 
 from robotwright._rotations import quat_to_mat
+from robotwright._usd_format import prim_name
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["UsdProof", "prove_usd"]
@@ -45,10 +46,6 @@ class UsdProof:
     drives: int = 0
     poses: int = 0
     max_pose_error: float = 0.0
-
-
-def _leaf(label: str) -> str:
-    return label.rsplit("/", 1)[-1]
 
 
 def _rel(a: float, b: float) -> float:
@@ -102,7 +99,7 @@ def prove_usd(
     mj = mjcf_model
 
     # -- bodies ---------------------------------------------------------------------
-    nb = {_leaf(lb): i for i, lb in enumerate(model.body_label)}
+    nb = {prim_name(lb): i for i, lb in enumerate(model.body_label)}
     mass = model.body_mass.numpy()
     com = model.body_com.numpy()
     inertia = model.body_inertia.numpy()
@@ -131,7 +128,7 @@ def prove_usd(
         diff.append(f"body {name!r}: in the USD, not in the MJCF")
 
     # -- joints ---------------------------------------------------------------------
-    nj = {_leaf(lb): i for i, lb in enumerate(model.joint_label)}
+    nj = {prim_name(lb): i for i, lb in enumerate(model.joint_label)}
     q_start = model.joint_q_start.numpy()
     qd_start = model.joint_qd_start.numpy()
     jtype = model.joint_type.numpy()

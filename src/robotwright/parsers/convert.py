@@ -15,6 +15,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from robotwright._usd_format import USD_SUFFIXES
 from robotwright.errors import ConversionError, HRDFError, OutputExistsError, Problem
 from robotwright.hrdf.model import HRDF
 
@@ -26,7 +27,7 @@ def file_kind(path: Path, *, existing: bool) -> str:
         return "urdf"
     if ext in (".xml", ".mjcf"):
         return "mjcf"
-    if existing and ext in (".usd", ".usda", ".usdc"):
+    if existing and ext in USD_SUFFIXES:
         return "usd"
     if (existing and path.is_dir()) or (not existing and ext == ""):
         return "hrdf"

@@ -653,25 +653,25 @@ _WRAP_FAMILY = {
 def _tendon_paths(src: _Side, res: _Side, maps: dict[str, dict[int, int]]) -> list[Difference]:
     """Each matched tendon's path: the kind, object (through the matching) and parameter
     of every element, in order."""
-    s, r = src.m, res.m
+    back = {fam: _inverse(maps[fam]) for fam in set(_WRAP_FAMILY.values())}
+
+    def path(model: mujoco.MjModel, k: int, remap: bool) -> list[tuple]:
+        steps = []
+        adr, num = int(model.tendon_adr[k]), int(model.tendon_num[k])
+        for w in range(adr, adr + num):
+            kind = int(model.wrap_type[w])
+            fam = _WRAP_FAMILY.get(kind)
+            obj = int(model.wrap_objid[w])
+            if fam is not None and remap:
+                obj = back[fam].get(obj, -2)
+            steps.append((kind, obj if fam is not None else -1, float(model.wrap_prm[w])))
+        return steps
+
     out: list[Difference] = []
     for t, u in maps["tendon"].items():
         if u < 0:
             continue
-
-        def path(model: mujoco.MjModel, k: int, remap: bool) -> list[tuple]:
-            steps = []
-            adr, num = int(model.tendon_adr[k]), int(model.tendon_num[k])
-            for w in range(adr, adr + num):
-                kind = int(model.wrap_type[w])
-                fam = _WRAP_FAMILY.get(kind)
-                obj = int(model.wrap_objid[w])
-                if fam is not None and remap:
-                    obj = _inverse(maps[fam]).get(obj, -2)
-                steps.append((kind, obj if fam is not None else -1, float(model.wrap_prm[w])))
-            return steps
-
-        mine, yours = path(s, t, False), path(r, u, True)
+        mine, yours = path(src.m, t, False), path(res.m, u, True)
         same = len(mine) == len(yours) and all(
             a[:2] == b[:2] and _same_values(np.array(a[2]), np.array(b[2]))
             for a, b in zip(mine, yours, strict=False)

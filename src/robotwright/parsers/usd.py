@@ -44,15 +44,14 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright._rotations import compose_pose
+from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES, prim_name
 from robotwright.errors import ConversionError, InputFileError, Problem
 from robotwright.parsers.report import ParseResult, Reporter
 
 __all__ = ["USD_SUFFIXES", "USDOptions", "parse_usd", "prepare_confined_read"]
 
-#: Set by ``robotwright export`` on a floating body's prim (USD has no free joint prim).
-FREE_JOINT_ATTR = "robotwright:freeJointName"
 
-USD_SUFFIXES = (".usd", ".usda", ".usdc")
 _MISSING = (
     "reading USD needs Newton and usd-core (Isaac Lab's environment, Python 3.12: pip "
     'install "robotwright[isaaclab]"); not importable here: {error}'
@@ -158,10 +157,6 @@ def check_usd_dependencies(path: Path, roots: list[Path]) -> None:
 # -- reading --------------------------------------------------------------------------
 
 
-def _leaf(label: str) -> str:
-    return label.rsplit("/", 1)[-1]
-
-
 class _Names:
     """Unique MJCF names per kind from prim names (a repeat gets ``_2``, ``_3``...)."""
 
@@ -170,7 +165,7 @@ class _Names:
         self.renamed: dict[str, list[tuple[str, str]]] = {}
 
     def __call__(self, kind: str, label: str) -> str:
-        base = _leaf(label) or kind
+        base = prim_name(label) or kind
         used = self.used.setdefault(kind, Counter())
         used[base] += 1
         if used[base] == 1:
@@ -190,7 +185,7 @@ class _Names:
             if kind in ("body", "joint", "actuator"):
                 for label, name in pairs:
                     rep.warn(
-                        f"{kind} name {_leaf(label)!r} is used by several prims; {label} "
+                        f"{kind} name {prim_name(label)!r} is used by several prims; {label} "
                         f"becomes {name!r}"
                     )
             elif kind != "mesh":
@@ -205,13 +200,6 @@ def _pose(t: Any) -> tuple[np.ndarray, np.ndarray]:
     """(pos, wxyz quaternion) of a warp transform (xyz, xyzw)."""
     v = np.asarray([float(x) for x in t], dtype=np.float64)
     return v[:3], np.array([v[6], v[3], v[4], v[5]])
-
-
-def _compose(a: tuple, b: tuple) -> tuple[np.ndarray, np.ndarray]:
-    pos, quat = np.empty(3), np.empty(4)
-    mujoco.mju_rotVecQuat(pos, b[0], a[1])
-    mujoco.mju_mulQuat(quat, a[1], b[1])
-    return a[0] + pos, quat
 
 
 def _inverse(t: tuple) -> tuple[np.ndarray, np.ndarray]:
@@ -239,7 +227,6 @@ class _Builder:
         self.spec.compiler.autolimits = True
         self.spec.compiler.degree = False  # Newton gives radians
         self.spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
-        self.body_names: dict[int, str] = {}
         self.joint_names: dict[int, str] = {}  # Newton joint -> first MJCF joint
         self.dof_joint: dict[int, str] = {}  # Newton dof -> MJCF joint
         self.meshes: dict[tuple, str] = {}
@@ -257,7 +244,7 @@ class _Builder:
             self._body(self.spec.worldbody, b, by_child.get(b), children)
         world = [s for s in range(nb.shape_count) if int(nb.shape_body[s]) == -1]
         if world:
-            labels = ", ".join(_leaf(nb.shape_label[s]) for s in world[:5])
+            labels = ", ".join(prim_name(nb.shape_label[s]) for s in world[:5])
             self.rep.warn(
                 f"{len(world)} shape(s) of the world, not of a body ({labels}): a robot file "
                 "holds the robot only; not carried"
@@ -271,9 +258,8 @@ class _Builder:
         if j is None or jtype == int(JT.FREE):
             pose = _pose(nb.body_q[b])  # a free or unjointed body: where it starts
         else:
-            pose = _compose(_pose(nb.joint_X_p[j]), _inverse(_pose(nb.joint_X_c[j])))
+            pose = compose_pose(*_pose(nb.joint_X_p[j]), *_inverse(_pose(nb.joint_X_c[j])))
         name = self.names("body", nb.body_label[b])
-        self.body_names[b] = name
         body = parent_spec.add_body(name=name, pos=pose[0], quat=pose[1])
         inertia = np.asarray(nb.body_inertia[b], dtype=np.float64).reshape(3, 3)
         body.mass = float(nb.body_mass[b])
@@ -336,7 +322,7 @@ class _Builder:
             )
         for k, kind in enumerate(kinds):
             d = d0 + k
-            name = self.names("joint", label if len(kinds) == 1 else f"{_leaf(label)}_{k}")
+            name = self.names("joint", label if len(kinds) == 1 else f"{prim_name(label)}_{k}")
             self.joint_names.setdefault(j, name)
             joint = body.add_joint(name=name, type=kind, pos=anchor[0])
             if kind != mujoco.mjtJoint.mjJNT_BALL:
@@ -638,7 +624,7 @@ def parse_usd(
         folder = Path(tmp)
         builder = _Builder(newton, nb, stage, rep, folder)
         spec = builder.build()
-        spec.modelname = _leaf(str(stage.GetDefaultPrim().GetPath())) or path.stem
+        spec.modelname = prim_name(str(stage.GetDefaultPrim().GetPath())) or path.stem
         if not _actuators(stage, builder, rep):
             _drive_actuators(builder, rep)
         _note_unread(stage, rep)

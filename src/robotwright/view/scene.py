@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from robotwright._usd_format import USD_SUFFIXES
 from robotwright.errors import InputFileError, RobotwrightError
 
 if TYPE_CHECKING:
@@ -140,7 +141,7 @@ def load_source(
     _no_scene(scene, f"'{text}'")
     if path.is_dir() and (path / "design.txt").is_file():
         return _design_scene(path, asset_roots)
-    robot_files = (".xml", ".mjcf", ".urdf", ".xacro", ".usd", ".usda", ".usdc")
+    robot_files = (".xml", ".mjcf", ".urdf", ".xacro", *USD_SUFFIXES)
     if path.is_file() and suffix not in robot_files:
         raise ViewError(
             f"{path}: cannot show a '{suffix or 'extensionless'}' file; expected an MJCF "
