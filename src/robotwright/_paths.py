@@ -195,7 +195,7 @@ def check_mjcf_includes(
     root: PathLike,
     trusted: Sequence[Path] | None = None,
     _depth: int = 0,
-) -> None:
+) -> list[Path]:
     """Check what MuJoCo's XML parser itself opens, before it runs: ``<include file>``
     (each included file is read safely, without entities, and checked the same way) and
     the files of other elements read while parsing (``<flexcomp file>``, ``<model
@@ -207,11 +207,16 @@ def check_mjcf_includes(
         model_dir: the folder of the main file (MuJoCo resolves includes from it).
         root: the folder every path must stay inside (besides trusted ones).
 
+    Returns:
+        The folders of the sub-models (``<asset><model file>``), nested ones too: their
+        meshes are named from there.
+
     Raises:
         UnsafePathError: naming the file and element; also for an included file that is
             not well-formed or unsafe XML, and for includes nested too deep.
     """
 
+    sub_models: list[Path] = []
     pending = [(tree, source, _depth)]
     dirs = [""]
     included: set[Path] = set()
@@ -268,7 +273,9 @@ def check_mjcf_includes(
                             raise UnsafePathError(exc.reason, file=where, element=elem) from None
                         _check_size(found, where, elem)
                         if el.tag == "model" and found.is_file():
-                            _check_sub_model(found, where, elem, root, trusted, depth)
+                            sub_models.append(found.parent)
+                            sub_models += _check_sub_model(found, where, elem, root, trusted, depth)
+    return sub_models
 
 
 def _read_named_xml(path: Path, what: str, where: str, elem: str) -> Any:
@@ -293,10 +300,11 @@ def _read_named_xml(path: Path, what: str, where: str, elem: str) -> Any:
 
 def _check_sub_model(
     path: Path, where: str, elem: str, root: PathLike, trusted: Sequence[Path] | None, depth: int
-) -> None:
+) -> list[Path]:
     """An ``<asset><model file>`` sub-model is a model of its own: MuJoCo reads its
     includes from its folder and its meshes and textures with its own ``<compiler
-    meshdir/texturedir/assetdir>``. Check them so, inside the same root."""
+    meshdir/texturedir/assetdir>``. Check them so, inside the same root; returns the
+    folders of its own sub-models."""
     import mujoco
 
     if depth + 1 > MAX_INCLUDE_DEPTH:
@@ -306,14 +314,15 @@ def _check_sub_model(
     tree = _read_named_xml(path, "the sub-model", where, elem)
     here = {"source": str(path), "model_dir": path.parent, "root": root, "trusted": trusted}
     try:
-        check_mjcf_includes(tree, **here, _depth=depth + 1)
+        nested = check_mjcf_includes(tree, **here, _depth=depth + 1)
         try:
             spec = mujoco.MjSpec.from_file(str(path))
         except ValueError:
-            return  # MuJoCo refuses the sub-model: it reads none of its assets
+            return nested  # MuJoCo refuses the sub-model: it reads none of its assets
         check_mjcf_spec(spec, **here)
     except UnsafePathError as exc:
         raise UnsafePathError(str(exc), file=where, element=elem) from None
+    return nested
 
 
 #: Bytes MuJoCo allocates per replicated body and per flexcomp point at least (an

@@ -655,35 +655,6 @@ def _keep_interleaved_order(
             table[row] = replace(table[row], order=position)
 
 
-def _sub_model_dirs(path: Path, meshdir: str) -> list[Path]:
-    """Folders of the sub-models the MJCF ``path`` attaches (``<asset><model file>``,
-    found as MuJoCo finds them: from the file's folder or its mesh folder), nested ones
-    too. Their meshes are named relative to their own folder and ``meshdir``. (The files
-    were checked for containment before MuJoCo read them.)"""
-    if not path.is_file():
-        return []
-    from robotwright.parsers.xmlsafe import parse_xml
-
-    found: list[Path] = []
-    pending = [(path.resolve(), meshdir)]
-    while pending and len(found) < 64:
-        file, folder = pending.pop()
-        for el in parse_xml(file).iter("model"):
-            name = el.get("file")
-            if not name:
-                continue
-            for base in (file.parent, file.parent / folder):
-                sub = (base / name).resolve()
-                if sub.is_file() and sub.parent not in found:
-                    found.append(sub.parent)
-                    sub_meshdir = next(
-                        (c.get("meshdir", "") for c in parse_xml(sub).iter("compiler")), ""
-                    )
-                    pending.append((sub, sub_meshdir))
-                    break
-    return found
-
-
 def _mesh_source(
     m_spec: mujoco.MjsMesh, meshdir: str, base_dir: Path, sub_dirs: list[Path]
 ) -> Path:
@@ -707,12 +678,13 @@ def _geoms(
     store: MeshStore,
     frames: set[int],
     rep: Reporter,
+    sub_dirs: list[Path],
 ) -> tuple[list[MeshGeom], list[SimpleGeom]]:
-    """Mesh geoms (files staged, authored poses restored) and primitive geoms."""
+    """Mesh geoms (files staged, authored poses restored) and primitive geoms;
+    ``sub_dirs``: the folders of the sub-models, whose meshes are named from there."""
     # Relative to the main file's folder (MuJoCo folds <compiler assetdir> into meshdir).
     meshdir = spec.compiler.meshdir or ""
     base_dir = path.resolve().parent
-    sub_dirs = _sub_model_dirs(path, meshdir)
     mesh_files: dict[int, tuple[str, str]] = {}
     meshes: list[MeshGeom] = []
     simple: list[SimpleGeom] = []
@@ -1086,7 +1058,7 @@ def parse_mjcf(
     where = {"source": str(path), "model_dir": path.resolve().parent}
     try:
         trusted = trusted_roots(opt.asset_roots)
-        check_mjcf_includes(tree, **where, root=path.resolve().parent, trusted=trusted)
+        sub_dirs = check_mjcf_includes(tree, **where, root=path.resolve().parent, trusted=trusted)
         spec = mujoco.MjSpec.from_file(str(path))
         check_mjcf_spec(spec, **where, root=path.resolve().parent, trusted=trusted)
         # Keyframes are allocated when the model compiles: refuse a flood of them first.
@@ -1105,7 +1077,7 @@ def parse_mjcf(
         raise  # a file over the size limit: refused before MuJoCo read it
     except ValueError as exc:
         raise ConversionError([Problem(str(path), f"MuJoCo cannot load it: {exc}")]) from exc
-    return _from_compiled(spec, model, path, opt, rep, strict)
+    return _from_compiled(spec, model, path, opt, rep, strict, sub_dirs)
 
 
 def parse_mjcf_spec(
@@ -1129,15 +1101,17 @@ def _from_compiled(
     opt: MJCFOptions,
     rep: Reporter,
     strict: bool,
+    sub_dirs: list[Path] | None = None,
 ) -> ParseResult:
-    """The HRDF of a compiled spec (the body of :func:`parse_mjcf`)."""
+    """The HRDF of a compiled spec (the body of :func:`parse_mjcf`; ``sub_dirs``: the
+    folders of its sub-models, from the containment check)."""
     root_id, keep = _select_robot(model, path, opt, rep)
     kept = set(keep)
     frames = _frames_as_sites(model, keep, root_id, opt)
     bodies = _bodies(model, keep, root_id, frames, rep)
     joints = _joints(model, kept, root_id, path, rep)
     store = mesh_store(opt.work_dir, opt.join_obj_objects)
-    meshes, simple = _geoms(model, spec, kept, path, store, frames, rep)
+    meshes, simple = _geoms(model, spec, kept, path, store, frames, rep, sub_dirs or [])
     sites = _sites(model, kept, frames, root_id, rep)
     names = {
         "joint": {j.name for j in joints if j.name},
