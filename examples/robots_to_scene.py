@@ -19,7 +19,7 @@ import numpy as np
 
 from robotwright.errors import ConversionWarning
 from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
-from robotwright.generators.tasks import compose_scene
+from robotwright.tasks import compose_scene
 from robotwright.hrdf import HRDF
 from robotwright.parsers import urdf_to_hrdf
 

@@ -41,7 +41,7 @@ def test_building_the_parser_imports_no_heavy_library() -> None:
 
 def test_every_option_has_help(capsys) -> None:
     parser = build_parser()
-    from robotwright.cli import _all_parsers
+    from robotwright.cli.main import _all_parsers
 
     missing = [
         f"{p.prog} {'/'.join(a.option_strings) or a.dest}"
@@ -197,7 +197,7 @@ def test_one_overwrite_rule_for_every_command(tmp_path: Path, capsys) -> None:
 
 
 def test_interrupt_is_one_line_and_exit_130(monkeypatch, capsys) -> None:
-    from robotwright.hrdf import cli as hrdf_cli
+    from robotwright.cli import hrdf as hrdf_cli
 
     def interrupted(args):
         raise KeyboardInterrupt

@@ -26,8 +26,7 @@ from pathlib import Path
 
 import pytest
 
-from robotwright import demo
-from robotwright.cli import build_parser, main
+from robotwright.cli import build_parser, demo, main
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from robotwright.cli import build_parser
-from robotwright.sources import ROBOT_SOURCE_HELP
+from robotwright.cli.options import ROBOT_SOURCE_HELP
 
 #: Positional arguments that name a robot to read.
 ROBOT_ARGS = {"robot", "robots", "src", "path"}

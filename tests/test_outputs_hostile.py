@@ -241,7 +241,7 @@ def _dead_pid() -> int:
 
 
 def test_a_failed_demo_keeps_the_previous_demo_folder(tmp_path: Path, monkeypatch) -> None:
-    from robotwright import demo
+    from robotwright.cli import demo
 
     def writes(out: Path, ctx: dict) -> str:
         (out / "robots").mkdir()

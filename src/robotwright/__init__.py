@@ -34,8 +34,10 @@ _SUBMODULES = frozenset(
         "hrdf",
         "parsers",
         "render",
+        "scene",
         "sensors",
         "sources",
+        "tasks",
         "things",
         "view",
     }

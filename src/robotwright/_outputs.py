@@ -8,7 +8,7 @@ output is a folder it replaces only a folder robotwright wrote as that kind of o
 written), never a folder holding anything else, a folder that holds the working folder or
 the home folder, or a symbolic link. It is checked before any work, so a refused run
 writes nothing. ``robotwright demo`` refreshes its own output folder without the flag
-(see :mod:`robotwright.demo`), under the same rule.
+(see :mod:`robotwright.cli.demo`), under the same rule.
 
 Files copied next to a file output (``export``/``compose --copy-meshes``, ``convert`` to
 a model file: ``meshes/<robot>/...``; ``things``: ``assets/...``) follow the rule too:
@@ -23,7 +23,6 @@ this module is the command line's side of it, importable without MuJoCo or numpy
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import re
@@ -37,7 +36,6 @@ from robotwright.errors import OutputExistsError
 
 __all__ = [
     "MARKER",
-    "add_overwrite_flag",
     "check_copy_destination",
     "check_folder_output",
     "check_overwrite",
@@ -77,13 +75,6 @@ _LEGACY: dict[str, tuple[str, re.Pattern[str]]] = {
     ),
     "designs": ("", re.compile(r"\d+_[0-9a-f]+")),
 }
-
-OVERWRITE_HELP = "replace an existing output (without it an existing output is refused)"
-
-
-def add_overwrite_flag(parser: argparse.ArgumentParser) -> None:
-    """Add ``--overwrite`` (``args.overwrite``, default False) to a command's parser."""
-    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
 
 
 def existing_output(path: str | os.PathLike[str]) -> bool:
@@ -301,17 +292,4 @@ def check_copy_destination(dst: str | os.PathLike[str], src: str | os.PathLike[s
     raise OutputExistsError(
         f"{dst}: {what}; not replacing a file the output copies there (give --overwrite to "
         "replace it, or another output path)"
-    )
-
-
-def add_strict_flags(p: argparse.ArgumentParser, *, strict_help: str, all_help: str) -> None:
-    """``--strict`` (``args.strict`` True: fail on a note that changes the physics) and
-    ``--strict-all`` (``"all"``: on every note, cosmetic ones too), one or the other
-    (see :func:`robotwright.errors.strict_failures`)."""
-    strictness = p.add_mutually_exclusive_group()
-    strictness.add_argument(
-        "--strict", action="store_const", const=True, default=False, help=strict_help
-    )
-    strictness.add_argument(
-        "--strict-all", dest="strict", action="store_const", const="all", help=all_help
     )

@@ -472,7 +472,7 @@ def checked_mjcf_spec(path: PathLike, *, trusted: Sequence[Path] | None = None) 
     """
     import mujoco
 
-    from robotwright.parsers.xmlsafe import parse_xml
+    from robotwright._xmlsafe import parse_xml
 
     path = Path(path)
     tree = parse_xml(path)

@@ -8,11 +8,11 @@ description packages; ``SOURCE:NAME`` picks one source). :func:`load_robot` read
 into an :class:`~robotwright.hrdf.model.HRDF` with the project's readers.
 
 The command line adds one option group to every command that reads a robot
-(:func:`add_source_options`: ``--root-body``, ``--fixed-joints``, ``--floating-base``,
-``--bound-mass``, ``--bound-inertia``, ``--inertia-from-geoms``, ``--density``,
-``--xacro-arg``; with
-``--asset-root`` and ``--package``, which ``robotwright.cli`` adds) and hands the
-options to the readers for the command's run with :func:`given_source_options`, as
+(:func:`robotwright.cli.options.add_source_options`: ``--root-body``,
+``--fixed-joints``, ``--floating-base``, ``--bound-mass``, ``--bound-inertia``,
+``--inertia-from-geoms``, ``--density``, ``--xacro-arg``; with ``--asset-root`` and
+``--package``) and hands the options to the readers for the command's run with
+:func:`given_source_options`, as
 ``--package`` is handed with :func:`robotwright.parsers.packages.given_packages`. An
 option that does not apply to the source's kind (``--bound-mass`` for an MJCF) is an
 error naming it.
@@ -20,7 +20,6 @@ error naming it.
 
 from __future__ import annotations
 
-import argparse
 import logging
 import os
 import warnings
@@ -40,12 +39,10 @@ if TYPE_CHECKING:
 __all__ = [
     "ResolvedSource",
     "SourceNotFoundError",
-    "add_source_options",
     "given_source_options",
     "load_robot",
     "load_robot_with_notes",
     "resolve_source",
-    "source_options",
 ]
 
 #: Robot file kinds by extension (``.urdf.xacro`` ends in ``.xacro``).
@@ -58,13 +55,6 @@ FILE_KINDS = {
     ".usda": "usd",
     ".usdc": "usd",
 }
-
-#: What a robot argument of any command takes: the help text every command shows (a test
-#: checks each one does, so that help cannot lag behind what the readers take).
-ROBOT_SOURCE_HELP = (
-    "a robot: a name ('robotwright robots' lists them), an HRDF folder, or a URDF (.urdf), "
-    "xacro (.xacro), MJCF (.xml, .mjcf) or USD (.usd, .usda, .usdc) file"
-)
 
 #: Options of the shared group, by the source kinds they apply to.
 URDF_OPTIONS = (
@@ -100,103 +90,6 @@ class ResolvedSource:
     path: Path
     title: str
     entry: RobotEntry | None = None
-
-
-def _float_arg(what: str, *, positive: bool) -> Any:
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = float("nan")
-        ok = value > 0 if positive else value >= 0
-        if not ok or value == float("inf"):
-            raise argparse.ArgumentTypeError(f"{text!r}: expected a finite {what}")
-        return value
-
-    return parse
-
-
-def parse_xacro_arg(text: str) -> tuple[str, str]:
-    """``NAME:=VALUE`` (xacro's own syntax) of ``--xacro-arg``, as ``(NAME, VALUE)``."""
-    name, sep, value = text.partition(":=")
-    if not sep or not name.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: expected NAME:=VALUE")
-    return name.strip(), value
-
-
-def add_source_options(p: argparse.ArgumentParser) -> None:
-    """The robot-source options (see the module docstring) on command parser ``p``; an
-    option the command already has (``convert`` and ``roundtrip`` define their own,
-    with the same meaning) is left as it is."""
-    have = set(p._option_string_actions)
-    group = p.add_argument_group("robot source (a name, HRDF folder, URDF, xacro or MJCF file)")
-
-    def add(flag: str, **kw: Any) -> None:
-        if flag not in have:
-            group.add_argument(flag, **kw)
-
-    add(
-        "--root-body",
-        metavar="NAME",
-        help="MJCF: the top-level body that is the robot (when the world holds several)",
-    )
-    add(
-        "--fixed-joints",
-        choices=("keep", "merge", "site"),
-        help="URDF: a link on a fixed joint stays a body (keep, the default), is merged "
-        "into its parent (merge), or becomes a site when massless (site)",
-    )
-    add(
-        "--bound-mass",
-        type=_float_arg("mass >= 0 [kg]", positive=False),
-        metavar="KG",
-        help="URDF: raise masses below KG to KG",
-    )
-    add(
-        "--bound-inertia",
-        type=_float_arg("inertia >= 0 [kg m^2]", positive=False),
-        metavar="KG_M2",
-        help="URDF: raise principal moments below KG_M2 [kg m^2] to it",
-    )
-    add(
-        "--inertia-from-geoms",
-        choices=("auto", "never"),
-        help="URDF: a link without <inertial> gets the mass and inertia of its collision "
-        "geoms (auto, the default) or none (never)",
-    )
-    add(
-        "--density",
-        type=_float_arg("density > 0 [kg/m^3]", positive=True),
-        metavar="KG_M3",
-        help="URDF, --inertia-from-geoms auto: density of those collision geoms (default 1000)",
-    )
-    add(
-        "--floating-base",
-        action="store_const",
-        const=True,
-        default=None,
-        help="URDF: give the root link a free joint (a legged robot's base; URDF has none); "
-        "render, view and lidar then stand it on the floor",
-    )
-    add(
-        "--xacro-arg",
-        action="append",
-        type=parse_xacro_arg,
-        metavar="NAME:=VALUE",
-        help=".xacro: value of $(arg NAME) (repeatable)",
-    )
-
-
-def source_options(args: argparse.Namespace) -> dict[str, Any]:
-    """The readers' options given on the command line (only those given)."""
-    opts: dict[str, Any] = {}
-    for name in (*URDF_OPTIONS, *MJCF_OPTIONS):
-        value = getattr(args, name, None)
-        if value is not None:
-            opts[name] = value
-    if getattr(args, "xacro_arg", None):
-        opts["xacro_args"] = dict(args.xacro_arg)
-    return opts
 
 
 @contextmanager

@@ -6,7 +6,7 @@ import mujoco
 import pytest
 
 from robotwright.cli import main
-from robotwright.generators.cli import parse_robot_spec
+from robotwright.cli.export import parse_robot_spec
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

@@ -6,7 +6,7 @@ import mujoco
 import pytest
 
 from robotwright.errors import GeneratorError
-from robotwright.generators import compose_scene, export_robot
+from robotwright.tasks import compose_scene, export_robot
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

@@ -179,7 +179,7 @@ def test_export_and_search_never_replace_a_file_or_a_foreign_folder(tmp_path, ca
 
 
 def test_long_work_is_announced_and_shows_progress_with_time_left(capsys, monkeypatch):
-    from robotwright.grammar import cli as gcli
+    from robotwright.cli import grammar as gcli
 
     progress = gcli.Progress(10, "designs done", every=0.0)
     progress.update(0)  # nothing done: no estimate yet

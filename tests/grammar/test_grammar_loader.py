@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from robotwright.cli.grammar import register  # noqa: F401  (import check)
 from robotwright.errors import GrammarError
-from robotwright.grammar.cli import register  # noqa: F401  (import check)
 from robotwright.grammar.loader import default_grammar, load_grammar, load_library
 from robotwright.grammar.symbols import NodePattern
 

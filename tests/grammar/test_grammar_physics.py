@@ -172,7 +172,7 @@ def test_search_writes_winners_view_can_open(tmp_path, capsys):
     second = json.loads((out / "best_2" / "values.json").read_text())["values"]["track"]
     assert first <= second
     assert f"best track = {first:.4f}" in printed
-    from robotwright.view.scene import load_source
+    from robotwright.scene.load import load_source
 
     scene = load_source(out / "best_1")  # what `robotwright view OUT/best_1` shows
     limb_xml = mujoco.MjModel.from_xml_path(str(out / "best_1" / "srl.xml"))

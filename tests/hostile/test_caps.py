@@ -415,7 +415,7 @@ def test_npz_declaring_huge_arrays_is_refused_before_loading(tmp_path, capsys, s
 
 
 def test_npz_zip_directory_declaring_a_huge_entry_is_refused(tmp_path):
-    from robotwright.view.scene import ViewError, read_scan
+    from robotwright.scene.load import ViewError, read_scan
 
     path = tmp_path / "big.npz"
     with (

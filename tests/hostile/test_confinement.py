@@ -26,7 +26,7 @@ import trimesh
 
 import robotwright._paths as paths
 import robotwright.parsers.mjcf as mjcf_parser
-import robotwright.view.scene as view_scene
+import robotwright.scene.load as view_scene
 from robotwright._confine import ConfinementError, confinement, run_confined
 from robotwright.cli import main
 from robotwright.errors import ConversionWarning, RobotwrightError, UnsafePathError
@@ -200,7 +200,7 @@ def test_render_view_loader_confined_with_checks_off(layout, checks_off) -> None
     confined compile cannot open the secret."""
     for label, path in _escapes(layout):
         try:
-            model = view_scene._compile_mjcf(path, ())
+            model = view_scene.compile_mjcf(path, ())
         except (RobotwrightError, ValueError):
             continue
         assert model.nmesh == 0 or float(np.max(np.abs(model.mesh_vert))) < SECRET_SIZE / 4, label
@@ -213,7 +213,7 @@ def test_sub_model_is_checked_with_its_own_compiler_folders(layout, capsys) -> N
     with pytest.raises(RobotwrightError, match="sub.xml"):
         mjcf_to_hrdf(path)
     with pytest.raises(UnsafePathError, match="sub.xml"):
-        view_scene._compile_mjcf(path, ())
+        view_scene.compile_mjcf(path, ())
     assert main(["convert", str(path), "-o", str(layout["tmp"] / "o.xml")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "sub.xml" in err and "Traceback" not in err
@@ -234,7 +234,7 @@ def test_a_sub_model_inside_the_folder_still_attaches(tmp_path: Path) -> None:
         '<asset><model name="sub" file="sub/sub.xml"/></asset>',
         '<attach model="sub" body="s" prefix="s_"/>',
     )
-    model = view_scene._compile_mjcf(path, ())
+    model = view_scene.compile_mjcf(path, ())
     assert model.nmesh == 1
     assert float(np.ptp(model.mesh_vert[:, 0])) == pytest.approx(0.2)
 

@@ -25,7 +25,7 @@ import trimesh
 
 from robotwright.cli import main
 from robotwright.errors import SensorError
-from robotwright.sensors.cli import read_mapping
+from robotwright.sensors.config import read_class_mapping
 
 SCENE = """<mujoco model="s">
   <compiler angle="radian"{compiler}/>
@@ -226,7 +226,7 @@ def test_bad_mappings_are_refused(shared: Path, capsys) -> None:
         try:
             err = _refused(_lidar(scene, out, "--mapping", str(mapping)), out, capsys)
             with pytest.raises(SensorError):
-                read_mapping(mapping)
+                read_class_mapping(mapping)
         except BaseException as exc:
             raise AssertionError(f"mapping not refused: {label}") from exc
         assert str(mapping) in err and err.count("\n") == 1, label
@@ -249,6 +249,6 @@ def test_string_keywords_are_not_split_into_letters(shared: Path) -> None:
 def test_good_mapping_is_read(shared: Path) -> None:
     mapping = shared / "map.json"
     mapping.write_text(json.dumps({"terrain": ["floor"], "obstacle": ["geom"]}))
-    assert read_mapping(mapping) == {"terrain": ["floor"], "obstacle": ["geom"]}
+    assert read_class_mapping(mapping) == {"terrain": ["floor"], "obstacle": ["geom"]}
     scene = _scene(shared / "scene", file="box.stl")
     assert main(_lidar(scene, shared / "good.npz", "--mapping", str(mapping))) == 0

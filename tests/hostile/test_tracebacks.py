@@ -27,9 +27,9 @@ import trimesh
 from robotwright._paths import resolve_inside
 from robotwright.cli import main
 from robotwright.errors import HRDFError, RobotwrightError, SensorError, UnsafePathError
+from robotwright.generators.compiles import validate_dir
 from robotwright.hrdf import HRDF
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
-from robotwright.hrdf.validate import validate_dir
 
 MESH_HEADER = (
     "contact_type,contact_affinity,static_friction,dynamic_friction,restitution,"
@@ -209,7 +209,7 @@ BAD_MESHES = _bad_meshes()
 def test_mesh_mujoco_refuses_is_bad_input_everywhere(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str
 ) -> None:
-    from robotwright.view.scene import load_source
+    from robotwright.scene.load import load_source
 
     folder = _robot(tmp_path)
     (folder / "meshes" / "part.stl").write_bytes(BAD_MESHES[kind])
@@ -335,7 +335,7 @@ def test_pattern_file_real_arrays_still_load(tmp_path: Path, dtype: type) -> Non
 
 @pytest.mark.parametrize(("nrow", "ncol"), [(2, 2), (7, 300), (1500, 1500), (3000, 40), (5, 9000)])
 def test_hfield_drawn_within_cap(nrow: int, ncol: int) -> None:
-    from robotwright.view.geometry import MAX_HFIELD_DRAWN, hfield_surface
+    from robotwright.scene.geometry import MAX_HFIELD_DRAWN, hfield_surface
 
     xml = (
         f"<mujoco><asset><hfield name='h' nrow='{nrow}' ncol='{ncol}' size='1 2 0.5 0.1'/>"

@@ -13,10 +13,9 @@ import trimesh
 
 from robotwright.cli import main
 from robotwright.generators import MJCFHumanoidGenerator
+from robotwright.generators.compiles import check_compiles, validate_dir
 from robotwright.hrdf import HRDF
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
-from robotwright.hrdf.compiles import check_compiles
-from robotwright.hrdf.validate import validate_dir
 
 MESH_HEADER = (
     "contact_type,contact_affinity,static_friction,dynamic_friction,restitution,"

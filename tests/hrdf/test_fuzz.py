@@ -34,9 +34,9 @@ import yaml
 
 from robotwright.errors import HRDFError, RobotwrightError
 from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
+from robotwright.generators.compiles import validate_dir
 from robotwright.hrdf import HRDF
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
-from robotwright.hrdf.validate import validate_dir
 
 SEED = 20_240_611
 MAX_CASES = 400

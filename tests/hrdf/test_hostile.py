@@ -26,9 +26,9 @@ from robotwright.errors import (
     UnsafePathError,
 )
 from robotwright.generators import MJCFHumanoidGenerator
+from robotwright.generators.compiles import validate_dir
 from robotwright.hrdf import HRDF
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
-from robotwright.hrdf.validate import validate_dir
 
 MESH_HEADER = (
     "contact_type,contact_affinity,static_friction,dynamic_friction,restitution,"

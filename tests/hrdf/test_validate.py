@@ -13,9 +13,9 @@ import pytest
 import yaml
 
 from robotwright.errors import HRDFError, Problem
+from robotwright.generators.compiles import validate_dir
 from robotwright.hrdf import HRDF
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
-from robotwright.hrdf.validate import validate_dir
 
 
 def edit_csv(path: Path, fn: Callable[[list[list[str]]], None]) -> None:

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from robotwright._xmlsafe import parse_xml
 from robotwright.errors import ConversionError
 from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
 from robotwright.hrdf.model import HRDF, Body, Joint
@@ -23,7 +24,6 @@ from robotwright.hrdf.validate import check_model as validate
 from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_from_model
 from robotwright.parsers.roundtrip import compare_extras, our_mjcf_model, roundtrip
-from robotwright.parsers.xmlsafe import parse_xml
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
 

@@ -12,9 +12,9 @@ import pytest
 from PIL import Image
 
 from robotwright.cli import main
+from robotwright.cli.render import default_output
 from robotwright.render import RenderError, RenderOptions, render_animation, render_model
 from robotwright.render.anim import simulate_states, sweep_states
-from robotwright.render.cli import default_output
 from robotwright.render.core import _scene
 
 #: A floor, a robot arm (group 0) and its collision box (group 3), a falling box.

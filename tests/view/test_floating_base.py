@@ -10,8 +10,8 @@ import mujoco
 import pytest
 
 from robotwright._mjmodel import lowest_collision_point
+from robotwright.scene.load import load_source
 from robotwright.sources import given_source_options
-from robotwright.view.scene import load_source
 
 LEGGED = """<robot name="legged">
   <link name="base">

@@ -14,8 +14,8 @@ import mujoco
 import numpy as np
 import pytest
 
+from robotwright.scene.geometry import geom_shapes
 from robotwright.view import ViewerConfig, load_source
-from robotwright.view.geometry import geom_shapes
 from robotwright.view.server import Viewer
 
 from .browser import Browser, find_chromium

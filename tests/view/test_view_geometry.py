@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from robotwright.view.geometry import (
+from robotwright.scene.geometry import (
     body_poses,
     geom_rgba,
     geom_shapes,
@@ -277,9 +277,9 @@ def test_primitive_mesh_is_none_for_meshes_and_height_fields() -> None:
 
 
 def test_view_says_nothing_of_its_own_floor_texture_without_v() -> None:
-    from robotwright.view.cli import note_lines
-    from robotwright.view.geometry import geom_shapes
-    from robotwright.view.scene import load_source
+    from robotwright.cli.view import note_lines
+    from robotwright.scene.geometry import geom_shapes
+    from robotwright.scene.load import load_source
 
     scene = load_source("mini_humanoid")  # generated with our floor: a textured plane
     skipped: list[str] = []

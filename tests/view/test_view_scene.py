@@ -14,7 +14,7 @@ import pytest
 from robotwright.errors import RobotwrightError, UnsafePathError
 from robotwright.generators import MJCFHumanoidGenerator
 from robotwright.hrdf.model import HRDF
-from robotwright.view.scene import ViewError, load_source
+from robotwright.scene.load import ViewError, load_source
 
 # The reference models are generated here too; what MJCF/URDF cannot hold is not the
 # viewer's concern.
@@ -59,7 +59,7 @@ def test_hrdf_folder_and_object(tmp_path: Path) -> None:
 
 
 def test_mjcf_and_urdf_files(tmp_path: Path) -> None:
-    from robotwright.generators.tasks import export_robot
+    from robotwright.tasks import export_robot
 
     paths = export_robot("mini_humanoid", tmp_path)
     mjcf = load_source(paths["mjcf"])
@@ -256,7 +256,7 @@ def test_cli_serves_the_page_until_ctrl_c(tmp_path: Path) -> None:
 def test_composed_scene(tmp_path: Path) -> None:
     """A scene written by compose_scene (two robots, prefixed) is shown as MuJoCo
     compiles it: both robots, each at its placement."""
-    from robotwright.generators.tasks import compose_scene
+    from robotwright.tasks import compose_scene
 
     xml = compose_scene(
         {"h": "mini_humanoid", "arm": "arm6"},

@@ -17,7 +17,6 @@ if TYPE_CHECKING:
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
     from robotwright.generators.mjcf_base import DEFAULT_SCENE, MJCFGeneratorBase, SceneDefaults
     from robotwright.generators.placement import Placement
-    from robotwright.generators.tasks import compose_scene, export_robot
     from robotwright.generators.urdf import URDFHumanoidGenerator
     from robotwright.generators.urdf_base import URDFGeneratorBase
     from robotwright.generators.usd import UsdExport, to_usd
@@ -37,8 +36,6 @@ __all__ = [
     "URDFHumanoidGenerator",
     "UsdExport",
     "UsdProof",
-    "compose_scene",
-    "export_robot",
     "prove_usd",
     "to_usd",
 ]

@@ -6,8 +6,10 @@ URDF, design text/JSON, tree, picture of the limb alone), readable by
 
 - ``values.json`` / ``values.txt``: every objective's value with its unit, the score,
   the rank and the design hash;
-- ``on_carrier.png``: the limb worn by its carrier in its display pose, drawn by
-  :mod:`robotwright.render` (OpenGL when available, else the software renderer);
+- ``on_carrier.png``: the limb worn by its carrier in its display pose, drawn by the
+  ``draw_carrier`` function given (``robotwright grammar search -o`` passes
+  :func:`robotwright.render.api.draw_pose`: OpenGL when available, else the software
+  renderer; the grammar does not import the renderer, which reads design folders);
 - ``track.png`` (objectives ``track`` and ``energy``): the tool path against the
   reference, seen from the front (y-z) and from above (x-y).
 
@@ -18,7 +20,7 @@ leaves the earlier output, or none).
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import mujoco
@@ -36,6 +38,9 @@ from robotwright.grammar.physics import (
     track,
 )
 from robotwright.grammar.rules import Grammar
+
+#: Draws a model at joint values ``qpos`` into a PNG at ``path`` under a ``title``.
+DrawPose = Callable[[mujoco.MjModel, np.ndarray, Path, str], None]
 
 #: Unit of each objective's value.
 UNITS = {
@@ -65,9 +70,12 @@ def write_winners(
     k: int = 3,
     carrier: Carrier = DEFAULT_CARRIER,
     pictures: bool = True,
+    draw_carrier: DrawPose | None = None,
 ) -> list[Path]:
     """Write the ``k`` best feasible designs of ``evaluations`` into ``out`` (a folder
     of designs; see the module docstring). Returns the ``best_N`` folders written.
+    ``draw_carrier(model, qpos, path, title)`` draws ``on_carrier.png`` (with
+    ``pictures``; none is drawn without it).
 
     Raises:
         OutputExistsError: ``out`` holds something other than an earlier folder of
@@ -104,26 +112,15 @@ def write_winners(
             if pictures:
                 limb = build(grammar, ev.design)
                 m = mount(limb, carrier)
-                draw_on_carrier(m.model, display_pose(limb), folder / "on_carrier.png", rank)
+                if draw_carrier is not None:
+                    title = f"best_{rank} on its carrier"
+                    draw_carrier(m.model, display_pose(limb), folder / "on_carrier.png", title)
                 if {"track", "energy"} & set(names):
                     run = track(limb, carrier, mounted=m)
                     plot_track(run, folder / "track.png", f"best_{rank} ({ev.design.hash()})")
             written.append(out / f"best_{rank}")
         (tmp / "winners.txt").write_text("".join(lines) or "no feasible design\n", encoding="utf-8")
     return written
-
-
-def draw_on_carrier(model: mujoco.MjModel, q: np.ndarray, path: Path, rank: int) -> None:
-    """A picture of the mounted limb at joint values ``q`` (the carrier held still)."""
-    from robotwright.render import RenderOptions, render_model
-    from robotwright.render.png import save_png
-
-    data = mujoco.MjData(model)
-    data.qpos[:] = q
-    mujoco.mj_forward(model, data)
-    # from behind and to the left: the limb on the back and its depth both show
-    opts = RenderOptions(width=360, height=300, camera="225,-15")
-    save_png(render_model(model, data, opts), path, title=f"best_{rank} on its carrier")
 
 
 def plot_track(run: TrackResult, path: Path, title: str) -> None:

@@ -854,19 +854,3 @@ def check_model(hrdf: HRDF, *, check_files: bool = True, finite: bool = True) ->
         reported = {(p.file, p.row, p.column) for p in problems if p.column is not None}
         problems += _check_finite(hrdf, reported)
     return problems
-
-
-def validate_dir(path: str | Path, *, compile_model: bool = True) -> list[Problem]:
-    """Read and check an HRDF folder; return every problem (errors and warnings).
-
-    With ``compile_model`` (the default), a folder without table errors is also exported in
-    memory and compiled with MuJoCo (see :func:`robotwright.hrdf.compiles.check_compiles`):
-    a folder that validates exports to MJCF and URDF, and its MJCF compiles.
-    """
-    from robotwright.hrdf.compiles import check_compiles
-    from robotwright.hrdf.io import collect_hrdf_dir
-
-    hrdf, problems = collect_hrdf_dir(path)
-    if compile_model and hrdf is not None and not any(p.severity == "error" for p in problems):
-        problems += check_compiles(hrdf)
-    return problems

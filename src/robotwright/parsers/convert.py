@@ -132,7 +132,7 @@ def _convert(
     scene: bool = False,
 ) -> list[str]:
     from robotwright._confine import run_confined
-    from robotwright.hrdf.compiles import require_compiles
+    from robotwright.generators.compiles import require_compiles
     from robotwright.parsers.collision import pop_config
     from robotwright.parsers.packages import source_read_roots
 

@@ -26,6 +26,7 @@ import numpy as np
 from robotwright._limits import keyframes_problem
 from robotwright._mjmodel import actuator_count
 from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
+from robotwright._xmlsafe import parse_xml
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
     HRDF,
@@ -53,7 +54,6 @@ from robotwright.parsers.meshes import (
 )
 from robotwright.parsers.reference import body_name, joint_name
 from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
-from robotwright.parsers.xmlsafe import parse_xml
 
 _JOINT = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 _GEOM = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box", 7: "mesh"}

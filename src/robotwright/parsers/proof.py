@@ -1246,7 +1246,7 @@ def prove(
     robot holds), and MuJoCo's import of our URDF against that MJCF
     (:func:`robotwright.parsers.proof_urdf.prove_urdf_output`: what a URDF holds)."""
     options = dict(options or {})
-    from robotwright.hrdf.compiles import too_deep_for_mjcf
+    from robotwright.generators.compiles import too_deep_for_mjcf
 
     deep = too_deep_for_mjcf(hrdf)
     if deep is not None:

@@ -25,9 +25,9 @@ import numpy as np
 
 from robotwright._mjmodel import actuator_count
 from robotwright._rotations import quat_to_mat, rpy_to_quat
+from robotwright._xmlsafe import parse_xml
 from robotwright.errors import UnsafePathError
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
-from robotwright.parsers.xmlsafe import parse_xml
 
 _MJ_JOINT = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 #: Actuator transmission type -> MuJoCo object type of its target.

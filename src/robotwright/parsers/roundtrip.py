@@ -934,7 +934,7 @@ def roundtrip(
 
 
 def _check_input(path: Path, configs: int) -> None:
-    from robotwright.parsers.xmlsafe import parse_xml
+    from robotwright._xmlsafe import parse_xml
 
     if configs < 1:
         raise ConversionError(

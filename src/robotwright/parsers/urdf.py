@@ -29,6 +29,7 @@ import numpy as np
 from robotwright._notes import name_list
 from robotwright._paths import trusted_asset_roots
 from robotwright._progress import steps
+from robotwright._xmlsafe import describe
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import (
     HRDF,
@@ -56,7 +57,6 @@ from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
 from robotwright.parsers.visuals import drop_unbuildable_visuals
 from robotwright.parsers.xacro import read_robot_xml
-from robotwright.parsers.xmlsafe import describe
 
 VISUAL_GROUP = 2
 #: Joints from a root link named "world" that stay on its child when the root is dropped.

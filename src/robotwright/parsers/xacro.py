@@ -40,6 +40,7 @@ import defusedxml.ElementTree as DET
 
 from robotwright._inputs import MAX_XML_BYTES, MAX_YAML_BYTES, decode, read_bytes
 from robotwright._paths import resolve_inside, trusted_roots
+from robotwright._xmlsafe import parse_xml
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.parsers.packages import (
     find_package,
@@ -49,7 +50,6 @@ from robotwright.parsers.packages import (
 )
 from robotwright.parsers.report import Reporter
 from robotwright.parsers.xacro_eval import ExpressionError, installed
-from robotwright.parsers.xmlsafe import parse_xml
 
 #: xacro keeps its state in module globals: one expansion at a time.
 _LOCK = threading.Lock()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 from robotwright.render.anim import (
@@ -21,7 +22,7 @@ from robotwright.render.png import save_png
 from robotwright.render.scan import render_scan
 from robotwright.render.source import load_model
 
-__all__ = ["render", "render_animation"]
+__all__ = ["draw_pose", "render", "render_animation"]
 
 
 def render(
@@ -122,3 +123,22 @@ def render_animation(
     if output is not None:
         save_animation(animation, output)
     return animation
+
+
+def draw_pose(
+    model: mujoco.MjModel,
+    qpos: np.ndarray,
+    path: str | os.PathLike[str],
+    title: str,
+    options: RenderOptions | None = None,
+) -> Picture:
+    """Draw ``model`` at joint values ``qpos`` (held still) into the PNG ``path``. By
+    default seen from behind and to the left at 360x300: a limb worn on a carrier's back
+    and its depth both show."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    opts = options or RenderOptions(width=360, height=300, camera="225,-15")
+    picture = render_model(model, data, opts)
+    save_png(picture, Path(path), title=title)
+    return picture

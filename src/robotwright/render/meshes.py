@@ -3,7 +3,7 @@
 MuJoCo's own :func:`mujoco.mjv_updateScene` decides what is visible (geom and site
 groups, materials, colours, poses); this module only turns each visible ``mjvGeom``
 into world-frame triangles: primitives come from
-:func:`robotwright.view.geometry.primitive_mesh` (the browser viewer's shapes too), meshes
+:func:`robotwright.scene.geometry.primitive_mesh` (the browser viewer's shapes too), meshes
 and height fields from the compiled model's arrays.
 """
 
@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from robotwright.view.geometry import hfield_surface, primitive_mesh
+from robotwright.scene.geometry import hfield_surface, primitive_mesh
 
 __all__ = ["SceneTriangles", "scene_triangles"]
 

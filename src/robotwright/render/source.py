@@ -1,6 +1,6 @@
 """What ``robotwright render`` draws: any source the viewer takes, as a compiled model.
 
-Sources are loaded by :func:`robotwright.view.scene.load_source` (one loader for the
+Sources are loaded by :func:`robotwright.scene.load.load_source` (one loader for the
 viewer and the pictures): a bundled robot name (or one under
 ``$HURODES_ASSETS_PATH``), an HRDF folder, an MJCF file (a robot, or a scene written by
 ``robotwright compose`` or the demo), a URDF file, a grammar design folder, or a scan
@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from robotwright.errors import ConversionWarning
-from robotwright.view.scene import ScanCloud, ViewError, load_source
+from robotwright.scene.load import ScanCloud, ViewError, load_source
 
 __all__ = ["LoadedModel", "SourceError", "load_model"]
 

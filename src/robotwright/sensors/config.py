@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Literal
 
 import numpy as np
 
-from robotwright.errors import SensorError
+from robotwright.errors import InputFileError, SensorError
 from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
 
 __all__ = [
@@ -16,6 +18,7 @@ __all__ = [
     "LidarCfg",
     "SemanticLidarCfg",
     "check_class_mapping",
+    "read_class_mapping",
 ]
 
 #: Most CPU threads a sensor may start.
@@ -276,3 +279,33 @@ def check_class_mapping(mapping: object, where: str) -> None:
             raise SensorError(f"{where}[{cls!r}]: empty keyword list (class can never match)")
         if any(not isinstance(k, str) or not k for k in keywords):
             raise SensorError(f"{where}[{cls!r}]: keywords must be non-empty strings")
+
+
+#: Largest ``--mapping`` file (a mapping of a hundred classes is a few kB).
+MAX_MAPPING_BYTES = 1 << 20
+
+
+def read_class_mapping(path: Path) -> dict[str, list[str]]:
+    """The ``--mapping`` JSON file ``{class name: [keywords]}``, read as every untrusted
+    input is (regular file, size cap, UTF-8, bounded nesting) and checked as the Python
+    API checks a mapping (a keyword string, an empty list, a class named ``unknown``
+    are refused).
+
+    Raises:
+        SensorError: naming the file and what is wrong.
+    """
+    from robotwright._inputs import load_json, read_text
+
+    expected = "expected a JSON object {class: [keywords]}"
+    try:
+        mapping = load_json(read_text(path, MAX_MAPPING_BYTES), path)
+    except InputFileError as exc:
+        raise SensorError(f"--mapping {exc}") from None
+    except OSError as exc:
+        raise SensorError(f"--mapping {path}: {exc.strerror or exc}") from None
+    except json.JSONDecodeError as exc:
+        raise SensorError(f"--mapping {path}: not valid JSON ({exc}); {expected}") from None
+    if not isinstance(mapping, dict):
+        raise SensorError(f"--mapping {path}: {expected}, got a JSON {type(mapping).__name__}")
+    check_class_mapping(mapping, f"--mapping {path}")
+    return mapping

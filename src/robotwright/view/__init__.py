@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     import mujoco
 
     from robotwright.hrdf.model import HRDF
-    from robotwright.view.scene import ScanCloud, ViewError, ViewScene, load_source
+    from robotwright.scene.load import ScanCloud, ViewError, ViewScene, load_source
     from robotwright.view.server import Viewer, ViewerConfig
 
 __all__ = [
@@ -35,16 +35,16 @@ __all__ = [
     "show",
 ]
 
-#: Exported name -> submodule; imported on first use, so that importing this package
+#: Exported name -> module; imported on first use, so that importing this package
 #: (as the command line does to register ``robotwright view``) loads neither MuJoCo nor
 #: viser.
 _LAZY = {
-    "ScanCloud": "scene",
-    "ViewError": "scene",
-    "ViewScene": "scene",
-    "load_source": "scene",
-    "Viewer": "server",
-    "ViewerConfig": "server",
+    "ScanCloud": "robotwright.scene.load",
+    "ViewError": "robotwright.scene.load",
+    "ViewScene": "robotwright.scene.load",
+    "load_source": "robotwright.scene.load",
+    "Viewer": "robotwright.view.server",
+    "ViewerConfig": "robotwright.view.server",
 }
 
 
@@ -54,7 +54,7 @@ def __getattr__(name: str) -> Any:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     import importlib
 
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    value = getattr(importlib.import_module(module), name)
     globals()[name] = value
     return value
 
@@ -74,7 +74,7 @@ def show(
     Args:
         source: robot name, HRDF folder, MJCF/URDF file, design folder, scan ``.npz``,
             or an ``HRDF`` / ``mujoco.MjModel`` object (see
-            :func:`~robotwright.view.scene.load_source`).
+            :func:`~robotwright.scene.load.load_source`).
         scene: the MJCF scene a scan was taken in.
         port: TCP port, that one only (a :class:`ViewError` when it is taken); None:
             8080 or the next free one; 0 for any free port.
@@ -83,7 +83,7 @@ def show(
         asset_roots: folders outside the source's folder its files may come from.
         config: other :class:`ViewerConfig` fields (``geom_groups``, ``body_frames``...).
     """
-    from robotwright.view.scene import load_source
+    from robotwright.scene.load import load_source
     from robotwright.view.server import Viewer, ViewerConfig
 
     cfg = ViewerConfig(host=host, port=port, **config)

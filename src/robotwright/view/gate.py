@@ -35,7 +35,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
-from robotwright.view.scene import ViewError
+from robotwright.scene.load import ViewError
 
 __all__ = [
     "DEFAULT_PORT",

@@ -1,4 +1,4 @@
-"""The browser page: a viser server drawing a :class:`~robotwright.view.scene.ViewScene`.
+"""The browser page: a viser server drawing a :class:`~robotwright.scene.load.ViewScene`.
 
 Scene layout (viser node names): ``/bodies/b<id>`` is a frame per MuJoCo body placed at
 its world pose; each geom is a mesh under its body (``/bodies/b<id>/g<id>``) at its
@@ -24,17 +24,17 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from robotwright.sensors.plot import CLASS_COLORS
-from robotwright.view._serve import gated_viser
-from robotwright.view.gate import Gate, bind_listener, check_value, is_loopback, parse_origin
-from robotwright.view.geometry import (
+from robotwright.scene.geometry import (
     DEFAULT_GEOM_GROUPS,
     GeomShape,
     body_poses,
     geom_shapes,
     site_frames,
 )
-from robotwright.view.scene import ViewError, ViewScene
+from robotwright.scene.load import ViewError, ViewScene
+from robotwright.sensors.plot import CLASS_COLORS
+from robotwright.view._serve import gated_viser
+from robotwright.view.gate import Gate, bind_listener, check_value, is_loopback, parse_origin
 from robotwright.view.simulate import Contacts, Simulation, contacts, ctrl_problem, ctrl_range
 
 if TYPE_CHECKING:

@@ -1,5 +1,8 @@
 """Does a valid HRDF model export and compile? The last step of ``validate``.
 
+It sits with the generators, above the model, because it uses them to write the MJCF
+and URDF it checks.
+
 The table checks of :mod:`robotwright.hrdf.validate` catch what the format forbids;
 MuJoCo is the judge of the rest (mesh contents, what ``extra.xml`` names, keyframe
 sizes, ...). So a folder that validates is one whose generated MJCF compiles and whose
@@ -263,4 +266,20 @@ __all__ = [
     "check_meshes",
     "require_compiles",
     "too_deep_for_mjcf",
+    "validate_dir",
 ]
+
+
+def validate_dir(path: str | Path, *, compile_model: bool = True) -> list[Problem]:
+    """Read and check an HRDF folder; return every problem (errors and warnings).
+
+    With ``compile_model`` (the default), a folder without table errors is also exported in
+    memory and compiled with MuJoCo (see :func:`check_compiles`):
+    a folder that validates exports to MJCF and URDF, and its MJCF compiles.
+    """
+    from robotwright.hrdf.io import collect_hrdf_dir
+
+    hrdf, problems = collect_hrdf_dir(path)
+    if compile_model and hrdf is not None and not any(p.severity == "error" for p in problems):
+        problems += check_compiles(hrdf)
+    return problems

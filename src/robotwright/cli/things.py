@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from robotwright._outputs import add_overwrite_flag, check_overwrite
+from robotwright._outputs import check_overwrite
+from robotwright.cli.options import add_overwrite_flag
 
 
 def register(sub: argparse._SubParsersAction) -> None:

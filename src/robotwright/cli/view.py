@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from robotwright.sources import ROBOT_SOURCE_HELP
+from robotwright.cli.options import ROBOT_SOURCE_HELP
 
 #: Geom groups accepted by ``--groups`` (MuJoCo has six).
 _GROUPS = range(6)
@@ -109,7 +109,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from robotwright._notes import notes_of, summary_line
-    from robotwright.view.scene import load_source
+    from robotwright.scene.load import load_source
     from robotwright.view.server import Viewer, ViewerConfig
 
     # --asset-root (added by the main parser) is in force around this call.
@@ -164,7 +164,7 @@ def note_lines(notes: list[str], skipped: list[str], verbose: bool) -> list[str]
     """What the page cannot draw as MuJoCo would: every note with ``verbose``, else one
     line; a texture drawn as its colour (the scene's own floor has one) only with
     ``verbose``."""
-    from robotwright.view.geometry import TEXTURE_NOT_DRAWN
+    from robotwright.scene.geometry import TEXTURE_NOT_DRAWN
 
     lines = [*notes, *skipped]
     if verbose:

@@ -46,7 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def step_hrdf(out: Path, ctx: dict[str, Any]) -> str:
-    from robotwright.hrdf.cli import format_info
+    from robotwright.cli.hrdf import format_info
     from robotwright.hrdf.io import HRDFWarning
     from robotwright.hrdf.model import HRDF
 
@@ -66,7 +66,7 @@ def step_hrdf(out: Path, ctx: dict[str, Any]) -> str:
 def step_export(out: Path, ctx: dict[str, Any]) -> str:
     import mujoco
 
-    from robotwright.generators.tasks import export_robot
+    from robotwright.tasks import export_robot
 
     written = []
     for name in ("mini_humanoid", "arm6"):
@@ -131,7 +131,7 @@ def step_limb(out: Path, ctx: dict[str, Any]) -> str:
 def step_scene(out: Path, ctx: dict[str, Any]) -> str:
     import mujoco
 
-    from robotwright.generators.tasks import compose_scene
+    from robotwright.tasks import compose_scene
     from robotwright.things import World
 
     scene_dir = out / "scene"

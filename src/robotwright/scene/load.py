@@ -38,7 +38,7 @@ from robotwright.errors import InputFileError, RobotwrightError
 if TYPE_CHECKING:
     from robotwright.hrdf.model import HRDF
 
-__all__ = ["ScanCloud", "ViewError", "ViewScene", "load_source"]
+__all__ = ["ScanCloud", "ViewError", "ViewScene", "compile_mjcf", "load_source"]
 
 SourceLike = str | os.PathLike[str]
 
@@ -162,11 +162,11 @@ def _hrdf_model(hrdf: HRDF) -> tuple[mujoco.MjModel, list[str], list[str]]:
     """Compile a robot through the MJCF generator; returns the model, its conversion
     notes, and how the model differs from the robot: a robot whose masses or inertias
     the generators refuse is shown with those replaced (see
-    :func:`robotwright.view.physics.for_display`), since a picture needs its geometry
+    :func:`robotwright.scene.display.for_display`), since a picture needs its geometry
     only."""
     from robotwright.errors import ConversionWarning, HRDFError, RobotwrightError
     from robotwright.generators import MJCFHumanoidGenerator
-    from robotwright.view.physics import for_display
+    from robotwright.scene.display import for_display
 
     shown: list[str] = []
     try:
@@ -181,7 +181,7 @@ def _hrdf_model(hrdf: HRDF) -> tuple[mujoco.MjModel, list[str], list[str]]:
         except ValueError as exc:  # MuJoCo refuses the model (a mesh it cannot read, ...)
             if isinstance(exc, RobotwrightError):
                 raise
-            from robotwright.hrdf.compiles import require_compiles
+            from robotwright.generators.compiles import require_compiles
 
             require_compiles(hrdf, f"cannot show robot '{hrdf.name}'")  # says where
             reason = " ".join(str(exc).split())  # MuJoCo's message spans lines
@@ -204,7 +204,7 @@ def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
 
     resolved = resolve_source(text)
     if resolved.kind == "mjcf" and not wants_parse():
-        model = _compile_mjcf(resolved.path, asset_roots)
+        model = compile_mjcf(resolved.path, asset_roots)
         return ViewScene(model, resolved.title, "mjcf", text)
     hrdf, notes = load_robot_with_notes(text, asset_roots=tuple(asset_roots))
     model, more, shown = _hrdf_model(hrdf)
@@ -221,43 +221,55 @@ def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
     return ViewScene(model, title, kind, text, notes=notes + more, warnings=shown)
 
 
-def _compile_mjcf(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjModel:
-    """Compile an MJCF file with MuJoCo after the project's safety checks: no XML
-    entities, and every file it names (includes, meshes, textures) inside its folder or
-    a trusted one; MuJoCo reads it in a confined reader (:mod:`robotwright._confine`)."""
+def compile_mjcf(
+    path: Path,
+    asset_roots: tuple[SourceLike, ...] = (),
+    *,
+    error: type[RobotwrightError] = ViewError,
+) -> mujoco.MjModel:
+    """Compile the MJCF file ``path`` (a robot or a whole scene) with MuJoCo, after the
+    checks every MJCF reader makes (:func:`robotwright._paths.checked_mjcf_spec`: no XML
+    entities, every file it names inside its folder, ``asset_roots`` or a folder trusted
+    with ``--asset-root``, no flood of keyframes); MuJoCo reads it in a confined reader
+    (:mod:`robotwright._confine`).
+
+    Raises:
+        error: (``ViewError`` unless given) the file is unreadable, not MJCF, or
+            refused by MuJoCo, naming the file.
+        UnsafePathError: a file it names leaves its folder or is not a regular file.
+    """
     from robotwright._confine import run_confined
     from robotwright.parsers.packages import source_read_roots
 
     roots = source_read_roots(path, "mjcf", {"asset_roots": asset_roots})
-    return run_confined(_compile_mjcf_here, path, asset_roots, roots=roots, what=str(path))
+    return run_confined(_compile_mjcf_here, path, asset_roots, error, roots=roots, what=str(path))
 
 
-def _compile_mjcf_here(path: Path, asset_roots: tuple[SourceLike, ...]) -> mujoco.MjModel:
-    from robotwright._paths import check_mjcf_includes, check_mjcf_spec, trusted_roots
+def _compile_mjcf_here(
+    path: Path, asset_roots: tuple[SourceLike, ...], error: type[RobotwrightError]
+) -> mujoco.MjModel:
+    """:func:`compile_mjcf`'s reading step (run confined)."""
+    from robotwright._paths import checked_mjcf_spec, trusted_roots
+    from robotwright._xmlsafe import parse_xml
     from robotwright.errors import ConversionError, UnsafePathError
-    from robotwright.parsers.xmlsafe import parse_xml
 
     try:
         tree = parse_xml(path)
     except ConversionError as exc:
-        raise ViewError(f"{path}: {exc.problems[0].message}") from None
+        raise error(f"{path}: {exc.problems[0].message}") from None
     if tree.tag != "mujoco":
-        raise ViewError(
+        raise error(
             f"{path}: root element <{tree.tag}>: expected <mujoco> (MJCF); "
             "a URDF is read from a file named .urdf"
         )
-    folder = path.resolve().parent
-    where = {"source": str(path), "model_dir": folder, "root": folder}
-    trusted = trusted_roots(asset_roots)
-    check_mjcf_includes(tree, **where, trusted=trusted)
     try:
-        spec = mujoco.MjSpec.from_file(str(path))
-        check_mjcf_spec(spec, **where, trusted=trusted)
-        return spec.compile()
+        return checked_mjcf_spec(path, trusted=trusted_roots(asset_roots)).compile()
+    except ConversionError as exc:
+        raise error(f"{path}: {exc.problems[0].message}") from None
     except (UnsafePathError, InputFileError):
         raise  # refused before MuJoCo read a file: not MuJoCo's words
     except ValueError as exc:  # MuJoCo reports parse and compile errors as ValueError
-        raise ViewError(f"{path}: MuJoCo cannot load it: {exc}") from None
+        raise error(f"{path}: MuJoCo cannot load it: {exc}") from None
 
 
 def _design_scene(folder: Path, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
@@ -266,7 +278,7 @@ def _design_scene(folder: Path, asset_roots: tuple[SourceLike, ...]) -> ViewScen
     grammar."""
     xmls = sorted(folder.glob("*.xml"))
     if len(xmls) == 1:
-        model = _compile_mjcf(xmls[0], asset_roots)
+        model = compile_mjcf(xmls[0], asset_roots)
         return ViewScene(model, f"{folder.name} ({xmls[0].name})", "design", str(folder))
     if len(xmls) > 1:
         raise ViewError(
@@ -301,7 +313,7 @@ def _scan_scene(
         scene_path = Path(scene)
         if not scene_path.is_file():
             raise ViewError(f"{scene_path}: scene file not found")
-        model = _compile_mjcf(scene_path, asset_roots)
+        model = compile_mjcf(scene_path, asset_roots)
         title = f"{path.stem} in {scene_path.stem}"
         other = _other_scene(path, scene_path, model)
         if other:

@@ -6,7 +6,7 @@ import argparse
 import warnings
 from typing import TYPE_CHECKING
 
-from robotwright.sources import ROBOT_SOURCE_HELP
+from robotwright.cli.options import ROBOT_SOURCE_HELP
 
 if TYPE_CHECKING:  # the readers load when a command runs, not with `robotwright --help`
     from robotwright.hrdf.model import HRDF
@@ -54,12 +54,12 @@ def _problems(source: str, kind: str) -> list:
     """Every problem of a robot: an HRDF folder as read and compiled; a URDF or MJCF as
     read into HRDF (a refusal of the reader is its problems), then the same checks."""
     from robotwright.errors import ProblemsError
-    from robotwright.hrdf.validate import check_model, validate_dir
+    from robotwright.generators.compiles import check_compiles, validate_dir
+    from robotwright.hrdf.validate import check_model
     from robotwright.sources import load_robot, resolve_source
 
     if kind == "hrdf":
         return validate_dir(resolve_source(source).path)
-    from robotwright.hrdf.compiles import check_compiles
 
     try:
         hrdf = load_robot(source)

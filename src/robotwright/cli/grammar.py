@@ -9,9 +9,10 @@ import time
 from pathlib import Path
 
 from robotwright._atomic import atomic_dir, check_output_path
-from robotwright._outputs import add_overwrite_flag, check_overwrite
+from robotwright._outputs import check_overwrite
 from robotwright._progress import Progress
 from robotwright._progress import duration as _duration
+from robotwright.cli.options import add_overwrite_flag
 from robotwright.errors import GrammarError, InputFileError, Problem
 
 #: Largest ``--max-links`` the commands accept. Exact counting grows with the cube of
@@ -457,9 +458,16 @@ def _search(args: argparse.Namespace) -> int:
     print(res.best.design.to_text(), end="")
     if args.out:
         from robotwright.grammar.winners import write_winners
+        from robotwright.render.api import draw_pose
 
         folders = write_winners(
-            g, res.evaluations, [objective], args.out, k=args.top, pictures=not args.no_picture
+            g,
+            res.evaluations,
+            [objective],
+            args.out,
+            k=args.top,
+            pictures=not args.no_picture,
+            draw_carrier=draw_pose,
         )
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
     return 0

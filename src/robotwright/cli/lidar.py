@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from robotwright._atomic import check_output_path
-from robotwright._outputs import add_overwrite_flag, check_overwrite
-from robotwright.errors import ConversionError, InputFileError, SensorError, UnsafePathError
+from robotwright._outputs import check_overwrite
+from robotwright.cli.options import add_overwrite_flag
+from robotwright.errors import SensorError
 from robotwright.sensors._names import PATTERN_NAMES
 
 if TYPE_CHECKING:
-    import mujoco
+    pass
 
-__all__ = ["load_scene", "read_mapping", "register", "run"]
+__all__ = ["register", "run"]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -71,75 +71,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-#: Largest ``--mapping`` file (a mapping of a hundred classes is a few kB).
-MAX_MAPPING_BYTES = 1 << 20
-
-
-def read_mapping(path: Path) -> dict[str, list[str]]:
-    """The ``--mapping`` JSON file ``{class name: [keywords]}``, read as every untrusted
-    input is (regular file, size cap, UTF-8, bounded nesting) and checked as the Python
-    API checks a mapping (a keyword string, an empty list, a class named ``unknown``
-    are refused).
-
-    Raises:
-        SensorError: naming the file and what is wrong.
-    """
-    from robotwright._inputs import load_json, read_text
-    from robotwright.sensors.config import check_class_mapping
-
-    expected = "expected a JSON object {class: [keywords]}"
-    try:
-        mapping = load_json(read_text(path, MAX_MAPPING_BYTES), path)
-    except InputFileError as exc:
-        raise SensorError(f"--mapping {exc}") from None
-    except OSError as exc:
-        raise SensorError(f"--mapping {path}: {exc.strerror or exc}") from None
-    except json.JSONDecodeError as exc:
-        raise SensorError(f"--mapping {path}: not valid JSON ({exc}); {expected}") from None
-    if not isinstance(mapping, dict):
-        raise SensorError(f"--mapping {path}: {expected}, got a JSON {type(mapping).__name__}")
-    check_class_mapping(mapping, f"--mapping {path}")
-    return mapping
-
-
-def load_scene(path: Path) -> mujoco.MjModel:
-    """The compiled MJCF scene at ``path``, through the gate every MJCF reader uses
-    (:func:`robotwright._paths.checked_mjcf_spec`): no XML entities, every file it names
-    a regular file inside its folder or a folder trusted with ``--asset-root``.
-
-    Raises:
-        SensorError: the scene is unreadable, not MJCF, or refused by MuJoCo.
-        UnsafePathError: a file it names leaves its folder or is not a regular file.
-    """
-    from robotwright._confine import run_confined
-    from robotwright.parsers.packages import source_read_roots
-
-    # The folders trusted with --asset-root are readable by every confined reader.
-    roots = source_read_roots(path, "mjcf")
-    return run_confined(_load_scene_here, path, roots=roots, what=str(path))
-
-
-def _load_scene_here(path: Path) -> mujoco.MjModel:
-    """:func:`load_scene`'s reading step (run confined)."""
-    from robotwright._paths import checked_mjcf_spec
-    from robotwright.parsers.xmlsafe import parse_xml
-
-    try:
-        root = parse_xml(path)
-    except ConversionError as exc:
-        raise SensorError(f"{path}: {exc.problems[0].message}") from None
-    if root.tag != "mujoco":
-        raise SensorError(f"{path}: root element <{root.tag}>: expected <mujoco> (an MJCF scene)")
-    try:
-        return checked_mjcf_spec(path).compile()
-    except ConversionError as exc:
-        raise SensorError(f"{path}: {exc.problems[0].message}") from None
-    except (UnsafePathError, InputFileError):
-        raise  # refused before MuJoCo read a file: not MuJoCo's words
-    except ValueError as exc:  # MuJoCo reports parse and compile errors as ValueError
-        raise SensorError(f"{path}: MuJoCo cannot load the scene: {exc}") from None
-
-
 def run(args: argparse.Namespace) -> int:
     import mujoco
 
@@ -163,13 +94,16 @@ def run(args: argparse.Namespace) -> int:
             if not out.parent.is_dir():
                 raise SensorError(f"{out}: folder {out.parent} does not exist")
     check_overwrite([args.output, args.png], args.overwrite)
-    mapping = None if args.mapping is None else read_mapping(args.mapping)
+    from robotwright.scene.load import compile_mjcf
+    from robotwright.sensors.config import read_class_mapping
+
+    mapping = None if args.mapping is None else read_class_mapping(args.mapping)
     from robotwright.sources import wants_parse
 
     if scene_file and not wants_parse():
-        model = load_scene(args.scene)
+        model = compile_mjcf(args.scene, error=SensorError)
     else:  # a robot by name, HRDF folder, URDF or xacro: as view and render show it
-        from robotwright.view.scene import load_source
+        from robotwright.scene.load import load_source
 
         model = load_source(str(args.scene)).model
     data = mujoco.MjData(model)

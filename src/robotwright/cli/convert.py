@@ -10,9 +10,14 @@ import warnings
 from collections.abc import Callable
 from pathlib import Path
 
-from robotwright._outputs import add_overwrite_flag, add_strict_flags, check_overwrite
+from robotwright._outputs import check_overwrite
+from robotwright.cli.options import (
+    ROBOT_SOURCE_HELP,
+    add_overwrite_flag,
+    add_strict_flags,
+    parse_xacro_arg,
+)
 from robotwright.errors import ConversionWarning
-from robotwright.sources import ROBOT_SOURCE_HELP, parse_xacro_arg
 
 
 def _options(args: argparse.Namespace) -> dict:

@@ -27,22 +27,23 @@ from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
 from robotwright._progress import shown as progress_shown
 from robotwright._suggest import did_you_mean
+from robotwright.cli.options import source_options
 from robotwright.errors import ProblemsError, RobotwrightError
 from robotwright.parsers.packages import given_packages
-from robotwright.sources import given_source_options, source_options
+from robotwright.sources import given_source_options
 
 # Modules that expose ``register(subparsers: argparse._SubParsersAction) -> None``.
 _COMMAND_MODULES: tuple[str, ...] = (
-    "robotwright.hrdf.cli",
-    "robotwright.demo",
-    "robotwright.parsers.cli",
-    "robotwright.sensors.cli",
-    "robotwright.grammar.cli",
-    "robotwright.generators.cli",
-    "robotwright.things.cli",
-    "robotwright.view.cli",
-    "robotwright.render.cli",
-    "robotwright.catalog_cli",
+    "robotwright.cli.hrdf",
+    "robotwright.cli.demo",
+    "robotwright.cli.convert",
+    "robotwright.cli.lidar",
+    "robotwright.cli.grammar",
+    "robotwright.cli.export",
+    "robotwright.cli.things",
+    "robotwright.cli.view",
+    "robotwright.cli.render",
+    "robotwright.cli.robots",
 )
 
 #: Commands that read robots from files: they take ``--asset-root DIR`` (see
@@ -151,7 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
             help="trust folder DIR: mesh/asset paths of the input may point into it "
             "(by default they must stay inside the robot's own folder); repeatable",
         )
-    from robotwright.sources import add_source_options
+    from robotwright.cli.options import add_source_options
 
     for name in _PACKAGE_COMMANDS:
         add_source_options(sub.choices[name])

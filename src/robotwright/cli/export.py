@@ -7,11 +7,11 @@ import re
 import warnings
 from pathlib import Path
 
-from robotwright._outputs import add_overwrite_flag, add_strict_flags, check_overwrite
+from robotwright._outputs import check_overwrite
 from robotwright._usd_format import USD_SUFFIXES
+from robotwright.cli.options import ROBOT_SOURCE_HELP, add_overwrite_flag, add_strict_flags
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.generators.placement import Placement
-from robotwright.sources import ROBOT_SOURCE_HELP
 
 #: Meshes that exist only while a source is read are always copied.
 _STAGED_MESHES = (
@@ -160,10 +160,10 @@ def output_format(output: str, fmt: str | None) -> str:
 
 
 def _export(args: argparse.Namespace) -> int:
+    from robotwright.generators.compiles import require_compiles
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
-    from robotwright.generators.tasks import load_robot
     from robotwright.generators.urdf import URDFHumanoidGenerator
-    from robotwright.hrdf.compiles import require_compiles
+    from robotwright.tasks import load_robot
 
     args.format = output_format(args.output, args.format)
     if args.usd_layout != "nested" and args.format != "usd":
@@ -219,7 +219,7 @@ def _export(args: argparse.Namespace) -> int:
 
 def _isaaclab_cfg(args: argparse.Namespace) -> int:
     from robotwright.generators.isaaclab_cfg import write_articulation_cfg
-    from robotwright.generators.tasks import load_robot
+    from robotwright.tasks import load_robot
 
     if Path(args.output).suffix != ".py":
         raise GeneratorError(f"{args.output}: expected a Python module file name ending in .py")
@@ -268,7 +268,7 @@ def parse_robot_spec(spec: str) -> tuple[str | None, str, Placement | None]:
 
 
 def _compose(args: argparse.Namespace) -> int:
-    from robotwright.generators.tasks import compose_scene, load_robot
+    from robotwright.tasks import compose_scene, load_robot
 
     args.format = output_format(args.output, args.format)
     if args.format == "usd":

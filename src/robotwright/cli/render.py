@@ -8,8 +8,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from robotwright._outputs import add_overwrite_flag
-from robotwright.sources import ROBOT_SOURCE_HELP
+from robotwright.cli.options import ROBOT_SOURCE_HELP, add_overwrite_flag
 
 __all__ = ["register", "run"]
 
