@@ -79,7 +79,9 @@ def _upward_imports() -> list[str]:
             if there == here or (rank.get(there, (1,))[0] == rank[here][0] == 0):
                 continue
             if there not in rank:
-                wrong.append(f"{path.relative_to(SRC)}:{line}: {target}: unit {there!r} in no layer")
+                wrong.append(
+                    f"{path.relative_to(SRC)}:{line}: {target}: unit {there!r} in no layer"
+                )
             elif rank[there] >= rank[here]:
                 wrong.append(
                     f"{path.relative_to(SRC)}:{line}: {here} ({LAYERS[rank[here][0]][0]}) "
