@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
-from robotwright.parsers.roundtrip import our_mjcf_model, parse_source, roundtrip
+from robotwright.parsers.roundtrip import roundtrip
 
 pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
 
@@ -110,8 +110,8 @@ def test_corpus_file_roundtrips(corpus: str, rel: str, body_differences, layout_
         options["root_body"] = robot
     report = roundtrip(path, configs=CONFIGS, reference="mujoco", **options)
     assert report.ok, report.table()
-    hrdf = parse_source(path, **options).hrdf
-    bad = body_differences(source, our_mjcf_model(hrdf), robot)
+    assert report.mjcf_model is not None
+    bad = body_differences(source, report.mjcf_model, robot)
     assert not bad, bad
 
 

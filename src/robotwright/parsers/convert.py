@@ -272,7 +272,7 @@ def _usd_proof(src_p: Path, hrdf: HRDF, out_kind: str, options: dict[str, Any]) 
     """A USD source's proof: Newton's reading of the file against MuJoCo's compile of the
     output (:func:`robotwright.generators.usd_proof.prove_usd`)."""
     from robotwright.generators.usd_proof import prove_usd
-    from robotwright.parsers.proof import result_model
+    from robotwright.parsers.proof_models import result_model
 
     work = options.get("work_dir")
     model, _ = result_model(hrdf, out_kind, Path(work) if work else None)

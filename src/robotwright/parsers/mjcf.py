@@ -1067,7 +1067,7 @@ def parse_mjcf(
             raise InputFileError(path, too_many)
         model = spec.compile()
         # The proof of the conversion compares with this compile (one compile saved).
-        from robotwright.parsers.proof import remember_parsed
+        from robotwright.parsers.proof_models import remember_parsed
 
         remember_parsed(path, spec, model)
     except UnsafePathError as exc:

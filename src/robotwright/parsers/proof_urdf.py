@@ -189,12 +189,8 @@ def prove_urdf_output(hrdf, file: str, notes: Iterable[str] = ()) -> list:
 
     from robotwright.errors import Problem
     from robotwright.generators import URDFHumanoidGenerator
-    from robotwright.parsers.proof import (
-        _compile_with_same_files,
-        _mesh_sources,
-        as_problems,
-        uncovered,
-    )
+    from robotwright.parsers.proof_models import _compile_with_same_files, _mesh_sources
+    from robotwright.parsers.proof_notes import as_problems, uncovered
     from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
     from robotwright.parsers.roundtrip import our_mjcf_text
 

@@ -41,6 +41,7 @@ from robotwright.parsers.reference import (
     urdf_yourdfpy_view,
     view_from_model,
 )
+from robotwright.parsers.report import ParseResult
 from robotwright.parsers.xacro import is_xacro, xacro_as_urdf
 
 TOL_EXACT = 1e-9
@@ -80,6 +81,12 @@ class RoundTripReport:
     #: under ``strict``), also summed up in ``error``: the command line reports it as bad
     #: input (exit 2), as ``convert`` does.
     input_error: ConversionError | None = field(default=None, repr=False)
+    #: The parse of the source the table is about (None when it failed): a caller that
+    #: needs the robot too reads it here instead of parsing the file again. Meshes the
+    #: parse staged stay only when ``roundtrip`` was given a ``work_dir``.
+    parse: ParseResult | None = field(default=None, repr=False)
+    #: MuJoCo's compile of our MJCF of that robot (None when not written or refused).
+    mjcf_model: mujoco.MjModel | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:
@@ -987,6 +994,7 @@ def _roundtrip_on(
             report.input_error = ConversionError([Problem(exc.path, exc.reason)])
         return report
     report.warnings = [str(w) for w in result.warnings]
+    report.parse = result
     mimic = mimic_map(path)
     try:
         mjcf_text = our_mjcf_text(result.hrdf)
@@ -1034,7 +1042,8 @@ def _roundtrip_on(
         return report
     report.reference = ref.kind
     try:
-        ours = view_from_model(mjcf_job.result())
+        report.mjcf_model = mjcf_job.result()
+        ours = view_from_model(report.mjcf_model)
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
         if ref.kind.startswith("yourdfpy (MuJoCo refuses"):
