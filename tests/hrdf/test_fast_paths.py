@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from robotwright.hrdf import HRDF
-from robotwright.hrdf import io as hio
+from robotwright.hrdf import read_tables as hio
 from robotwright.hrdf import validate as hval
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
 from robotwright.hrdf.tables import TABLES

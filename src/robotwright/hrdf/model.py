@@ -564,7 +564,7 @@ class HRDF:
         Only robotwright extensions that carry information are written, so a robot that
         uses hurodes' features only gives a folder hurodes can read.
         """
-        from robotwright.hrdf.io import write_hrdf_dir
+        from robotwright.hrdf.write import write_hrdf_dir
 
         return write_hrdf_dir(self, path, overwrite=overwrite)
 

@@ -734,7 +734,7 @@ def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> lis
     robot built in memory (by a parser, in Python) would otherwise be saved as a folder
     that does not load. Cells of a field ``reported`` already (table, row, field) are
     left out."""
-    from robotwright.hrdf.io import table_rows
+    from robotwright.hrdf.write import table_rows
     from robotwright.hrdf.tables import TABLES
 
     out: list[Problem] = []
@@ -767,7 +767,7 @@ def _check_names(hrdf: HRDF) -> list[Problem]:
     """Every name a table defines is one XML, CSV and terminals can hold (see
     :mod:`robotwright._names`): a name with a control character would be written into
     an MJCF or URDF that no reader accepts."""
-    from robotwright.hrdf.io import table_rows
+    from robotwright.hrdf.write import table_rows
 
     out: list[Problem] = []
     for stem in ("body", "joint", "actuator", "mesh", "simple_geom", "site", "sensor"):
@@ -802,7 +802,7 @@ def _check_physics_fields(hrdf: HRDF) -> list[Problem]:
     ``actuatorfrcrange`` lower > upper, ``actuatorgravcomp`` other than 0/1, ``user``
     data longer than ``mjcf_size``'s ``nuser_*`` (MuJoCo: "user has more values than
     nuser")."""
-    from robotwright.hrdf.io import table_rows
+    from robotwright.hrdf.write import table_rows
 
     out: list[Problem] = []
     for row, j in enumerate(table_rows(hrdf, "joint")):
