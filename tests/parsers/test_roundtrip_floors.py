@@ -12,6 +12,7 @@ import pytest
 
 from robotwright.cli import main
 from robotwright.parsers import roundtrip as rt
+from robotwright.parsers.roundtrip_compare import _rel
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
 
@@ -82,10 +83,10 @@ def test_corpus_non_physical_inertias_exit_2(rel: str, capsys: pytest.CaptureFix
 
 def test_floor_makes_round_off_of_a_zero_inertia_zero() -> None:
     # Relative to itself, 6e-36 against 0 is an error of 1; against the floor, none.
-    assert rt._rel(0.0, 6e-36) == 1.0
-    assert rt._rel(0.0, 6e-36, rt.FLOOR * 0.1) <= rt.TOL_EXACT
+    assert _rel(0.0, 6e-36) == 1.0
+    assert _rel(0.0, 6e-36, rt.FLOOR * 0.1) <= rt.TOL_EXACT
     # The floor does not hide a real difference of a value above it.
-    assert rt._rel(1.0, 1.0 + 1e-6, rt.FLOOR * 1.0) > rt.TOL_EXACT
+    assert _rel(1.0, 1.0 + 1e-6, rt.FLOOR * 1.0) > rt.TOL_EXACT
 
 
 ZERO_INERTIA = """<mujoco model="z">
