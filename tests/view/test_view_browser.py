@@ -122,7 +122,7 @@ def test_scan_points_are_drawn_in_their_class_colours(chromium: str, tmp_path) -
     """A scan shown alone: its points appear inside their projected outline, in the
     colours of their classes (terrain brown, valuable blue)."""
     from robotwright.sensors import scan_to_files
-    from robotwright.view.server import class_color
+    from robotwright.view.drawing import class_color
 
     room = tmp_path / "room.xml"
     room.write_text(

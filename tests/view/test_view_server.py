@@ -10,8 +10,9 @@ import mujoco
 import numpy as np
 import pytest
 
+from robotwright.sensors.plot import CLASS_COLORS
 from robotwright.view import Viewer, ViewerConfig, ViewError, load_source, show
-from robotwright.view.server import CLASS_COLORS, class_color
+from robotwright.view.drawing import class_color
 
 pytestmark = pytest.mark.filterwarnings("ignore::robotwright.errors.ConversionWarning")
 

@@ -20,7 +20,7 @@ import viser
 from websockets.sync.client import ClientConnection, connect
 
 from robotwright.view import Viewer, ViewError, show
-from robotwright.view.server import robot_bodies
+from robotwright.view.drawing import robot_bodies
 from robotwright.view.simulate import contacts
 
 DEADLINE = 60.0

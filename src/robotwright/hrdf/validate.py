@@ -734,8 +734,8 @@ def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> lis
     robot built in memory (by a parser, in Python) would otherwise be saved as a folder
     that does not load. Cells of a field ``reported`` already (table, row, field) are
     left out."""
-    from robotwright.hrdf.write import table_rows
     from robotwright.hrdf.tables import TABLES
+    from robotwright.hrdf.write import table_rows
 
     out: list[Problem] = []
     for stem, schema in TABLES.items():
