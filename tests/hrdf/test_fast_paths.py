@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from robotwright.hrdf import HRDF
+from robotwright.hrdf import HRDF, validate_common
 from robotwright.hrdf import read_tables as hio
 from robotwright.hrdf import validate as hval
 from robotwright.hrdf.assets import BUNDLED_ROBOTS_DIR
@@ -170,7 +170,7 @@ def test_csv_fast_split_matches_on_mutated_g1_tables(
 def _problems_both(hrdf: HRDF, monkeypatch: pytest.MonkeyPatch) -> tuple[list, list]:
     quick = hval.check_model(hrdf, check_files=True)
     with monkeypatch.context() as m:
-        m.setattr(hval, "_QUICK_PASS", False)
+        m.setattr(validate_common, "QUICK_PASS", False)
         full = hval.check_model(hrdf, check_files=True)
     return quick, full
 
