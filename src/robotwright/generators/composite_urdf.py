@@ -15,8 +15,9 @@ from typing import Any
 from robotwright.errors import GeneratorError, Problem
 from robotwright.generators.mjcf import _report
 from robotwright.generators.placement import Placement, composite_members
-from robotwright.generators.urdf import URDFHumanoidGenerator, _RobotWriter
+from robotwright.generators.urdf import URDFHumanoidGenerator
 from robotwright.generators.urdf_base import WORLD_LINK, URDFGeneratorBase
+from robotwright.generators.urdf_writer import _RobotWriter
 from robotwright.generators.xmlfmt import prefixed
 
 
