@@ -275,7 +275,7 @@ class World(BaseThing):
         """Build Things from MJCF text; relative file paths resolve against ``base_dir``
         (default: the working directory) and must stay inside it or inside one of
         ``asset_roots``. See :mod:`robotwright.things.xml_reader`."""
-        from robotwright.things.xml_reader import world_from_string
+        from robotwright.things.xml_world import world_from_string
 
         return world_from_string(xml, base_dir=base_dir, strict=strict, asset_roots=asset_roots)
 
@@ -289,7 +289,7 @@ class World(BaseThing):
         """Build Things from an MJCF file (``<include>`` and relative paths resolve from
         it); every file it names must lie inside its folder or inside one of
         ``asset_roots`` (:class:`~robotwright.errors.UnsafePathError` otherwise)."""
-        from robotwright.things.xml_reader import world_from_path
+        from robotwright.things.xml_world import world_from_path
 
         return world_from_path(path, strict=strict, asset_roots=asset_roots)
 
