@@ -24,6 +24,7 @@ from robotwright._progress import steps
 from robotwright.render.core import (
     RenderError,
     RenderOptions,
+    RenderSession,
     _scene,
     drawn_bounds,
     render_model,
@@ -144,25 +145,25 @@ def animate(
     """Draw each pose of ``states`` ``(N, nq)``, one camera framing all of them."""
     opts = options or RenderOptions()
     data = mujoco.MjData(model)
-    corners = []
-    for q in states:
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        corners.append(
-            drawn_bounds(model, _scene(model, data, mujoco.MjvCamera(), opts.geom_groups))
-        )
-    every = np.concatenate(corners) if corners else np.zeros((0, 3))
-    box = np.zeros((0, 3))
-    if len(every):
-        lo, hi = every.min(axis=0), every.max(axis=0)
-        box = np.array(
-            [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
-        )
-    pictures = []
-    for q in steps(states, len(states), "frames drawn"):
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        pictures.append(render_model(model, data, opts, bounds=box))
+    with RenderSession(model, opts) as session:
+        corners = []
+        for q in states:
+            data.qpos[:] = q
+            mujoco.mj_forward(model, data)
+            scene = _scene(model, data, mujoco.MjvCamera(), opts.geom_groups, session.scene)
+            corners.append(drawn_bounds(model, scene))
+        every = np.concatenate(corners) if corners else np.zeros((0, 3))
+        box = np.zeros((0, 3))
+        if len(every):
+            lo, hi = every.min(axis=0), every.max(axis=0)
+            box = np.array(
+                [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+            )
+        pictures = []
+        for q in steps(states, len(states), "frames drawn"):
+            data.qpos[:] = q
+            mujoco.mj_forward(model, data)
+            pictures.append(render_model(model, data, opts, bounds=box, session=session))
     notes = list(dict.fromkeys(n for p in pictures for n in p.notes))
     return Animation(
         np.stack([p.image for p in pictures]), fps, np.asarray(times), pictures[0].backend, notes

@@ -20,7 +20,7 @@ import numpy as np
 
 from robotwright.errors import RobotwrightError
 from robotwright.render.camera import CameraSpec, make_camera, parse_camera
-from robotwright.render.gl import GLUnavailable, render_gl
+from robotwright.render.gl import GLSession, GLUnavailable, render_gl
 from robotwright.render.meshes import scene_triangles
 from robotwright.render.raster import View, rasterise, shade
 
@@ -127,9 +127,12 @@ def _scene(
     data: mujoco.MjData,
     cam: mujoco.MjvCamera,
     groups: tuple[int, ...] = DEFAULT_GEOM_GROUPS,
+    scene: mujoco.MjvScene | None = None,
 ) -> mujoco.MjvScene:
-    """MuJoCo's scene of ``data`` seen by ``cam``, with the geoms of ``groups`` only."""
-    scene = mujoco.MjvScene(model, maxgeom=_MAX_SCENE_GEOMS)
+    """MuJoCo's scene of ``data`` seen by ``cam``, with the geoms of ``groups`` only
+    (filled into ``scene`` when given, else into a new one)."""
+    if scene is None:
+        scene = mujoco.MjvScene(model, maxgeom=_MAX_SCENE_GEOMS)
     option = mujoco.MjvOption()
     option.geomgroup[:] = [int(g in groups) for g in range(GEOM_GROUPS)]
     mujoco.mjv_updateScene(
@@ -304,6 +307,47 @@ def _draw_points(
             image[y[ok], x[ok]] = colours[ok]
 
 
+class RenderSession:
+    """What the frames of one animation share: one MuJoCo scene, and one OpenGL context
+    made at the first frame drawn with OpenGL (:class:`~robotwright.render.gl.GLSession`;
+    a platform that cannot start is tried once, not at every frame). Close it (or use it
+    in a ``with`` block) to free the context.
+    """
+
+    def __init__(self, model: mujoco.MjModel, options: RenderOptions) -> None:
+        self.model, self.options = model, options
+        self.scene = mujoco.MjvScene(model, maxgeom=_MAX_SCENE_GEOMS)
+        self._gl: GLSession | None = None
+        self._gl_refused: GLUnavailable | None = None
+
+    def gl(self) -> GLSession:
+        """The session's GL context, made on first use.
+
+        Raises:
+            GLUnavailable: no platform could start (raised again on every later call).
+        """
+        if self._gl is None:
+            if self._gl_refused is not None:
+                raise self._gl_refused
+            try:
+                self._gl = GLSession(self.model, self.options.width, self.options.height)
+            except GLUnavailable as exc:
+                self._gl_refused = exc
+                raise
+        return self._gl
+
+    def close(self) -> None:
+        if self._gl is not None:
+            self._gl.close()
+            self._gl = None
+
+    def __enter__(self) -> RenderSession:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
 def render_model(
     model: mujoco.MjModel,
     data: mujoco.MjData | None = None,
@@ -312,6 +356,7 @@ def render_model(
     points: np.ndarray | None = None,
     point_colors: np.ndarray | None = None,
     bounds: np.ndarray | None = None,
+    session: RenderSession | None = None,
 ) -> Picture:
     """Draw ``model`` in the state ``data`` (``qpos0`` after ``mj_forward`` if None).
 
@@ -324,6 +369,8 @@ def render_model(
         point_colors: ``(N, 3)`` RGB in [0, 1] per point (default black).
         bounds: ``(K, 3)`` world points [m] a free camera frames instead of what is
             drawn (the frames of an animation share one camera this way).
+        session: the scene and GL context shared with other frames of the same model
+            and ``options`` (see :class:`RenderSession`); None makes and frees them here.
 
     Raises:
         RenderError: bad options or points; ``backend="gl"`` with no GL platform.
@@ -335,14 +382,19 @@ def render_model(
         mujoco.mj_forward(model, data)
     pts, cols = _check_points(points, point_colors)
     spec = opts.camera_spec
+    if session is not None and (session.model is not model or session.options != opts):
+        raise RenderError("a render session draws the model and options it was made for")
+    buffer = None if session is None else session.scene
     if bounds is None:
-        corners = drawn_bounds(model, _scene(model, data, mujoco.MjvCamera(), opts.geom_groups))
+        corners = drawn_bounds(
+            model, _scene(model, data, mujoco.MjvCamera(), opts.geom_groups, buffer)
+        )
     else:
         corners = np.asarray(bounds, dtype=np.float64).reshape(-1, 3)
     if pts is not None and len(pts):  # the points are framed too (a scan without scene)
         corners = np.concatenate([corners, pts.min(axis=0)[None], pts.max(axis=0)[None]])
     cam = make_camera(model, spec, corners, opts.width / opts.height)
-    scene = _scene(model, data, cam, opts.geom_groups)
+    scene = _scene(model, data, cam, opts.geom_groups, buffer)
     notes: list[str] = []
     image: np.ndarray | None = None
     backend = "software"
@@ -351,7 +403,10 @@ def render_model(
         # depth buffer tells the model from the background.
         scene.flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         try:
-            gl = render_gl(model, scene, opts.width, opts.height)
+            if session is None:
+                gl = render_gl(model, scene, opts.width, opts.height)
+            else:
+                gl = session.gl().draw(scene)
         except GLUnavailable as exc:
             if opts.backend == "gl":
                 raise RenderError(f"no OpenGL platform could draw: {exc}") from None
