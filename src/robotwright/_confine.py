@@ -410,6 +410,23 @@ def _child(
         os._exit(code)
 
 
+def _silenced(logger: Any) -> bool:  # pragma: no cover - used in the forked copy
+    """Whether the step silenced ``logger`` (its records reach only ``NullHandler``s and
+    stop there, as :func:`robotwright.sources` does while a source is read): such records
+    are not carried back, where the parent's handlers, or Python's last resort, would
+    print them."""
+    import logging
+
+    node = logger
+    while node is not None:
+        if any(not isinstance(h, logging.NullHandler) for h in node.handlers):
+            return False
+        if not node.propagate:
+            return bool(node.handlers)
+        node = node.parent
+    return False
+
+
 class _SideOutput:  # pragma: no cover - used in the forked copy
     """What the step says besides its result, carried back to the parent: its log records
     (the parent's handlers show them: a command's own collectors live there) and, where
@@ -424,7 +441,7 @@ class _SideOutput:  # pragma: no cover - used in the forked copy
         records = self.records
 
         def handle(logger: logging.Logger, record: logging.LogRecord) -> None:
-            if not logger.disabled and logger.filter(record):
+            if not logger.disabled and logger.filter(record) and not _silenced(logger):
                 records.append(record)
 
         logging.Logger.handle = handle  # type: ignore[method-assign]

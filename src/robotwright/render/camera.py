@@ -9,6 +9,9 @@ A camera is given as text (the ``--camera`` option):
 - ``AZIMUTH,ELEVATION`` or ``AZIMUTH,ELEVATION,DISTANCE``: MuJoCo free-camera angles
   in degrees (elevation < 0 looks down) and the distance to the point looked at [m].
 
+Text made of numbers alone but not in that form (``150``, ``150 -25``, ``150;-25``) is
+refused at once, before any robot is read: it is angles mistyped, not a camera's name.
+
 A free camera looks at the centre of the drawn geoms' bounding box; without a
 distance it stands as close as it can with every drawn geom (planes excepted) in the
 picture.
@@ -17,6 +20,7 @@ picture.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import mujoco
@@ -104,7 +108,17 @@ def parse_camera(text: str) -> CameraSpec:
             distance=values[2] if len(values) == 3 else None,
             text=t,
         )
+    if _NUMBERS_ONLY.fullmatch(t):
+        raise CameraError(
+            f"camera '{t}': expected AZIMUTH,ELEVATION[,DISTANCE] separated by commas "
+            "(degrees and metres, e.g. 150,-25), a view (" + ", ".join(VIEWS) + ") or the "
+            "name of a camera of the model"
+        )
     return CameraSpec(name=t, text=t)
+
+
+#: One or more numbers apart from separators other than a lone comma form.
+_NUMBERS_ONLY = re.compile(r"[+-]?[\d.]+(?:[eE][+-]?\d+)?(?:[\s;:/]+[+-]?[\d.]+(?:[eE][+-]?\d+)?)*")
 
 
 def _axes(azimuth: float, elevation: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
