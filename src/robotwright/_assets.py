@@ -69,13 +69,14 @@ def _declared(where: object, what: str, limit: int) -> InputFileError:
     )
 
 
-def check_asset_file(path: str | os.PathLike[str]) -> Path:
+def check_asset_file(path: str | os.PathLike[str], *, image: bool = True) -> Path:
     """``path`` when the file MuJoCo will read there is within the limit (a missing file
     or one that is not a regular file passes: its reader, or
     :func:`robotwright._paths.check_regular`, reports it).
 
     Only ``stat`` is asked for the size; of a PNG image, the 24-byte header is read for
-    the image size.
+    the image size. ``image=False`` (a mesh file, which MuJoCo never decodes as an
+    image) skips opening it for that header.
 
     Raises:
         robotwright.errors.InputFileError: naming the file, its size and the limit.
@@ -90,7 +91,7 @@ def check_asset_file(path: str | os.PathLike[str]) -> Path:
     limit = mesh_limit_bytes()
     if st.st_size > limit:
         raise _refusal(path, f"{st.st_size:,} bytes", limit)
-    size = _png_size(path)
+    size = _png_size(path) if image else None
     if size is not None:
         width, height = size
         decoded = width * height * 4

@@ -61,7 +61,7 @@ def contained_resolver(source: str | os.PathLike[str], root: Path | None = None)
                 )
             except ValueError as exc:  # UnsafePathError is a ValueError
                 raise ValueError(f"mesh {source}: side file '{name}': {exc}") from None
-            check_asset_file(resolved)
+            check_asset_file(resolved, image=False)
             return resolved.read_bytes()
 
         def namespaced(self, namespace: str) -> Any:

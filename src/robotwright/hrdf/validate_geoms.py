@@ -188,7 +188,7 @@ def _too_large(path: str | Path, row: int, column: str) -> list[Problem]:
     """The mesh size cap (``--max-mesh-mb``), checked with ``stat`` before MuJoCo or a
     mesh reader opens the file (see :mod:`robotwright._assets`)."""
     try:
-        check_asset_file(path)
+        check_asset_file(path, image=False)
     except InputFileError as exc:
         return [Problem("mesh.csv", f"mesh file {exc}", row=row, column=column)]
     return []
