@@ -9,7 +9,9 @@ refuses is out of scope and skipped with MuJoCo's reason. The rest goes through
 :func:`robotwright.parsers.roundtrip.roundtrip` (our MJCF to 1e-9: masses, inertias,
 joints, 20 random configurations, actuators with gear/ctrlrange, tendons, equalities,
 sensors, keyframes; our URDF to 1e-6) plus a check of every body's mass, centre of mass
-and inertia tensor, massless bodies included. A world holding several top-level bodies
+and inertia tensor, massless bodies included, and the proof ``robotwright convert`` runs
+(:func:`robotwright.parsers.proof.prove`: no compiled field differs unless a note says
+so), all on one parse of the file. A world holding several top-level bodies
 (an arm and its target) is converted with the largest one as the robot.
 
 The counts per corpus are in docs/parsers.md and the README.
@@ -23,6 +25,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from robotwright.parsers.proof import prove
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
 from robotwright.parsers.roundtrip import roundtrip
 
@@ -96,7 +99,9 @@ def _robot_root(model: mujoco.MjModel) -> str | None:
 
 @pytest.mark.corpus
 @pytest.mark.parametrize(("corpus", "rel"), _params())
-def test_corpus_file_roundtrips(corpus: str, rel: str, body_differences, layout_package) -> None:
+def test_corpus_file_roundtrips(
+    corpus: str, rel: str, tmp_path: Path, body_differences, layout_package
+) -> None:
     root = CORPORA[corpus]
     path = root / rel
     source = _source_model(path)
@@ -108,11 +113,17 @@ def test_corpus_file_roundtrips(corpus: str, rel: str, body_differences, layout_
     robot = _robot_root(source) if path.suffix == ".xml" else None
     if robot is not None:
         options["root_body"] = robot
-    report = roundtrip(path, configs=CONFIGS, reference="mujoco", **options)
+    work = tmp_path / "parse"  # the parse's staged meshes stay for the proof
+    report = roundtrip(path, configs=CONFIGS, reference="mujoco", work_dir=work, **options)
     assert report.ok, report.table()
-    assert report.mjcf_model is not None
+    assert report.parse is not None and report.mjcf_model is not None
     bad = body_differences(source, report.mjcf_model, robot)
     assert not bad, bad
+    # The proof of the conversion (what `robotwright convert` runs): no difference in any
+    # compared MjModel field that no note reports, on the same parse.
+    kind = "urdf" if path.suffix == ".urdf" else "mjcf"
+    found = prove(path, kind, report.parse.hrdf, "hrdf", report.warnings, options=options)
+    assert not found, [str(p) for p in found]
 
 
 def test_expected_failures_exist() -> None:

@@ -336,62 +336,7 @@ def test_range_of_a_free_joint_is_noted(tmp_path: Path) -> None:
     assert not [m for m in messages if "proof:" in m], messages
 
 
-# -- real robots ------------------------------------------------------------------------------
-TESTDATA = Path(__file__).resolve().parents[2] / ".testdata"
-CORPORA = {
-    "robosuite-models": TESTDATA / "robosuite-models" / "robosuite_models" / "assets",
-    "robosuite": TESTDATA / "robosuite" / "robosuite" / "models" / "assets",
-    "gymnasium": TESTDATA / "gymnasium" / "gymnasium" / "envs" / "mujoco" / "assets",
-    "pybullet": TESTDATA / "pybullet" / "pybullet_data",
-}
-#: "corpus/path" -> why the proof finds a difference no note reports (a fault to fix).
-KNOWN: dict[str, str] = {}
-
-
-def _corpus_params() -> list:
-    out = []
-    for corpus, root in CORPORA.items():
-        if not root.is_dir():
-            out.append(pytest.param(corpus, "", marks=pytest.mark.skip(reason="absent"), id=corpus))
-            continue
-        files = [*root.rglob("*.xml"), *root.rglob("*.urdf")]
-        for p in sorted(f for f in files if "random_urdfs" not in f.parts):
-            key = f"{corpus}/{p.relative_to(root).as_posix()}"
-            marks = [pytest.mark.xfail(reason=KNOWN[key], strict=True)] if key in KNOWN else []
-            out.append(pytest.param(corpus, p.relative_to(root).as_posix(), marks=marks, id=key))
-    return out
-
-
-@pytest.mark.realdata
-@pytest.mark.corpus
-@pytest.mark.parametrize(("corpus", "rel"), _corpus_params())
-def test_corpus_proof_has_no_unreported_difference(corpus: str, rel: str, tmp_path: Path) -> None:
-    root = CORPORA[corpus]
-    path = root / rel
-    if path.suffix == ".urdf":
-        # Compared with MuJoCo's own import of the URDF; a file MuJoCo or the parser
-        # refuses is the business of test_corpora.py.
-        if proof.source_model(path, "urdf", {}) is None:
-            pytest.skip("MuJoCo does not import it")
-        try:
-            messages = convert(path, tmp_path / "out", asset_roots=(root,))
-        except ConversionError as exc:
-            pytest.skip(f"refused: {str(exc).splitlines()[0][:120]}")
-        assert not [m for m in messages if "proof:" in m], messages
-        return
-    try:
-        source = mujoco.MjModel.from_xml_path(str(path))
-    except Exception as exc:  # noqa: BLE001 - a file MuJoCo refuses is out of scope
-        pytest.skip(f"MuJoCo does not compile it: {str(exc).splitlines()[0][:120]}")
-    top = [i for i in range(1, source.nbody) if source.body_parentid[i] == 0]
-    if not top:
-        pytest.skip("no body")
-    options: dict = {"asset_roots": (root,)}
-    if len(top) > 1:  # the largest top-level body is the robot
-        size = {i: int(np.sum(source.body_rootid == i)) for i in top}
-        options["root_body"] = source.body(max(top, key=lambda i: (size[i], -i))).name
-    messages = convert(path, tmp_path / "out", **options)
-    assert not [m for m in messages if "proof:" in m], messages
+# -- real robots: the corpus files' proofs run in test_corpora.py, on the round trip's parse.
 
 
 # -- URDF sources: compared with MuJoCo's own import -----------------------------------------
