@@ -251,6 +251,9 @@ def load_robot_with_notes(
     _check_applies(resolved, opts)
     roots = tuple(asset_roots)
     work = opts.get("work_dir")
+    from robotwright.parsers.api import prepare_read
+
+    prepare_read()
     if resolved.kind == "usd":
         from robotwright.parsers.usd import prepare_confined_read
 

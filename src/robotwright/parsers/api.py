@@ -62,6 +62,41 @@ def usd_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any
     return usd_to_hrdf_with_warnings(path, strict=strict, **options).hrdf
 
 
+#: Modules of the readers' packages that are not read in a confined copy (USD's reader
+#: needs Newton and prepares itself: :func:`robotwright.parsers.usd.prepare_confined_read`).
+_NOT_PREPARED = frozenset({"usd"})
+_prepared = False
+
+
+def prepare_read() -> None:
+    """Before a reader runs in a confined copy of this process: import here the modules
+    the readers use and ask MuJoCo, here, the questions they ask it
+    (:mod:`robotwright.parsers.mujoco_probes`, remembered). A copy keeps nothing of what
+    it imports or learns, and may not write Python's bytecode cache (it may write no
+    code), so without this every read would import, compile and ask again. Once per
+    process; cheap after that."""
+    global _prepared
+    if _prepared:
+        return
+    import importlib
+    import pkgutil
+
+    import trimesh  # noqa: F401 - the mesh readers use it
+
+    import robotwright.hrdf
+    import robotwright.parsers
+    from robotwright.parsers import mujoco_probes
+
+    for package in (robotwright.hrdf, robotwright.parsers):
+        for info in pkgutil.iter_modules(package.__path__):
+            if info.name not in _NOT_PREPARED:
+                importlib.import_module(f"{package.__name__}.{info.name}")
+    for name in dir(mujoco_probes):
+        if name.startswith("mujoco_"):
+            getattr(mujoco_probes, name)()
+    _prepared = True
+
+
 def _confined(
     parse: Any, path: str | os.PathLike, opts: Any, strict: bool, kind: str, options: dict
 ) -> ParseResult:
@@ -73,6 +108,7 @@ def _confined(
 
     roots = source_read_roots(path, kind, options)
     work = options.get("work_dir")
+    prepare_read()
     if kind == "usd":
         from robotwright.parsers.usd import prepare_confined_read
 

@@ -141,6 +141,9 @@ def _convert(
     # Reading, repairs and the proof in one confined reader: the proof compiles the
     # source and the output where MuJoCo has just decoded the source's meshes.
     work = options.get("work_dir")
+    from robotwright.parsers.api import prepare_read
+
+    prepare_read()
     if file_kind(src_p, existing=True) == "usd":
         from robotwright.parsers.usd import prepare_confined_read
 

@@ -38,6 +38,9 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
                 _SOURCE_MESHES[id(model)] = _mesh_files(folder, meshdir, files)
             return model
     roots = source_read_roots(path, kind, options)
+    from robotwright.parsers.api import prepare_read
+
+    prepare_read()
     try:
         compiled = run_confined(
             _compile_source, Path(path), kind, options, roots=roots, what=str(path)

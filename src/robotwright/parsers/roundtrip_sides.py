@@ -207,6 +207,9 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
     from robotwright.parsers.packages import source_read_roots
 
     roots = source_read_roots(path, source_kind(path), options)
+    from robotwright.parsers.api import prepare_read
+
+    prepare_read()
     if source_kind(path) == "mjcf":
         root = options.get("root_body")
 
