@@ -262,7 +262,7 @@ def test_livox_window_advances_with_each_environments_simulated_time(world):
     sim, scene = world
     sensor = scene["seed"]
     pattern: LivoxPatternCfg = sensor.cfg.pattern_cfg
-    period = pattern.num_rays / pattern.points_per_second
+    period = pattern.num_rays / pattern.effective("points_per_second")
     assert sensor.frame_period == pytest.approx(period)
     scene.reset()
     _step(sim, scene, 25)

@@ -402,6 +402,20 @@ def test_config_is_validated_in_build_after_any_change(kwargs, message):
         later.build()
 
 
+def test_pattern_fields_edited_after_construction_are_checked_in_build():
+    """mjlab's CLI edits ``cfg.pattern.*`` after the config is made: the edit takes effect
+    (the Avia preset, not the Mid-360's under its name) and a bad value fails in build()."""
+    base = {"name": "lidar", "frame": ObjRef(type="body", name="trunk", entity="robot")}
+    cfg = rw_mjlab.SemanticLidarSensorCfg(**base, pattern=LivoxPatternCfg(num_rays=500))
+    cfg.pattern.sensor_type = "avia"
+    rw_mjlab.resolve(cfg)  # valid
+    avia = LivoxPatternCfg(sensor_type="avia", num_rays=500)
+    np.testing.assert_array_equal(cfg.pattern.ray_table().directions, avia.ray_table().directions)
+    cfg.pattern.num_rays = 0
+    with pytest.raises(SensorError, match="num_rays: expected an integer >= 1"):
+        cfg.build()
+
+
 def test_a_config_that_is_not_an_mjlab_sensor_config_is_named():
     core = SemanticLidarCfg(prim_path="trunk")
     with pytest.raises(SensorError, match="not an mjlab sensor config"):

@@ -150,3 +150,41 @@ def test_pattern_config_errors():
         LivoxPatternCfg(sensor_type="mid70")
     with pytest.raises(SensorError, match="unknown pattern 'hdl64'"):
         pattern_from_name("hdl64")
+
+
+def test_sensor_type_changed_after_construction_brings_its_preset():
+    """A pattern edited after construction (as mjlab's and Isaac Lab's config systems
+    and command lines do) scans as a pattern built with the new value."""
+    edited = LivoxPatternCfg(sensor_type="mid360")
+    edited.sensor_type = "avia"
+    built = LivoxPatternCfg(sensor_type="avia")
+    np.testing.assert_array_equal(edited.ray_table().directions, built.ray_table().directions)
+    assert edited.effective("points_per_second") == 240_000.0
+    # a field given explicitly stays, whatever the type
+    wide = LivoxPatternCfg(sensor_type="mid360", vertical_fov_max=math.radians(30))
+    wide.sensor_type = "avia"
+    assert wide.effective("vertical_fov_max") == math.radians(30)
+
+
+@pytest.mark.parametrize(
+    ("make", "field", "value", "words"),
+    [
+        (lambda: LivoxPatternCfg(), "num_rays", 0, "num_rays: expected an integer >= 1"),
+        (lambda: LivoxPatternCfg(), "table_frames", 0, "table_frames: expected an integer"),
+        (lambda: LivoxPatternCfg(), "sensor_type", "hap", "sensor_type: expected one of"),
+        (lambda: GridPatternCfg(), "resolution", -0.1, "resolution: expected a positive"),
+        (lambda: PinholeCameraPatternCfg(), "width", 0, "width: expected an integer >= 1"),
+        (lambda: SpinningLidarPatternCfg.vlp16(), "vertical_angles", (), "empty pattern"),
+    ],
+)
+def test_field_edited_after_construction_is_checked_when_built(make, field, value, words):
+    """``num_rays = 0`` set after construction is a named error when the pattern is used
+    (and when a sensor is built from it), not a ZeroDivisionError."""
+    from robotwright.sensors.config import LidarCfg
+
+    pattern = make()
+    setattr(pattern, field, value)
+    with pytest.raises(SensorError, match=words):
+        pattern.ray_table()
+    with pytest.raises(SensorError, match=words):
+        LidarCfg(prim_path="base", pattern_cfg=pattern)

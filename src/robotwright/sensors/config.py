@@ -135,6 +135,7 @@ class LidarCfg:
             raise SensorError(
                 f"{name}.pattern_cfg: expected a PatternCfg, got {type(self.pattern_cfg).__name__}"
             )
+        self.pattern_cfg.validate()  # its fields as they are now (edited after construction)
         offset_pos = _floats(self.offset_pos, 3)
         if offset_pos is None or not all(math.isfinite(v) for v in offset_pos):
             raise SensorError(

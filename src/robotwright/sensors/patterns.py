@@ -96,6 +96,14 @@ class PatternCfg:
     #: True when every frame casts the same rays (lets the sensor cache them).
     repetitive: ClassVar[bool] = True
 
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:
+        """Check every field as it is now: a field changed after construction (by a user,
+        mjlab's or Isaac Lab's config system, a command line) is checked again when a
+        sensor is built from the pattern (:class:`SensorError` naming the field)."""
+
     @property
     def num_rays(self) -> int:
         """Number of rays per frame."""
@@ -103,11 +111,13 @@ class PatternCfg:
 
     def rays(self, frame: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Ray origins ``(N, 3)`` [m] and unit directions ``(N, 3)`` in the sensor frame."""
+        self.validate()
         dirs = self._directions(frame)
         return np.zeros_like(dirs), dirs
 
     def ray_table(self) -> RayTable:
         """The rays of every distinct frame, computed once (see :class:`RayTable`)."""
+        self.validate()
         origins, dirs = self.rays(0)
         return RayTable(
             np.ascontiguousarray(origins, dtype=np.float64),
@@ -229,16 +239,20 @@ class LivoxPatternCfg(PatternCfg):
     prism_rpm: tuple[float, float] = (7294.0, -4664.0)
     table_frames: int = 20
 
-    def __post_init__(self) -> None:
+    def effective(self, key: str) -> float:
+        """The value the pattern fires with: field ``key`` (``points_per_second``,
+        ``horizontal_fov``, ``vertical_fov_min``, ``vertical_fov_max``), or where it is
+        None, the published value of the current ``sensor_type`` (looked up at each use,
+        so that a sensor type changed after construction brings its own preset)."""
+        value = getattr(self, key)
+        return _LIVOX_PRESETS[self.sensor_type][key] if value is None else value
+
+    def validate(self) -> None:
         name = type(self).__name__
         if self.sensor_type not in _LIVOX_PRESETS:
             raise SensorError(
                 f"{name}.sensor_type: expected one of {sorted(_LIVOX_PRESETS)}, got {self.sensor_type!r}"
             )
-        preset = _LIVOX_PRESETS[self.sensor_type]
-        for key, value in preset.items():
-            if getattr(self, key) is None:
-                setattr(self, key, value)
         _check_count("num_rays", self.num_rays, name)
         _check_count("num_lines", self.num_lines, name)
         _check_count("table_frames", self.table_frames, name)
@@ -246,13 +260,15 @@ class LivoxPatternCfg(PatternCfg):
         _check_ray_count(
             self.num_rays * self.table_frames, name, "table rows (num_rays x table_frames)"
         )
-        for key in ("points_per_second", "horizontal_fov", "rotation_hz", "elevation_sweep_hz"):
+        for key in ("points_per_second", "horizontal_fov"):
+            _check_positive(key, self.effective(key), name)
+        for key in ("rotation_hz", "elevation_sweep_hz"):
             _check_positive(key, getattr(self, key), name)
-        if self.horizontal_fov > 2.0 * math.pi + 1e-12:
+        if self.effective("horizontal_fov") > 2.0 * math.pi + 1e-12:
             raise SensorError(
-                f"{name}.horizontal_fov: expected <= 2*pi rad, got {self.horizontal_fov}"
+                f"{name}.horizontal_fov: expected <= 2*pi rad, got {self.effective('horizontal_fov')}"
             )
-        lo, hi = self.vertical_fov_min, self.vertical_fov_max
+        lo, hi = self.effective("vertical_fov_min"), self.effective("vertical_fov_max")
         if not (-math.pi / 2 <= lo < hi <= math.pi / 2):
             raise SensorError(
                 f"{name}: expected -pi/2 <= vertical_fov_min < vertical_fov_max <= pi/2, got {lo}, {hi}"
@@ -271,21 +287,23 @@ class LivoxPatternCfg(PatternCfg):
         return self._fire(first, int(self.num_rays))
 
     def ray_table(self) -> RayTable:
+        self.validate()
         dirs = self._fire(0, self.table_frames * int(self.num_rays))
         return RayTable(np.zeros_like(dirs), dirs, int(self.num_rays))
 
     def _fire(self, first: int, count: int) -> np.ndarray:
         """Directions of the rays fired ``first .. first + count - 1`` (sensor frame)."""
         idx = np.arange(first, first + count, dtype=np.int64)
-        t = idx / self.points_per_second
-        lo, hi = self.vertical_fov_min, self.vertical_fov_max
+        t = idx / self.effective("points_per_second")
+        lo, hi = self.effective("vertical_fov_min"), self.effective("vertical_fov_max")
+        fov = self.effective("horizontal_fov")
         if self.sensor_type == "mid360":
             line_frac = (idx % self.num_lines) / self.num_lines
             turns = self.rotation_hz * t + line_frac
             az = (2.0 * math.pi) * (turns - np.floor(turns))  # in [0, 2 pi)
-            if self.horizontal_fov < 2.0 * math.pi:
+            if fov < 2.0 * math.pi:
                 # Squeeze one turn into the field of view, centred on +x.
-                az = az * (self.horizontal_fov / (2.0 * math.pi)) - self.horizontal_fov / 2.0
+                az = az * (fov / (2.0 * math.pi)) - fov / 2.0
             phase = self.elevation_sweep_hz * t + line_frac
             phase -= np.floor(phase)
             tri = 1.0 - np.abs(2.0 * phase - 1.0)  # triangle wave in [0, 1]
@@ -294,7 +312,7 @@ class LivoxPatternCfg(PatternCfg):
             w1, w2 = (2.0 * math.pi * r / 60.0 for r in self.prism_rpm)
             x = 0.5 * (np.cos(w1 * t) + np.cos(w2 * t))
             y = 0.5 * (np.sin(w1 * t) + np.sin(w2 * t))
-            az = x * self.horizontal_fov / 2.0
+            az = x * fov / 2.0
             el = (lo + hi) / 2.0 + y * (hi - lo) / 2.0
         return spherical_to_directions(az, el)
 
@@ -355,7 +373,7 @@ class SpinningLidarPatternCfg(PatternCfg):
     horizontal_fov: float = 2.0 * math.pi
     horizontal_start: float = -math.pi
 
-    def __post_init__(self) -> None:
+    def validate(self) -> None:
         name = type(self).__name__
         self.vertical_angles = tuple(float(a) for a in self.vertical_angles)
         if not self.vertical_angles:
@@ -423,7 +441,7 @@ class GridPatternCfg(PatternCfg):
     size: tuple[float, float] = (1.6, 1.0)
     direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
 
-    def __post_init__(self) -> None:
+    def validate(self) -> None:
         name = type(self).__name__
         _check_positive("resolution", self.resolution, name)
         if len(self.size) != 2 or any(not math.isfinite(s) or s < 0 for s in self.size):
@@ -470,7 +488,7 @@ class PinholeCameraPatternCfg(PatternCfg):
     height: int = 48
     horizontal_fov: float = math.pi / 2.0
 
-    def __post_init__(self) -> None:
+    def validate(self) -> None:
         name = type(self).__name__
         _check_count("width", self.width, name)
         _check_count("height", self.height, name)
@@ -505,8 +523,11 @@ class FilePatternCfg(PatternCfg):
     path: str | Path
     degrees: bool = False
     _angles: np.ndarray = field(init=False, repr=False, compare=False)
+    _read_as: tuple[str, bool] | None = field(default=None, init=False, repr=False, compare=False)
 
-    def __post_init__(self) -> None:
+    def validate(self) -> None:
+        if self._read_as == (str(self.path), bool(self.degrees)):
+            return  # read and checked as it is now
         path = Path(self.path)
         data = _read_pattern_file(path)
         angles = _load_npy(data, path) if path.suffix == ".npy" else _read_angle_table(data, path)
@@ -529,8 +550,10 @@ class FilePatternCfg(PatternCfg):
                 f"{' (file read as degrees)' if self.degrees else ''}, got {angles[bad[0]].tolist()}"
             )
         self._angles = angles
+        self._read_as = (str(self.path), bool(self.degrees))
 
     def _directions(self, frame: int) -> np.ndarray:
+        self.validate()
         return spherical_to_directions(self._angles[:, 0], self._angles[:, 1])
 
 

@@ -144,7 +144,7 @@ def _pattern_table(pattern: Any) -> tuple[np.ndarray, np.ndarray, int, float | N
         table = pattern.ray_table()
         period = None
         if table.num_frames > 1 and isinstance(pattern, LivoxPatternCfg):
-            period = table.rays_per_frame / float(pattern.points_per_second)
+            period = table.rays_per_frame / float(pattern.effective("points_per_second"))
         return table.origins, table.directions, table.rays_per_frame, period
     starts, dirs = pattern.func(pattern, "cpu")
     starts = starts.detach().cpu().double().numpy()
