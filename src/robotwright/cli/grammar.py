@@ -194,6 +194,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=4,
         help="beam: partial designs kept per step (default 4)",
     )
+    q.add_argument(
+        "--batch",
+        type=_int_at_least(1),
+        default=None,
+        help="mcts: leaves picked per round (default 8). A parameter of the search, not the "
+        "worker count: the same seed gives the same search with any --workers or --ray; a "
+        "log resumes only with the batch it was written with",
+    )
     q.add_argument("--max-links", type=_max_links, default=4, help=f"{_MAX_LINKS_HELP}; default 4")
     seed(q, "search")
     q.add_argument(
@@ -417,6 +425,9 @@ def _search(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.batch is not None and args.method != "mcts":
+        print(f"error: --batch: applies to --method mcts, not {args.method}", file=sys.stderr)
+        return 2
     _check_log_paths(args)
     if args.ray is not None:
         from robotwright.grammar.executors import check_ray_address, import_ray
@@ -444,11 +455,17 @@ def _search(args: argparse.Namespace) -> int:
         if args.method == "beam":
             res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
         elif args.method == "mcts":
-            res = mcts_search(g, [objective], constraints, **kw)
+            from robotwright.grammar.search import MCTS_BATCH
+
+            batch = args.batch or MCTS_BATCH
+            res = mcts_search(g, [objective], constraints, batch=batch, **kw)
         else:
             res = random_search(g, [objective], constraints, **kw)
     dt = time.perf_counter() - t0
-    print(f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s")
+    print(
+        f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s "
+        f"(stopped: {res.stopped})"
+    )
     if res.best is None:
         print("no feasible design found")
         return 1

@@ -18,7 +18,14 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Executor, Future
 from typing import Any
 
-__all__ = ["RayExecutor", "check_ray_address", "import_ray", "pool_size", "usable_cores"]
+__all__ = [
+    "RayExecutor",
+    "check_ray_address",
+    "die_with_parent",
+    "import_ray",
+    "pool_size",
+    "usable_cores",
+]
 
 
 def usable_cores() -> int:
@@ -36,6 +43,28 @@ def pool_size(workers: int | None, budget: int) -> int:
     beyond the number of evaluations would only sit idle."""
     wanted = workers or usable_cores()
     return max(1, min(wanted, budget))
+
+
+def die_with_parent(parent: int) -> None:
+    """Initializer of a search's pool processes: each is killed when the process that
+    started it dies, even by ``kill -9`` (Linux's parent-death signal), instead of
+    running on as an orphan. ``parent`` is that process's id, checked after the signal
+    is set in case it died in between. Elsewhere it does nothing."""
+    import signal
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+
+    pr_set_pdeathsig = 1
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:  # the parent died before the signal was set
+        os._exit(1)
 
 
 def import_ray() -> Any:

@@ -21,7 +21,7 @@ from typing import Any
 
 from robotwright.grammar.derive import Counter, Partial, choices_at, options, random_step, sample
 from robotwright.grammar.design import Design
-from robotwright.grammar.executors import RayExecutor, pool_size, usable_cores
+from robotwright.grammar.executors import RayExecutor, die_with_parent, pool_size, usable_cores
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, evaluate
 from robotwright.grammar.rules import Grammar
 from robotwright.grammar.searchlog import SearchLog, read_log
@@ -61,12 +61,19 @@ def check_workers(
         )
 
 
+#: Leaves MCTS picks per round by default. A fixed number, not one that follows the
+#: workers: the same seed then gives the same search on any machine, pool or Ray cluster.
+MCTS_BATCH = 8
+
+
 @dataclass
 class SearchResult:
-    """Best design found and every evaluation made (in order)."""
+    """Best design found, every evaluation made (in order), and why the search stopped
+    (``"budget reached"``, or what ended it before)."""
 
     best: Evaluation | None
     evaluations: list[Evaluation] = field(default_factory=list)
+    stopped: str = "budget reached"
 
     @property
     def n_evaluated(self) -> int:
@@ -105,7 +112,7 @@ class _Evaluator:
         self.workers = workers
         # Read before the log is opened: resuming into the same file appends to it.
         self.known: dict[str, Evaluation] = (
-            read_log(resume, grammar.name, objectives, constraints) if resume else {}
+            read_log(resume, grammar.name, objectives, constraints, header) if resume else {}
         )
         same = resume is not None and (log is None or _same_file(log, resume))
         # Appending to the resumed log: its own evaluations are in it already.
@@ -121,7 +128,11 @@ class _Evaluator:
         if self.executor is None:
             # Never more processes than evaluations: a forced count above the budget
             # would only start idle processes.
-            self.executor = ProcessPoolExecutor(max_workers=pool_size(self.workers, self.budget))
+            self.executor = ProcessPoolExecutor(
+                max_workers=pool_size(self.workers, self.budget),
+                initializer=die_with_parent,
+                initargs=(os.getpid(),),
+            )
         return self
 
     def __exit__(self, *exc) -> None:
@@ -221,7 +232,13 @@ def random_search(
             batch = [sample(grammar, max_links, rng, counter) for _ in range(ev.left)]
             tries += len(batch)
             ev.run(batch)
-        return SearchResult(_best(ev.order), ev.order)
+        stopped = (
+            "budget reached"
+            if ev.left <= 0
+            else f"{tries} draws found only {len(ev.order)} distinct designs (the grammar "
+            f"has few within max_links {max_links})"
+        )
+        return SearchResult(_best(ev.order), ev.order, stopped)
 
 
 def beam_search(
@@ -301,7 +318,10 @@ def beam_search(
                     scored.append((max(r.score for r in rs), i, c))
             scored.sort(key=lambda t: (-t[0], t[1]))
             beam = [c for _, _, c in scored[:beam_width]]
-        return SearchResult(_best(ev.order), ev.order)
+        stopped = (
+            "budget reached" if ev.left <= 0 else "the beam emptied: every design was complete"
+        )
+        return SearchResult(_best(ev.order), ev.order, stopped)
 
 
 class _Node:
@@ -334,7 +354,7 @@ def mcts_search(
     budget: int = 100,
     max_links: int = 4,
     exploration: float = 0.5,
-    batch: int | None = None,
+    batch: int = MCTS_BATCH,
     seed: int = 0,
     executor: Executor | None = None,
     workers: int | None = None,
@@ -348,13 +368,17 @@ def mcts_search(
     Each iteration walks down by UCT (value = mix of the mean and best normalised score
     below a node), expands one untried decision, completes it uniformly at random and
     evaluates the design. ``batch`` leaves are chosen per round (with a virtual visit
-    so they differ) and evaluated together through the executor. Scores are normalised
-    to [0, 1] by the range seen so far; infeasible designs count as 0.
+    so they differ) and evaluated together through the executor; the batch is a
+    parameter of the search (recorded in its log, checked on resume), not the number of
+    workers, so the same seed gives the same search with any executor. Scores are
+    normalised to [0, 1] by the range seen so far; infeasible designs count as 0.
     """
     import math
 
     if budget < 1:
         raise ValueError("budget must be >= 1")
+    if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
+        raise ValueError(f"batch must be an integer >= 1, got {batch!r}")
     rng = random.Random(seed)
     counter = Counter(grammar)
     start = Partial.start(grammar)
@@ -380,9 +404,9 @@ def mcts_search(
         force_workers,
         log=log,
         resume=resume,
-        header=dict(method="mcts", seed=seed, budget=budget, max_links=max_links),
+        header=dict(method="mcts", seed=seed, budget=budget, max_links=max_links, batch=batch),
     ) as ev:
-        k = batch or max(1, 2 * (ev.workers or os.cpu_count() or 1))
+        k = batch
         stalls = 0
         while ev.left > 0 and stalls < 50 and (root.untried or root.children):
             paths: list[list[_Node]] = []
@@ -432,4 +456,13 @@ def mcts_search(
                 for n in path:
                     n.total += s
                     n.best = max(n.best, s)
-        return SearchResult(_best(ev.order), ev.order)
+        if ev.left <= 0:
+            stopped = "budget reached"
+        elif stalls >= 50:
+            stopped = (
+                f"50 rounds in a row found no design not evaluated before ({len(ev.order)} "
+                f"distinct designs within max_links {max_links})"
+            )
+        else:
+            stopped = f"every derivation within max_links {max_links} was explored"
+        return SearchResult(_best(ev.order), ev.order, stopped)

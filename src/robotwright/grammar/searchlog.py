@@ -57,6 +57,7 @@ _SEARCH_KEYS = {
     "seed",
     "budget",
     "max_links",
+    "batch",
     "objectives",
     "constraints",
 }
@@ -180,12 +181,15 @@ def read_log(
     grammar: str,
     objectives: Sequence[Objective],
     constraints: Sequence[Constraint],
+    search: Mapping[str, Any] | None = None,
 ) -> dict[str, Evaluation]:
     """The evaluations of the log at ``path`` by design hash, checked line by line.
 
     Every ``search`` line must name ``grammar`` and the same objectives and constraints
     (names and settings) as the search resuming, so that its evaluations are the ones
-    this search would make. Scores are recomputed from the values (the first objective,
+    this search would make. An MCTS search (``search``: the resuming search's ``search``
+    line fields) resumes only a log of MCTS with the same ``batch``: another batch walks
+    another tree and would end elsewhere. Scores are recomputed from the values (the first objective,
     negated when minimised, ``-inf`` when a constraint is violated).
 
     Raises:
@@ -236,6 +240,7 @@ def read_log(
                             "settings); resume with the objectives and constraints the log "
                             "was written with"
                         )
+                _check_batch(rec, search or {})
                 header_seen = True
                 continue
             if kind != "evaluation":
@@ -258,6 +263,17 @@ def read_log(
         except _Bad as exc:
             raise InputFileError(path, f"line {n}: {exc}") from None
     return {h: ev for h, (_, ev) in found.items()}
+
+
+def _check_batch(rec: Mapping[str, Any], search: Mapping[str, Any]) -> None:
+    if search.get("method") != "mcts" or rec.get("method") != "mcts":
+        return
+    if rec.get("batch") != search.get("batch"):
+        logged = "no batch" if "batch" not in rec else f"batch {json.dumps(rec['batch'])[:20]}"
+        raise _Bad(
+            f"an MCTS search with {logged}; this one has batch {search.get('batch')} (resume "
+            "with the batch the log was written with: another batch walks another tree)"
+        )
 
 
 def _same_values(a: Mapping[str, float], b: Mapping[str, float]) -> bool:
