@@ -145,6 +145,9 @@ def _search_to(out: Path, *extra: str) -> list[str]:
         "--workers",
         "1",
         "--no-picture",
+        # designs touching the carrier stay feasible: this checks the output folder
+        "--constraint",
+        "no-self-collision",
         "-o",
         str(out),
         *extra,

@@ -173,7 +173,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--constraint",
         action="append",
         default=None,
-        help="no-self-collision (default), no-carrier-collision, joint-limits, max-mass=KG, "
+        help="no-self-collision (default; with no-carrier-collision for payload, track and "
+        "energy), no-carrier-collision, joint-limits, max-mass=KG, "
         "max-dof=N, min-dof=N; repeatable",
     )
     q.add_argument(
@@ -400,6 +401,30 @@ def _search_progress(budget: int, name: str):
     return show
 
 
+#: Objectives that evaluate the limb worn by its carrier: their searches refuse designs
+#: that touch the carrier unless --constraint says otherwise.
+_CARRIER_OBJECTIVES = ("payload", "track", "energy")
+
+
+def _default_constraints(args: argparse.Namespace) -> list[str]:
+    if args.objective in _CARRIER_OBJECTIVES:
+        return ["no-self-collision", "no-carrier-collision"]
+    return ["no-self-collision"]
+
+
+def _value_text(objective: object, value: float) -> str:
+    """``name = value unit``, saying when the value is the objective's bound."""
+    from robotwright.grammar.winners import UNITS
+
+    name = getattr(objective, "name", "")
+    unit = UNITS.get(name, "")
+    text = f"{name} = {value:.6g} {unit}".rstrip()
+    limit = getattr(objective, "limit", None)
+    if limit is not None and value >= limit:
+        text += f" (the {limit:g} {unit} bound: the design holds at least this)".replace("  ", " ")
+    return text
+
+
 def _search(args: argparse.Namespace) -> int:
     from robotwright.grammar.objectives import OBJECTIVES, make_constraint
     from robotwright.grammar.search import beam_search, check_workers, mcts_search, random_search
@@ -408,7 +433,7 @@ def _search(args: argparse.Namespace) -> int:
     if args.out:
         _check_design_dir(args.out, args.overwrite, kind="designs")
     try:
-        constraints = [make_constraint(c) for c in (args.constraint or ["no-self-collision"])]
+        constraints = [make_constraint(c) for c in (args.constraint or _default_constraints(args))]
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -470,7 +495,7 @@ def _search(args: argparse.Namespace) -> int:
         print("no feasible design found")
         return 1
     print(
-        f"best {objective.name} = {res.best.values[objective.name]:.4f} (design {res.best.design.hash()})"
+        f"best {_value_text(objective, res.best.values[objective.name])} (design {res.best.design.hash()})"
     )
     print(res.best.design.to_text(), end="")
     if args.out:

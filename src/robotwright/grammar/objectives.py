@@ -21,6 +21,7 @@ import numpy as np
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.design import Design
 from robotwright.grammar.physics import (
+    MIN_FREE_SHARE,
     Carrier,
     Mounted,
     TrackResult,
@@ -258,20 +259,36 @@ class NoSelfCollision:
 class Payload:
     """Largest mass (kg) at every tool point that the limb, worn by ``carrier``, holds
     still at the zero pose and ``samples`` seeded random poses with every joint torque
-    within its peak (:func:`robotwright.grammar.physics.payload`); larger is better."""
+    within its peak (:func:`robotwright.grammar.physics.payload`); larger is better.
+    Every pose counts: with fewer than ``min_free_share`` of them free of contact with
+    the limb itself or the carrier, the payload is 0; it is at most ``limit`` kg, a
+    bound the command line names when a design reaches it."""
 
     samples: int = 32
     seed: int = 0
     carrier: Carrier = Carrier()
+    limit: float = 100.0
+    min_free_share: float = MIN_FREE_SHARE
     name: str = "payload"
     maximize: bool = True
 
     def __post_init__(self) -> None:
-        check_settings("Payload", samples=self.samples, seed=self.seed)
+        check_settings("Payload", samples=self.samples, seed=self.seed, limit=self.limit)
+        share = self.min_free_share
+        if not (isinstance(share, (int, float)) and 0.0 <= share <= 1.0):
+            raise ValueError(f"Payload: min_free_share must be in [0, 1], got {share!r}")
 
     def __call__(self, ctx: EvalContext) -> float:
         m = ctx.mounted(self.carrier)
-        return payload(ctx.limb, self.carrier, samples=self.samples, seed=self.seed, mounted=m).mass
+        return payload(
+            ctx.limb,
+            self.carrier,
+            samples=self.samples,
+            seed=self.seed,
+            limit=self.limit,
+            min_free_share=self.min_free_share,
+            mounted=m,
+        ).mass
 
 
 @dataclass(frozen=True)

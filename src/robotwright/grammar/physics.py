@@ -174,15 +174,24 @@ def carrier_collisions(m: Mounted, q: np.ndarray) -> list[tuple[int, str, str]]:
     return out
 
 
+#: Share of the sampled poses a limb must take without touching itself or its carrier
+#: for its payload to count (see :func:`payload`): a limb free at a few poses only is no
+#: limb that holds anything where it is asked to.
+MIN_FREE_SHARE = 0.5
+
+
 @dataclass(frozen=True)
 class PayloadResult:
-    """Payload (kg), the worst pose, and per-pose limits (kg; ``inf`` where no joint
-    limits it)."""
+    """Payload (kg), the worst pose, per-pose limits (kg; ``inf`` where no joint limits
+    it) of the free poses, the share of all sampled poses that were free, and whether
+    the payload is the ``limit`` (the limb holds at least that much: ``bounded``)."""
 
     mass: float
     worst: int
     poses: np.ndarray
     per_pose: np.ndarray
+    free_share: float = 1.0
+    bounded: bool = False
 
 
 def holding_torques(
@@ -221,6 +230,7 @@ def payload(
     samples: int = 32,
     seed: int = 0,
     limit: float = 100.0,
+    min_free_share: float = MIN_FREE_SHARE,
     mounted: Mounted | None = None,
 ) -> PayloadResult:
     """Largest mass (kg) hung at every tool point that the limb holds at each of the
@@ -229,11 +239,16 @@ def payload(
     Per pose the holding torque is ``tau0 + M * per_kg`` (:func:`holding_torques`), so
     the largest ``M`` with ``|tau_i| <= peak_i`` for all joints is found in closed form;
     the payload is the smallest over the poses, 0 when the limb cannot hold itself at
-    some pose, and at most ``limit`` kg (a limb without joints holds anything: the
-    carrier carries it). Poses where the limb touches itself or the carrier are not
-    reachable and are skipped; when every pose is, the payload is 0.
+    some pose. Every sampled pose counts: a pose where the limb touches itself or the
+    carrier is one it cannot take, and when fewer than ``min_free_share`` of the poses
+    are free the payload is 0 (a limb free at 2 poses of 33 does not score on those
+    two). The payload is at most ``limit`` kg, a physical bound reported as such
+    (``bounded``): a limb whose joints bear no load (no joint, or horizontal slides)
+    holds anything its carrier carries.
     """
     check_settings("payload", samples=samples, seed=seed, limit=limit)
+    if not (isinstance(min_free_share, (int, float)) and 0.0 <= min_free_share <= 1.0):
+        raise ValueError(f"payload: min_free_share must be in [0, 1], got {min_free_share!r}")
     m = mounted or mount(limb, carrier)
     poses = sample_poses(m, samples, seed)
     data = mujoco.MjData(m.model)
@@ -244,15 +259,17 @@ def payload(
         mujoco.mj_collision(m.model, data)
         if not contacts(m, data):
             keep.append(k)
+    share = len(keep) / len(poses)
     poses = poses[keep]
-    if len(poses) == 0:
-        return PayloadResult(0.0, -1, poses, np.zeros(0))
+    if len(poses) == 0 or share < min_free_share:
+        return PayloadResult(0.0, -1, poses, np.zeros(0), share)
     per_pose = np.empty(len(poses))
     for k, qk in enumerate(poses):
         tau0, a = holding_torques(m, qk, data)
         per_pose[k] = _max_mass(tau0, a, m.peak)
     worst = int(np.argmin(per_pose))
-    return PayloadResult(float(min(per_pose[worst], limit)), worst, poses, per_pose)
+    mass = float(per_pose[worst])
+    return PayloadResult(min(mass, limit), worst, poses, per_pose, share, mass >= limit)
 
 
 def _max_mass(tau0: np.ndarray, a: np.ndarray, peak: np.ndarray) -> float:
