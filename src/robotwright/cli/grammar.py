@@ -591,15 +591,21 @@ def _show(args: argparse.Namespace) -> int:
             depth, p = depth + 1, p.parent
         print(f"{'  ' * depth}{n.label()}")
     for k, br in enumerate(limb.branches):
+        # Every number at full precision (Python's shortest exact form): forward
+        # kinematics from the printed table alone equals MuJoCo's.
         print(
             f"branch {k} -> site '{br.site}': modified DH (a_i-1 m, alpha_i-1 rad, d_i m, theta_i rad)"
         )
-        z0 = br.base_frame[:3, 3]
-        print(f"  frame 0 in the mount frame at ({z0[0]:.4g}, {z0[1]:.4g}, {z0[2]:.4g}) m")
+        print("  frame 0 in the mount frame (4x4, m):")
+        for row in br.base_frame:
+            print("    " + " ".join(repr(float(v)) for v in row))
         for r in br.rows:
             print(
-                f"  {r.name:8s} {r.type:6s} a={r.a:<8.4g} alpha={r.alpha:<8.4g} d={r.d:<8.4g} theta={r.theta:.4g}"
+                f"  {r.name:8s} {r.type:6s} a={r.a!r} alpha={r.alpha!r} d={r.d!r} theta={r.theta!r}"
             )
+        print(f"  tool point in the last frame (4x4, m), site '{br.site}':")
+        for row in br.tool:
+            print("    " + " ".join(repr(float(v)) for v in row))
     return 0
 
 
