@@ -117,7 +117,9 @@ def test_show_prints_tree_dh_and_dot(tmp_path, capsys):
     )
     assert main(["grammar", "show", str(design)]) == 0
     out = capsys.readouterr().out
-    assert "2 DoF" in out and "  L:link(" in out and "joint2   hinge  a=0.0 alpha=1.5708 d=0.0" in out
+    assert (
+        "2 DoF" in out and "  L:link(" in out and "joint2   hinge  a=0.0 alpha=1.5708 d=0.0" in out
+    )
     assert main(["grammar", "show", str(design), "--dot"]) == 0
     assert capsys.readouterr().out.count("->") == 4
     design.write_text("# grammar=srl\nr2 @0: C=universal(limit=1.5708)\n")

@@ -38,6 +38,7 @@ from robotwright.sensors import (  # noqa: E402
     SemanticLidarSensor,
     SpinningLidarPatternCfg,
     classify_path,
+    learning_obs,  # noqa: E402
 )
 from robotwright.sensors import mjlab as rw_mjlab  # noqa: E402
 
@@ -630,3 +631,28 @@ def test_seed_getters_point_cloud_and_range_image(clutter_model):
                     frac = (hits & (labels[e] == k)).sum() / max(in_cell.sum(), 1)
                     assert abs(float(image[e, 1 + k, r, c]) - frac) < 1e-5
     assert float(image[:, 0].min()) < 1.0
+    # scanned: a last channel, 1 where a ray of this frame fell in the cell, else 0
+    marked = rw_mjlab.lidar_range_image(env, "lidar", 16, 4, scanned=True)
+    assert marked.shape == (3, 2 + classes, 4, 16) and torch.equal(marked[:, :-1], image)
+    scanned = np.zeros((4, 16), bool)
+    scanned[row, col] = True
+    assert (marked[:, -1].numpy() == scanned).all() and not scanned.all()
+    # The cells are looked up per pattern frame: after more steps (other windows of the
+    # rosette) the image equals one binned from this step's window of the table.
+    for _ in range(2):
+        env.sense()
+        window = torch.as_tensor(s.table.window(int(data.frame[0]))[1])
+        local = window.expand(3, *window.shape)
+        again = learning_obs.range_image(
+            local,
+            data.hit_mask,
+            data.distances,
+            40.0,
+            data.semantic_labels,
+            classes,
+            learning_obs.direction_bounds(torch.as_tensor(s.table.directions)),
+            16,
+            4,
+            scanned=True,
+        )
+        assert torch.equal(rw_mjlab.lidar_range_image(env, "lidar", 16, 4, scanned=True), again)

@@ -22,6 +22,7 @@ __all__ = [
     "one_hot_classes",
     "point_cloud",
     "range_image",
+    "ray_cells",
     "semantic_obs",
 ]
 
@@ -110,8 +111,26 @@ def check_image_size(width: object, height: object) -> None:
             )
 
 
-def range_image(
+def ray_cells(
     local_dirs: torch.Tensor,
+    bounds: tuple[float, float, float, float, bool],
+    width: int,
+    height: int,
+) -> torch.Tensor:
+    """The range-image cell (``row * width + col``) of each ray ``(..., 3)`` of the
+    sensor's ray frame: columns by azimuth from the smallest of ``bounds``, rows by
+    elevation from the highest. A pattern's rays keep their cells from step to step, so
+    a sensor computes them once per pattern frame (see :func:`range_image`'s ``cells``)."""
+    az0, az1, el0, el1, _ = bounds
+    az = torch.atan2(local_dirs[..., 1], local_dirs[..., 0])
+    el = torch.atan2(local_dirs[..., 2], torch.hypot(local_dirs[..., 0], local_dirs[..., 1]))
+    col = ((az - az0) / (az1 - az0) * width).floor().long().clamp(0, width - 1)
+    row = ((el1 - el) / (el1 - el0) * height).floor().long().clamp(0, height - 1)
+    return row * width + col
+
+
+def range_image(
+    local_dirs: torch.Tensor | None,
     hit: torch.Tensor,
     distances: torch.Tensor,
     max_distance: float,
@@ -120,34 +139,43 @@ def range_image(
     bounds: tuple[float, float, float, float, bool],
     width: int,
     height: int,
+    *,
+    cells: torch.Tensor | None = None,
+    scanned: bool = False,
 ) -> torch.Tensor:
-    """``(E, 1 + C, height, width)`` nearest distance and class occupancy per direction cell.
+    """``(E, 1 + C, height, width)`` nearest distance and class occupancy per direction
+    cell (``(E, 2 + C, height, width)`` with ``scanned``).
 
     Each ray falls in the cell of its azimuth (columns, left to right from the smallest
     azimuth of ``bounds``) and elevation (rows, top = highest), from ``local_dirs``
-    ``(E, N, 3)`` in the sensor's ray frame. Channel 0: the nearest hit in the cell /
-    ``max_distance``, 1 where the cell has no hit this step, also a cell no ray of
-    this step fell in (so "no return" and "not scanned" read alike, as a real range
-    image with no return does); channels 1..C: the fraction of the cell's rays this
-    step that hit each class, 0 in a cell no ray fell in. ``distances`` may hold
-    anything where ``hit`` is False.
+    ``(E, N, 3)`` in the sensor's ray frame, or given as ``cells`` ``(N,)`` or ``(E, N)``
+    (:func:`ray_cells`, computed once; ``local_dirs`` is then not read). Channel 0: the
+    nearest hit in the cell / ``max_distance``, 1 where the cell has no hit this step;
+    channels 1..C: the fraction of the cell's rays this step that hit each class, 0 in a
+    cell no ray fell in. Without ``scanned`` a cell no ray of this step fell in reads as
+    one whose rays all missed (as a real range image with no return does); with it, a
+    last channel says which cells this step's rays scanned (1) and which none did (0),
+    so an obstacle in a pattern's blind part of this step is not free space.
+    ``distances`` may hold anything where ``hit`` is False.
     """
     e = hit.shape[0]
-    az0, az1, el0, el1, _ = bounds
-    az = torch.atan2(local_dirs[..., 1], local_dirs[..., 0])
-    el = torch.atan2(local_dirs[..., 2], torch.hypot(local_dirs[..., 0], local_dirs[..., 1]))
-    col = ((az - az0) / (az1 - az0) * width).floor().long().clamp(0, width - 1)
-    row = ((el1 - el) / (el1 - el0) * height).floor().long().clamp(0, height - 1)
-    cell = row * width + col
-    cells = height * width
+    if cells is None:
+        if local_dirs is None:
+            raise SensorError("range_image: give the rays' directions or their cells")
+        cells = ray_cells(local_dirs, bounds, width, height)
+    cell = cells.expand(hit.shape)
+    n_cells = height * width
     dev = hit.device
     scaled = torch.where(hit, distances / float(max_distance), 1.0).clamp(0.0, 1.0)
-    depth = torch.ones(e, cells, device=dev)
+    depth = torch.ones(e, n_cells, device=dev)
     depth.scatter_reduce_(1, cell, scaled, reduce="amin", include_self=True)
-    rays = torch.zeros(e, cells, device=dev)
+    rays = torch.zeros(e, n_cells, device=dev)
     rays.scatter_add_(1, cell, torch.ones_like(scaled))
-    per_class = torch.zeros(e, classes * cells, device=dev)
-    slot = labels.long().clamp(0, classes - 1) * cells + cell
+    per_class = torch.zeros(e, classes * n_cells, device=dev)
+    slot = labels.long().clamp(0, classes - 1) * n_cells + cell
     per_class.scatter_add_(1, slot, hit.float())
-    occupancy = per_class.view(e, classes, cells) / rays.clamp(min=1.0)[:, None]
-    return torch.cat([depth[:, None], occupancy], dim=1).view(e, 1 + classes, height, width)
+    occupancy = per_class.view(e, classes, n_cells) / rays.clamp(min=1.0)[:, None]
+    parts = [depth[:, None], occupancy]
+    if scanned:
+        parts.append((rays > 0).float()[:, None])
+    return torch.cat(parts, dim=1).view(e, 1 + classes + int(scanned), height, width)

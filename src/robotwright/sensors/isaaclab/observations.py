@@ -94,11 +94,17 @@ def lidar_point_cloud(
 
 
 def lidar_range_image(
-    env: Any, sensor_cfg: SceneEntityCfg, width: int, height: int, flatten: bool = False
+    env: Any,
+    sensor_cfg: SceneEntityCfg,
+    width: int,
+    height: int,
+    flatten: bool = False,
+    scanned: bool = False,
 ) -> torch.Tensor:
     """``(E, 1 + C, height, width)`` nearest distance and class occupancy per direction
     cell of the sensor frame, over the pattern's whole field of view (every window);
-    ``flatten=True`` gives ``(E, (1 + C) * height * width)`` for an MLP. See
+    ``scanned=True`` adds a last channel saying which cells this step's rays scanned;
+    ``flatten=True`` gives ``(E, channels * height * width)`` for an MLP. See
     :func:`robotwright.sensors.learning_obs.range_image`."""
     learning_obs.check_image_size(width, height)
     s = _sensor(env, sensor_cfg)
@@ -113,5 +119,6 @@ def lidar_range_image(
         s.direction_bounds(),
         width,
         height,
+        scanned=scanned,
     )
     return out.reshape(out.shape[0], -1) if flatten else out

@@ -128,10 +128,32 @@ def _image_bounds(s: MjlabSemanticLidarSensor) -> tuple[float, float, float, flo
     return s._obs_cache[key]
 
 
+def _frame_cells(s: MjlabSemanticLidarSensor, width: int, height: int) -> torch.Tensor:
+    """``(N,)`` range-image cells of the rays of the pattern frame last cast. The rays of
+    every frame have fixed directions in the ray frame (whatever ``ray_alignment``), so
+    their cells are computed once per image size for the whole table and only looked
+    up each step (on the device, no copy to the host)."""
+    key = ("range_image_cells", width, height)
+    data = s.data
+    if key not in s._obs_cache:
+        table = s.table
+        dirs = torch.as_tensor(table.directions).view(table.num_frames, -1, 3)
+        cells = learning_obs.ray_cells(dirs, _image_bounds(s), width, height)
+        s._obs_cache[key] = cells.to(data.hit_mask.device)
+    frame = data.frame.long().clamp(min=0) % s.table.num_frames
+    return s._obs_cache[key].index_select(0, frame).squeeze(0)
+
+
 def lidar_range_image(
-    env: Any, sensor_name: str, width: int, height: int, flatten: bool = False
+    env: Any,
+    sensor_name: str,
+    width: int,
+    height: int,
+    flatten: bool = False,
+    scanned: bool = False,
 ) -> torch.Tensor:
-    """``(E, 1 + C, height, width)`` distances and class occupancy binned by direction.
+    """``(E, 1 + C, height, width)`` distances and class occupancy binned by direction
+    (``(E, 2 + C, height, width)`` with ``scanned``).
 
     Each ray falls in the cell of its azimuth (columns, left to right from -pi, or from the
     pattern's smallest azimuth when it spans less than the full circle) and elevation
@@ -139,21 +161,22 @@ def lidar_range_image(
     sensor frame under ``ray_alignment``). Channel 0: the nearest hit in the cell /
     ``max_distance`` (1 where the cell has no hit this step); channels 1..C: the
     fraction of the cell's rays this step that hit each class (class 0: unknown geoms).
-    Every cell means the same direction every step, whatever the pattern, so a CNN or a
-    flattened MLP can learn from it; a rosette fills different cells each step.
+    ``scanned=True`` adds a last channel: 1 where a ray of this step fell in the cell, 0
+    where none did (a rotating pattern leaves cells unscanned each step; without this
+    channel they read as free space). Every cell means the same direction every step,
+    whatever the pattern, so a CNN or a flattened MLP can learn from it; a rosette fills
+    different cells each step. The rays' cells are computed once per pattern frame.
 
     Size per env: ``(1 + C) * height * width`` floats; 32 x 8 with 5 classes: 1 536
     floats (6 KiB), 24 MiB per step for 4096 envs (576 MiB of PPO rollout at 24 steps).
-    ``flatten=True`` returns it as ``(E, (1 + C) * height * width)`` (channel-major), the
+    ``flatten=True`` returns it as ``(E, channels * height * width)`` (channel-major), the
     form an MLP actor (rsl_rl's) and mjlab's term concatenation take.
     """
     learning_obs.check_image_size(width, height)
     s = _sensor(env, sensor_name)
     data = s.data
-    # The rays in the ray frame: R^T d (R = this step's ray rotation).
-    local = torch.einsum("eji,enj->eni", s._ray_rot, data.ray_directions_w)
     out = learning_obs.range_image(
-        local,
+        None,
         data.hit_mask,
         data.distances,
         float(s.cfg.max_distance),
@@ -162,6 +185,8 @@ def lidar_range_image(
         _image_bounds(s),
         width,
         height,
+        cells=_frame_cells(s, width, height),
+        scanned=scanned,
     )
     if flatten:
         return out.reshape(out.shape[0], -1)
