@@ -285,7 +285,7 @@ FOLDER_WRITERS: dict[str, list[str]] = {
 def quick_demo(monkeypatch) -> list[Path]:
     """``robotwright demo`` with one quick step (the gate runs before the steps); the
     list collects the folders the step ran in."""
-    from robotwright import demo
+    from robotwright.cli import demo
 
     ran: list[Path] = []
 

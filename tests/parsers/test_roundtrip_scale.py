@@ -199,7 +199,7 @@ def test_every_body_inertia_is_compared_on_both_legs(full: bool) -> None:
 def test_actuators_made_for_a_urdf_are_checked_against_its_joints(tmp_path: Path) -> None:
     """MuJoCo's URDF import has no actuators; those ``actuators="motor"`` makes are not a
     failure, but each must drive a moving joint of the source, once."""
-    from robotwright.parsers.roundtrip import _made_actuators_row
+    from robotwright.parsers.roundtrip_compare import _made_actuators_row
 
     path = tmp_path / "tree.urdf"
     path.write_text(tree_urdf(6))
