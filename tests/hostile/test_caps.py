@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 import random
 import shutil
 import zipfile
@@ -306,8 +307,10 @@ class _RecordingPool:
 
     sizes: list[int] = []
 
-    def __init__(self, max_workers: int) -> None:
+    def __init__(self, max_workers: int, initializer=None, initargs=()) -> None:
         type(self).sizes.append(max_workers)
+        # the pool's workers are told to die with the search (see executors.die_with_parent)
+        assert initializer is not None and initargs == (os.getpid(),)
 
     def map(self, fn, items, chunksize=1):
         return map(fn, items)
