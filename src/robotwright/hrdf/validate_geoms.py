@@ -7,7 +7,7 @@ import math
 import os
 from pathlib import Path
 
-from robotwright._assets import check_asset_file
+from robotwright._assets import check_asset_file, mesh_limit_bytes
 from robotwright.errors import InputFileError, Problem, UnsafePathError
 from robotwright.hrdf import validate_common
 from robotwright.hrdf.model import (
@@ -35,22 +35,28 @@ def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
     return str(hrdf.mesh_path(mesh))
 
 
-def _listing(folder: str, listings: dict[str, set[str]]) -> set[str]:
-    """Names of the regular files in ``folder`` that are not symbolic links, listed once
-    per check (meshes share a folder)."""
-    names = listings.get(folder)
-    if names is None:
+def _listing(folder: str, listings: dict[str, dict[str, int]]) -> dict[str, int]:
+    """Size [bytes] of each regular file in ``folder`` that is not a symbolic link, by
+    name, listed once per check (meshes share a folder): the size cap is checked from
+    it, with no other call per mesh."""
+    sizes = listings.get(folder)
+    if sizes is None:
+        sizes = {}
         try:
-            names = {e.name for e in os.scandir(folder) if e.is_file(follow_symlinks=False)}
+            with os.scandir(folder) as entries:
+                for e in entries:
+                    if e.is_file(follow_symlinks=False):
+                        sizes[e.name] = e.stat(follow_symlinks=False).st_size
         except OSError:
-            names = set()
-        listings[folder] = names
-    return names
+            sizes = {}
+        listings[folder] = sizes
+    return sizes
 
 
 def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Problem]:
     out: list[Problem] = []
-    listings: dict[str, set[str]] = {}
+    listings: dict[str, dict[str, int]] = {}
+    limit = mesh_limit_bytes()
     hypot = math.hypot
     for table, rows in (("mesh.csv", hrdf.meshes), ("simple_geom.csv", hrdf.simple_geoms)):
         for i, g in enumerate(rows):
@@ -138,15 +144,16 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
                     column="inertia",
                 )
             )
-        # A plain file listed in the robot's own meshes/ folder is inside and exists.
+        # A plain file listed in the robot's own meshes/ folder is inside and exists; its
+        # size is the listing's.
         if (
             validate_common.QUICK_PASS
             and default_dir is not None
             and m.file is None
             and os.sep not in m.name
-            and f"{m.name}.{ext}" in _listing(default_dir, listings)
+            and (size := _listing(default_dir, listings).get(f"{m.name}.{ext}")) is not None
         ):
-            if check_files:
+            if check_files and size > limit:
                 out += _too_large(f"{default_dir}{os.sep}{m.name}.{ext}", i, "name")
             continue
         column = "file" if m.file is not None else "name"
