@@ -35,22 +35,22 @@ def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
     return str(hrdf.mesh_path(mesh))
 
 
-def _listing(folder: str, listings: dict[str, dict[str, int]]) -> dict[str, int]:
-    """Size [bytes] of each regular file in ``folder`` that is not a symbolic link, by
-    name, listed once per check (meshes share a folder): the size cap is checked from
-    it, with no other call per mesh."""
-    sizes = listings.get(folder)
-    if sizes is None:
-        sizes = {}
+def _listing(folder: str, listings: dict[str, dict[str, int]], sizes: bool) -> dict[str, int]:
+    """The regular files in ``folder`` that are not symbolic links, by name, listed once
+    per check (meshes share a folder), with their size [bytes] when ``sizes`` (else 0):
+    the size cap is checked from it, with no other call per mesh."""
+    found = listings.get(folder)
+    if found is None:
+        found = {}
         try:
             with os.scandir(folder) as entries:
                 for e in entries:
                     if e.is_file(follow_symlinks=False):
-                        sizes[e.name] = e.stat(follow_symlinks=False).st_size
+                        found[e.name] = e.stat(follow_symlinks=False).st_size if sizes else 0
         except OSError:
-            sizes = {}
-        listings[folder] = sizes
-    return sizes
+            found = {}
+        listings[folder] = found
+    return found
 
 
 def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Problem]:
@@ -151,7 +151,8 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             and default_dir is not None
             and m.file is None
             and os.sep not in m.name
-            and (size := _listing(default_dir, listings).get(f"{m.name}.{ext}")) is not None
+            and (size := _listing(default_dir, listings, check_files).get(f"{m.name}.{ext}"))
+            is not None
         ):
             if check_files and size > limit:
                 out += _too_large(f"{default_dir}{os.sep}{m.name}.{ext}", i, "name")
