@@ -19,9 +19,9 @@ import numpy as np
 
 from robotwright.errors import ConversionWarning
 from robotwright.generators import MJCFHumanoidGenerator, URDFHumanoidGenerator
-from robotwright.tasks import compose_scene
 from robotwright.hrdf import HRDF
 from robotwright.parsers import urdf_to_hrdf
+from robotwright.tasks import compose_scene
 
 
 def main(out_dir: str = "robots_to_scene") -> None:
