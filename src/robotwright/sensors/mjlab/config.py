@@ -210,22 +210,12 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
         mjlab_class_mapping() if cfg.semantic_class_mapping is None else cfg.semantic_class_mapping
     )
     # The core config validates and normalises the shared fields (ranges, noise,
-    # mapping, offsets, alignment, seed) with the same rules and messages.
-    core = SemanticLidarCfg(
-        prim_path=cfg.frame.prefixed_name(),
-        pattern_cfg=cfg.pattern if isinstance(cfg.pattern, PatternCfg) else GridPatternCfg(),
-        offset_pos=cfg.offset_pos,
-        offset_rot=cfg.offset_rot,
-        ray_alignment=cfg.ray_alignment,
-        min_distance=cfg.min_distance,
-        max_distance=cfg.max_distance,
-        range_noise_std=cfg.range_noise_std,
-        dropout_prob=cfg.dropout_prob,
-        seed=cfg.seed,
-        miss_distance=cfg.miss_distance,
-        num_threads=cfg.num_threads,
-        semantic_class_mapping=mapping,
-    )
+    # mapping, offsets, alignment, seed) with the same rules; its messages are put in
+    # this config's terms (its class and field names).
+    try:
+        core = _core_config(cfg, mapping)
+    except SensorError as exc:
+        raise SensorError(_in_terms_of(str(exc), name)) from None
     miss = float(core.miss_distance)  # type: ignore[arg-type]
     if not math.isfinite(miss):
         raise SensorError(f"{name}.miss_distance: expected a finite number [m]")
@@ -246,3 +236,38 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
         offset_pos=tuple(float(v) for v in core.offset_pos),  # type: ignore[arg-type]
         offset_rot=tuple(float(v) for v in core.offset_rot),  # type: ignore[arg-type]
     )
+
+
+def _core_config(cfg: Any, mapping: dict[str, list[str]]) -> SemanticLidarCfg:
+    return SemanticLidarCfg(
+        prim_path=cfg.frame.prefixed_name(),
+        pattern_cfg=cfg.pattern if isinstance(cfg.pattern, PatternCfg) else GridPatternCfg(),
+        offset_pos=cfg.offset_pos,
+        offset_rot=cfg.offset_rot,
+        ray_alignment=cfg.ray_alignment,
+        min_distance=cfg.min_distance,
+        max_distance=cfg.max_distance,
+        range_noise_std=cfg.range_noise_std,
+        dropout_prob=cfg.dropout_prob,
+        seed=cfg.seed,
+        miss_distance=cfg.miss_distance,
+        num_threads=cfg.num_threads,
+        semantic_class_mapping=mapping,
+    )
+
+
+#: Field of the core config -> the field of the mjlab config it comes from.
+_FIELDS = {"pattern_cfg": "pattern", "prim_path": "frame"}
+
+
+def _in_terms_of(message: str, name: str) -> str:
+    """A core config's error about ``SemanticLidarCfg.<field>`` (or a pattern's) as an
+    error about the mjlab config ``name``: the class and field the user set."""
+    core = SemanticLidarCfg.__name__
+    if message.startswith(core):
+        rest = message[len(core) :]
+        for ours, theirs in _FIELDS.items():
+            if rest.startswith(f".{ours}"):
+                rest = f".{theirs}" + rest[len(ours) + 1 :]
+        return name + rest
+    return f"{name}.pattern: {message}"
