@@ -48,8 +48,10 @@ def pool_size(workers: int | None, budget: int) -> int:
 def die_with_parent(parent: int) -> None:
     """Initializer of a search's pool processes: each is killed when the process that
     started it dies, even by ``kill -9`` (Linux's parent-death signal), instead of
-    running on as an orphan. ``parent`` is that process's id, checked after the signal
-    is set in case it died in between. Elsewhere it does nothing."""
+    running on as an orphan. ``parent`` is the search's process id: a worker that finds
+    it gone once the signal is set (it died in between) exits at once. Under a fork
+    server (Python's default from 3.14) the signal follows the server, which ends with
+    the search. Elsewhere than Linux it does nothing."""
     import signal
     import sys
 
@@ -63,8 +65,12 @@ def die_with_parent(parent: int) -> None:
         libc.prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
     except (OSError, AttributeError):
         return
-    if os.getppid() != parent:  # the parent died before the signal was set
+    try:
+        os.kill(parent, 0)  # is the search still there?
+    except ProcessLookupError:
         os._exit(1)
+    except PermissionError:
+        pass  # there, under another user (cannot happen for our own parent)
 
 
 def import_ray() -> Any:
