@@ -420,6 +420,43 @@ def test_pattern_fields_edited_after_construction_are_checked_in_build():
         cfg.build()
 
 
+def test_class_mapping_from_a_command_line():
+    """mjlab's train/play CLI (tyro) reads a dict of lists as one class only; the string
+    field ``semantic_classes`` sets the whole mapping from a command line."""
+    import dataclasses
+
+    import tyro
+
+    base = {"name": "lidar", "frame": ObjRef(type="body", name="trunk", entity="robot")}
+
+    @dataclasses.dataclass
+    class Scene:
+        lidar: rw_mjlab.SemanticLidarSensorCfg = dataclasses.field(
+            default_factory=lambda: rw_mjlab.SemanticLidarSensorCfg(**base)
+        )
+
+    text = "valuable = sofa, table; dynamic_obstacle=box"
+    scene = tyro.cli(Scene, args=["--lidar.semantic-classes", text])
+    resolved = rw_mjlab.resolve(scene.lidar)
+    assert resolved.mapping == {"valuable": ["sofa", "table"], "dynamic_obstacle": ["box"]}
+    assert resolved.class_names == ("unknown", "valuable", "dynamic_obstacle", "robot")
+    for bad, words in [
+        ("valuable", "expected CLASS=KEYWORD"),
+        ("a=x;a=y", "class 'a' given twice"),
+        ("a=x,,y", "expected CLASS=KEYWORD"),
+        ("unknown=x", "unknown"),
+    ]:
+        cfg = rw_mjlab.SemanticLidarSensorCfg(**base, semantic_classes=bad)
+        with pytest.raises(SensorError, match=words) as refused:
+            cfg.build()
+        assert str(refused.value).startswith("SemanticLidarSensorCfg")
+    both = rw_mjlab.SemanticLidarSensorCfg(
+        **base, semantic_classes="a=x", semantic_class_mapping={"a": ["x"]}
+    )
+    with pytest.raises(SensorError, match="both given"):
+        both.build()
+
+
 def test_a_config_that_is_not_an_mjlab_sensor_config_is_named():
     core = SemanticLidarCfg(prim_path="trunk")
     with pytest.raises(SensorError, match="not an mjlab sensor config"):

@@ -32,6 +32,7 @@ __all__ = [
     "ResolvedLidarCfg",
     "SemanticLidarSensorCfg",
     "mjlab_class_mapping",
+    "parse_class_mapping",
     "resolve",
 ]
 
@@ -89,6 +90,10 @@ class SemanticLidarSensorCfg(RayCastSensorCfg):
             paths (``/world/<bodies>/<geom>[/<mesh>]``); class ids 1..K in mapping
             order, 0 = miss/unknown. ``None``: :func:`mjlab_class_mapping` (the default
             mapping with mjlab's terrain geoms as terrain).
+        semantic_classes: the same mapping as one string, for command lines (tyro
+            reads a dict of lists as a single class): ``CLASS=KW,KW;CLASS=KW``, e.g.
+            ``valuable=sofa,table;dynamic_obstacle=box``. Given, it takes the place of
+            ``semantic_class_mapping``, which must then be ``None``.
         self_class: class of the geoms of the robot carrying the sensor when rays can
             hit them (``include_geom_groups`` holding their group); appended after the
             mapping's classes unless the mapping has it. ``None``: such geoms are
@@ -118,6 +123,7 @@ class SemanticLidarSensorCfg(RayCastSensorCfg):
     offset_pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
     offset_rot: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
     semantic_class_mapping: dict[str, list[str]] | None = None
+    semantic_classes: str | None = None
     self_class: str | None = "robot"
     min_distance: float = 0.0
     max_distance: float = 40.0
@@ -206,9 +212,16 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
             f"{name}.self_class: expected None or a non-empty class name other than "
             f"{UNKNOWN_CLASS!r}, got {cfg.self_class!r}"
         )
-    mapping = (
-        mjlab_class_mapping() if cfg.semantic_class_mapping is None else cfg.semantic_class_mapping
-    )
+    if cfg.semantic_classes is not None:
+        if cfg.semantic_class_mapping is not None:
+            raise SensorError(
+                f"{name}: semantic_classes and semantic_class_mapping both given; expected one"
+            )
+        mapping = parse_class_mapping(cfg.semantic_classes, f"{name}.semantic_classes")
+    elif cfg.semantic_class_mapping is None:
+        mapping = mjlab_class_mapping()
+    else:
+        mapping = cfg.semantic_class_mapping
     # The core config validates and normalises the shared fields (ranges, noise,
     # mapping, offsets, alignment, seed) with the same rules; its messages are put in
     # this config's terms (its class and field names).
@@ -271,3 +284,31 @@ def _in_terms_of(message: str, name: str) -> str:
                 rest = f".{theirs}" + rest[len(ours) + 1 :]
         return name + rest
     return f"{name}.pattern: {message}"
+
+
+def parse_class_mapping(text: object, where: str) -> dict[str, list[str]]:
+    """A class mapping written as ``CLASS=KW,KW;CLASS=KW`` (spaces around the parts
+    ignored), in order; its classes and keywords are checked by the config as any
+    mapping is.
+
+    Raises:
+        SensorError: naming ``where``, the part that is wrong and the expected form.
+    """
+    form = "expected CLASS=KEYWORD,KEYWORD;CLASS=KEYWORD (e.g. 'valuable=sofa,table;box=box')"
+    if not isinstance(text, str) or not text.strip():
+        raise SensorError(f"{where}: {form}, got {text!r}")
+    mapping: dict[str, list[str]] = {}
+    for part in text.split(";"):
+        if not part.strip():
+            continue
+        cls, sep, words = part.partition("=")
+        cls = cls.strip()
+        keywords = [w.strip() for w in words.split(",")]
+        if not sep or not cls or not all(keywords):
+            raise SensorError(f"{where}: {part.strip()!r}: {form}")
+        if cls in mapping:
+            raise SensorError(f"{where}: class {cls!r} given twice")
+        mapping[cls] = keywords
+    if not mapping:
+        raise SensorError(f"{where}: {form}, got {text!r}")
+    return mapping
