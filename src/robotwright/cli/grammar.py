@@ -421,7 +421,8 @@ def _value_text(objective: object, value: float) -> str:
     text = f"{name} = {value:.6g} {unit}".rstrip()
     limit = getattr(objective, "limit", None)
     if limit is not None and value >= limit:
-        text += f" (the {limit:g} {unit} bound: the design holds at least this)".replace("  ", " ")
+        bound = f"{limit:g} {unit}".rstrip()
+        text += f" (the {bound} bound: the design holds at least this)"
     return text
 
 

@@ -4,16 +4,12 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from robotwright._atomic import check_output_path
 from robotwright._outputs import check_overwrite
 from robotwright.cli.options import add_overwrite_flag
 from robotwright.errors import SensorError
 from robotwright.sensors._names import PATTERN_NAMES
-
-if TYPE_CHECKING:
-    pass
 
 __all__ = ["register", "run"]
 

@@ -273,10 +273,13 @@ class Payload:
     maximize: bool = True
 
     def __post_init__(self) -> None:
-        check_settings("Payload", samples=self.samples, seed=self.seed, limit=self.limit)
-        share = self.min_free_share
-        if not (isinstance(share, (int, float)) and 0.0 <= share <= 1.0):
-            raise ValueError(f"Payload: min_free_share must be in [0, 1], got {share!r}")
+        check_settings(
+            "Payload",
+            samples=self.samples,
+            seed=self.seed,
+            limit=self.limit,
+            min_free_share=self.min_free_share,
+        )
 
     def __call__(self, ctx: EvalContext) -> float:
         m = ctx.mounted(self.carrier)

@@ -43,8 +43,9 @@ class Carrier:
 
 
 def check_settings(what: str, **values: float) -> None:
-    """Refuse a setting that is not a finite number, or is below its floor: ``samples``
-    (>= 0, whole), ``duration``/``omega``/``limit`` (> 0), ``scale`` (>= 0).
+    """Refuse a setting that is not a finite number, or is out of its range: ``samples``
+    (>= 0, whole), ``duration``/``omega``/``limit`` (> 0), ``min_free_share`` (in
+    [0, 1]), ``scale`` (>= 0).
 
     Raises:
         ValueError: naming ``what``, the setting and the expectation.
@@ -54,12 +55,16 @@ def check_settings(what: str, **values: float) -> None:
         ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
         if ok and whole:
             ok = float(v).is_integer() and v >= 0
+        elif ok and name == "min_free_share":
+            ok = 0 <= v <= 1
         elif ok:
             ok = v > 0 if name in ("duration", "omega", "limit") else v >= 0
         if not ok:
             floor = (
                 "a whole number >= 0"
                 if whole
+                else "in [0, 1]"
+                if name == "min_free_share"
                 else (
                     "a finite number > 0"
                     if name in ("duration", "omega", "limit")
@@ -246,9 +251,9 @@ def payload(
     (``bounded``): a limb whose joints bear no load (no joint, or horizontal slides)
     holds anything its carrier carries.
     """
-    check_settings("payload", samples=samples, seed=seed, limit=limit)
-    if not (isinstance(min_free_share, (int, float)) and 0.0 <= min_free_share <= 1.0):
-        raise ValueError(f"payload: min_free_share must be in [0, 1], got {min_free_share!r}")
+    check_settings(
+        "payload", samples=samples, seed=seed, limit=limit, min_free_share=min_free_share
+    )
     m = mounted or mount(limb, carrier)
     poses = sample_poses(m, samples, seed)
     data = mujoco.MjData(m.model)

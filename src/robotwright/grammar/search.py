@@ -406,12 +406,11 @@ def mcts_search(
         resume=resume,
         header=dict(method="mcts", seed=seed, budget=budget, max_links=max_links, batch=batch),
     ) as ev:
-        k = batch
         stalls = 0
         while ev.left > 0 and stalls < 50 and (root.untried or root.children):
             paths: list[list[_Node]] = []
             designs: list[Design] = []
-            for _ in range(min(k, ev.left)):
+            for _ in range(min(batch, ev.left)):
                 node, path = root, [root]
                 while not node.untried and node.children:
                     ln = math.log(node.visits + 1)

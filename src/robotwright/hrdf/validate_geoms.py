@@ -105,16 +105,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
                 )
             )
             continue
-        used = _SIZE_USED.get(g.type, 3)
-        if any(not v > 0 for v in g.size[:used]):
-            out.append(
-                Problem(
-                    "simple_geom.csv",
-                    f"{g.type} size {g.size}: expected the first {used} value(s) > 0",
-                    row=i,
-                    column="size0",
-                )
-            )
+        out += _size_problems("simple_geom.csv", g.type, g.size, i)
     for name in sorted(_duplicates(g.name for g in hrdf.simple_geoms)):
         out.append(Problem("simple_geom.csv", f"duplicate geom name '{name}'", column="name"))
     unit = (1.0, 1.0, 1.0)
@@ -187,6 +178,15 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
     return out
 
 
+def _size_problems(table: str, kind: str, size: tuple[float, ...], row: int) -> list[Problem]:
+    """A geom's or site's ``size``: the values its type uses must be > 0."""
+    used = _SIZE_USED.get(kind, 3)
+    if all(v > 0 for v in size[:used]):
+        return []
+    message = f"{kind} size {size}: expected the first {used} value(s) > 0"
+    return [Problem(table, message, row=row, column="size0")]
+
+
 def _missing(path: str | Path, row: int, column: str) -> Problem:
     why = "is not a regular file" if os.path.exists(path) else "does not exist"
     return Problem("mesh.csv", f"mesh file '{path}' {why}", row=row, column=column)
@@ -229,16 +229,8 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
         msg = _quat_problem(s.quat)
         if msg:
             out.append(Problem("site.csv", msg, row=i, column="quat"))
-        used = _SIZE_USED.get(s.type, 3)
-        if s.type in SITE_TYPES and any(not v > 0 for v in s.size[:used]):
-            out.append(
-                Problem(
-                    "site.csv",
-                    f"{s.type} size {s.size}: expected the first {used} value(s) > 0",
-                    row=i,
-                    column="size0",
-                )
-            )
+        if s.type in SITE_TYPES:
+            out += _size_problems("site.csv", s.type, s.size, i)
     for name in sorted(_duplicates(s.name for s in hrdf.sensors)):
         out.append(Problem("sensor.csv", f"duplicate sensor name '{name}'", column="name"))
     targets = {

@@ -93,9 +93,7 @@ class GLSession:
                 continue
             self._ctx, self.platform = ctx, platform
             return
-        if not reasons:
-            reasons.append("MUJOCO_GL disables OpenGL" if os.environ.get("MUJOCO_GL") else "none")
-        raise GLUnavailable("; ".join(r.splitlines()[0] for r in reasons))
+        raise _unavailable(reasons)
 
     def draw(self, scene: mujoco.MjvScene) -> GLImage:
         """Draw ``scene`` (filled by ``mjv_updateScene`` for the session's model)."""
@@ -132,10 +130,16 @@ def render_gl(model: mujoco.MjModel, scene: mujoco.MjvScene, width: int, height:
             with GLSession(model, width, height, [platform]) as session:
                 return session.draw(scene)
         except Exception as exc:  # noqa: BLE001 - any failure means "not this platform"
-            reasons.append(str(exc) if isinstance(exc, GLUnavailable) else f"{platform}: {exc}")
+            failed = isinstance(exc, GLUnavailable)  # its reason names the platform
+            reasons.append(str(exc) if failed else f"{platform}: {type(exc).__name__}: {exc}")
+    raise _unavailable(reasons)
+
+
+def _unavailable(reasons: list[str]) -> GLUnavailable:
+    """The error saying why no platform drew: each one's reason, first line only."""
     if not reasons:
-        reasons.append("MUJOCO_GL disables OpenGL" if os.environ.get("MUJOCO_GL") else "none")
-    raise GLUnavailable("; ".join(r.splitlines()[0] for r in reasons))
+        reasons = ["MUJOCO_GL disables OpenGL" if os.environ.get("MUJOCO_GL") else "none"]
+    return GLUnavailable("; ".join(r.splitlines()[0] for r in reasons))
 
 
 def _render_context(model: mujoco.MjModel, width: int, height: int) -> mujoco.MjrContext:

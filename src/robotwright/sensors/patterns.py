@@ -117,7 +117,7 @@ class PatternCfg:
 
     def ray_table(self) -> RayTable:
         """The rays of every distinct frame, computed once (see :class:`RayTable`)."""
-        self.validate()
+        self.validate()  # a pattern's own rays() (the grid's) may not
         origins, dirs = self.rays(0)
         return RayTable(
             np.ascontiguousarray(origins, dtype=np.float64),
