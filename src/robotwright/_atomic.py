@@ -31,6 +31,7 @@ from __future__ import annotations
 import errno
 import os
 import re
+import secrets
 import shutil
 import stat
 import tempfile
@@ -254,17 +255,25 @@ def _remove_empty(folders: list[Path]) -> None:
 
 
 def _mkstemp(path: Path) -> str:
+    """Create an empty temporary file for ``path`` in its folder and return its name.
+
+    It is created with mode 0666 less the umask, as any file the user writes (the
+    kernel applies the umask), under a random name that :data:`_TEMP_NAME` matches."""
     remove_stale_temporaries(path.parent, path.name)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=_prefix(path.name), suffix=".tmp", dir=path.parent)
-        os.close(fd)
-        # mkstemp makes the file private (0600); the output is an ordinary file of the user.
-        os.chmod(tmp, 0o666 & ~_umask())
-    except OSError as exc:
-        raise OutputPathError(
-            f"{path}: cannot write in folder {path.parent}: {exc.strerror or exc}"
-        ) from exc
-    return tmp
+    prefix = os.path.join(path.parent, _prefix(path.name))
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    for _ in range(100):
+        tmp = f"{prefix}{secrets.token_hex(4)}.tmp"
+        try:
+            os.close(os.open(tmp, flags, 0o666))
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            raise OutputPathError(
+                f"{path}: cannot write in folder {path.parent}: {exc.strerror or exc}"
+            ) from exc
+        return tmp
+    raise OutputPathError(f"{path}: no free temporary file name in folder {path.parent}")
 
 
 @contextmanager

@@ -115,6 +115,52 @@ def _folder_text(path: Path, limit: int, problems: list[Problem]) -> str | None:
     return _folder_read(path, lambda p: read_text(p, limit), problems)
 
 
+_Layout = tuple[dict[str, int], list[tuple[Column, list[int]]], dict[str, Any], list[str]]
+#: Header layouts already worked out, by (schema identity, header): a robot's tables
+#: keep their headers from load to load. The schema is kept in the value so that its
+#: identity cannot be reused by another list.
+_LAYOUTS: dict[tuple[int, tuple[str, ...]], tuple[list[Column], _Layout]] = {}
+
+
+def _header_layout(
+    schema: list[Column], header: list[str], fname: str, problems: list[Problem]
+) -> _Layout | None:
+    """(column index by header, conversion plan, defaults of absent fields, unknown
+    headers) of a table, or ``None`` after reporting missing or incomplete columns."""
+    key = (id(schema), tuple(header))
+    cached = _LAYOUTS.get(key)
+    if cached is not None and cached[0] is schema:
+        return cached[1]
+    index = {h: i for i, h in enumerate(header)}
+    known: set[str] = set()
+    missing = False
+    for col in schema:
+        known.update(col.headers)
+        present = [h in index for h in col.headers]
+        if col.required and not all(present):
+            for h in col.headers:
+                if h not in index:
+                    problems.append(Problem(fname, "required column is missing", column=h))
+            missing = True
+        elif any(present) and not all(present):
+            gone = [h for h in col.headers if h not in index]
+            problems.append(
+                Problem(fname, f"vector columns incomplete: missing {gone}", column=col.csv)
+            )
+            missing = True
+    extra = [h for h in header if h not in known]
+    if missing:
+        for h in extra:
+            problems.append(Problem(fname, "unknown column, ignored", column=h, severity="warning"))
+        return None
+    plan = [(col, [index[h] for h in col.headers]) for col in schema if col.headers[0] in index]
+    absent = {col.field: col.default for col in schema if col.headers[0] not in index}
+    layout = (index, plan, absent, extra)
+    if len(_LAYOUTS) < 256:  # a bound for a process that reads many odd headers
+        _LAYOUTS[key] = (schema, layout)
+    return layout
+
+
 def _read_table(
     path: Path, schema: list[Column], problems: list[Problem], *, hurodes_format: bool
 ) -> _Table | None:
@@ -137,38 +183,20 @@ def _read_table(
             return None
         header, body_rows = parsed[0], parsed[1:]
     header = [h.strip() for h in header]
-    index = {h: i for i, h in enumerate(header)}
-    known: set[str] = set()
-    missing = False
-    for col in schema:
-        known.update(col.headers)
-        present = [h in index for h in col.headers]
-        if col.required and not all(present):
-            for h in col.headers:
-                if h not in index:
-                    problems.append(Problem(fname, "required column is missing", column=h))
-            missing = True
-        elif any(present) and not all(present):
-            absent = [h for h in col.headers if h not in index]
-            problems.append(
-                Problem(fname, f"vector columns incomplete: missing {absent}", column=col.csv)
-            )
-            missing = True
-    extra = [h for h in header if h not in known]
+    layout = _header_layout(schema, header, fname, problems)
+    if layout is None:
+        return None
+    index, plan, absent, extra = layout
     for h in extra:
         problems.append(Problem(fname, "unknown column, ignored", column=h, severity="warning"))
-    if missing:
-        return None
 
     def empty_ok_here(col: Column) -> bool:
         return col.empty_ok and not (hurodes_format and col.csv == "range")
 
-    plan = [(col, [index[h] for h in col.headers]) for col in schema if col.headers[0] in index]
-    absent = {col.field: col.default for col in schema if col.headers[0] not in index}
     if columns is not None:
         fast = _convert_table_fast(columns, plan, absent, empty_ok_here)
         if fast is not None:
-            return _Table(fields=fast[0], rows=fast[1], extra_columns=extra)
+            return _Table(fields=fast[0], rows=fast[1], extra_columns=list(extra))
     # Empty lines are skipped (an empty line is [] for csv, [""] for str.split).
     data = [cells for cells in body_rows if cells and (len(cells) > 1 or cells[0].strip())]
     if columns is None and data and all(len(cells) == len(header) for cells in data):
@@ -176,7 +204,7 @@ def _read_table(
             [list(col) for col in zip(*data, strict=True)], plan, absent, empty_ok_here
         )
         if fast is not None:
-            return _Table(fields=fast[0], rows=fast[1], extra_columns=extra)
+            return _Table(fields=fast[0], rows=fast[1], extra_columns=list(extra))
     fields = [col.field for col in schema]
     rows: list[tuple[Any, ...] | None] = []
     for row_no, cells in enumerate(data):
@@ -231,7 +259,7 @@ def _read_table(
             else:
                 record[col.field] = values[0] if col.size == 0 else tuple(values)
         rows.append(tuple([record[f] for f in fields]) if ok else None)
-    return _Table(fields=fields, rows=rows, extra_columns=extra)
+    return _Table(fields=fields, rows=rows, extra_columns=list(extra))
 
 
 def _floats_or_none(cells: list[str]) -> list[float | None]:
