@@ -133,6 +133,15 @@ def prepare_robot(robot: Path, assets: Path, peak_velocity: float) -> tuple[Path
     return dst, filled
 
 
+def _block_runs(timed: list[tuple[float, float]], seconds: float) -> int:
+    """Runs in the next block so that it lasts about ``seconds`` of wall time, judged by
+    the median run so far (one run, to measure, when there is none yet)."""
+    if not timed:
+        return 1
+    per_run = statistics.median(wall for wall, _ in timed)
+    return max(1, min(10_000, round(seconds / max(per_run, 1e-9))))
+
+
 class HurodesWorker:
     """hurodes in its own interpreter, timing one task per request (same process
     throughout, so imports and caches are warm as on our side)."""
@@ -183,7 +192,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--robot", type=Path, default=DEFAULT_ROBOT, help="HRDF folder")
     parser.add_argument("--hurodes-python", default=None, help="python of a hurodes venv")
     parser.add_argument("--repeat", type=int, default=30, help="runs of each task per tool")
-    parser.add_argument("--block", type=int, default=10, help="runs per alternation block")
+    parser.add_argument(
+        "--block-seconds",
+        type=float,
+        default=0.25,
+        help="wall time [s] of each tool's block of runs of one task, the tools alternating",
+    )
     parser.add_argument(
         "--peak-velocity",
         type=float,
@@ -216,32 +230,41 @@ def main(argv: list[str] | None = None) -> int:
                 else None
             )
             try:
-                # Alternate the two tools in blocks of --block runs of one task: both see
-                # the same machine load, and each block runs with warm caches (timing one
-                # run of each in turn would start every short run with caches emptied by
-                # the other process and penalise the faster tool).
-                done = 0
-                while done < args.repeat:
-                    n = min(args.block, args.repeat - done)
+                # Alternate the two tools in blocks of equal wall time (--block-seconds)
+                # per task, until each tool has --repeat runs: both see the same machine
+                # load over the same span of time, and each block runs warm. Blocks of
+                # equal run counts would not: the first few runs after the other process
+                # ran are up to 1.6x slower (its work evicted our caches), which for the
+                # tool whose runs are shorter spreads over most of its block.
+                pending = True
+                while pending:
+                    pending = False
                     for task, fn in tasks.items():
-                        for _ in range(n):
+                        mine = ours.setdefault(task, [])
+                        for _ in range(_block_runs(mine, args.block_seconds)):
                             c = time.process_time()
                             t = time.perf_counter()
                             fn()
                             dt = time.perf_counter() - t
-                            ours.setdefault(task, []).append((dt, time.process_time() - c))
-                        if worker is not None and theirs is not None and task not in failed:
-                            timed = worker.time(task, n)
-                            if isinstance(timed, str):
-                                failed[task] = timed
-                            else:
-                                theirs.setdefault(task, []).extend(timed)
-                    done += n
+                            mine.append((dt, time.process_time() - c))
+                        pending |= len(mine) < args.repeat
+                        if worker is None or theirs is None or task in failed:
+                            continue
+                        done = theirs.setdefault(task, [])
+                        timed = worker.time(task, _block_runs(done, args.block_seconds))
+                        if isinstance(timed, str):
+                            failed[task] = timed
+                            continue
+                        done.extend(timed)
+                        pending |= len(done) < args.repeat
             finally:
                 if worker is not None:
                     worker.close()
     print(f"robot: {robot}  repeats: {args.repeat}  python: {sys.version.split()[0]}")
-    print(f"output folder: {tmp} (medians of wall time per task)")
+    print(
+        f"output folder: {tmp} (medians of wall time per task; blocks of "
+        f"{args.block_seconds} s per tool, alternating)"
+    )
     if filled:
         print(
             f"note: {filled} empty peak_velocity cell(s) set to {args.peak_velocity} rad/s "

@@ -286,3 +286,59 @@ def test_tree_check_finds_the_same_cycles_as_the_plain_walk() -> None:
             for c in _tree_problems_reference(parents)
         ]
         assert got == want, parents
+
+
+# ------------------------------------------------------------------ remembered work
+
+
+def _table(tmp_path: Path, header: str, rows: list[str]) -> Path:
+    path = tmp_path / "joint.csv"
+    path.write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")
+    return path
+
+
+def test_remembered_cell_numbers_are_exact_and_bad_cells_still_refused() -> None:
+    """Cell numbers are remembered by text: a number read again is the same float, and a
+    cell that is not a number is refused on every read (never remembered)."""
+    rng = random.Random(3)
+    texts = [repr(rng.uniform(-1e3, 1e3)) for _ in range(200)] + ["1e-320", "-0.0", "7"]
+    remembered = hio._float_of_cell.__self__
+    for t in texts:
+        first = hio._float_of_cell(t)
+        again = hio._float_of_cell(t)
+        assert first == float(t) and math.copysign(1, first) == math.copysign(1, float(t))
+        assert again is first  # the remembered value
+    for _ in range(2):
+        with pytest.raises(ValueError):
+            hio._float_of_cell("1.0.0")
+        assert "1.0.0" not in remembered
+    # bounded: a full memory starts again rather than growing
+    small = hio._FloatOfCell()
+    small.update({str(i): float(i) for i in range(1 << 16)})
+    assert small["0.5"] == 0.5 and len(small) == 1
+
+
+def test_a_remembered_header_layout_reports_unknown_columns_on_every_read(
+    tmp_path: Path,
+) -> None:
+    """The header layout is worked out once per header; the warnings about unknown
+    columns and the errors about missing ones still come on every read."""
+    required = [h for c in TABLES["joint"] if c.required for h in c.headers]
+    header = ",".join([*required, "extra_col"])
+    row = ",".join("b1" if h == "body_name" else "j1" if h == "name" else "0.5" for h in required)
+    good = _table(tmp_path, header, [f"{row},5"])
+    for _ in range(2):
+        problems: list = []
+        table = hio._read_table(good, TABLES["joint"], problems, hurodes_format=False)
+        assert table is not None and table.extra_columns == ["extra_col"]
+        assert [(p.column, p.severity) for p in problems] == [("extra_col", "warning")]
+        table.extra_columns.append("changed")  # the caller's list, not the remembered one
+    for _ in range(2):
+        problems = []
+        without_name = [h for h in required if h != "name"]
+        bad = _table(
+            tmp_path, ",".join([*without_name, "extra_col"]), [",".join(["0.5"] * len(required))]
+        )
+        assert hio._read_table(bad, TABLES["joint"], problems, hurodes_format=False) is None
+        assert ("name", "error") in [(p.column, p.severity) for p in problems]
+        assert ("extra_col", "warning") in [(p.column, p.severity) for p in problems]

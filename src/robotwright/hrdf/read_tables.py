@@ -262,8 +262,24 @@ def _read_table(
     return _Table(fields=fields, rows=rows, extra_columns=list(extra))
 
 
+class _FloatOfCell(dict[str, float]):
+    """``float(text)`` of table cells, remembered (bounded): a robot's tables repeat most
+    numbers (the G1's five tables hold 2,352 numeric cells, 592 distinct), and parsing a
+    17-digit number costs several dictionary lookups. Exact: the same text is the same
+    float. A text ``float`` refuses raises ``ValueError`` and is not stored."""
+
+    def __missing__(self, text: str) -> float:
+        if len(self) >= 1 << 16:
+            self.clear()
+        value = self[text] = float(text)
+        return value
+
+
+_float_of_cell = _FloatOfCell().__getitem__
+
+
 def _floats_or_none(cells: list[str]) -> list[float | None]:
-    return [None if t == "" else float(t) for t in cells]
+    return [None if t == "" else _float_of_cell(t) for t in cells]
 
 
 def _convert_table_fast(
@@ -296,7 +312,7 @@ def _convert_table_fast(
                         if not all(isfinite(v) for v in part if v is not None):
                             return None
                     else:
-                        part = list(map(float, cells))
+                        part = list(map(_float_of_cell, cells))
                         # inf/nan propagate through a sum: one C-level check per column
                         # (a finite sum that overflows only sends us to the slow path).
                         if not isfinite(sum(part)):
