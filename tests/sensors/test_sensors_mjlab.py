@@ -73,14 +73,36 @@ class _Env:
         self.num_envs = len(host)
 
     def sense(self) -> None:
+        """One sensed step; a timed pattern's sensor is told that one frame's time
+        passed since the last (mjlab's env tells it every physics step)."""
         import mujoco_warp as mjw
 
+        for s in self.ctx.raycast_sensors:
+            if s._rate > 0.0:
+                s.update(s.table.rays_per_frame / s._rate)
         self.ctx.prepare()
         with wp.ScopedDevice("cpu"):
             mjw.refit_bvh(self.mw, self.dw, self.ctx.render_context)
             for s in self.ctx.raycast_sensors:
                 s.raycast_kernel(rc=self.ctx.render_context)
         self.ctx.finalize()
+
+
+class _FixedWindow(LivoxPatternCfg):
+    """A Mid-360 that casts one window of its firing stream, starting at ray ``first``
+    (the window an mjlab sensor casts after some simulated time)."""
+
+    def __init__(self, first: int) -> None:
+        super().__init__(sensor_type="mid360")
+        self.first = first
+
+    def ray_table(self):  # noqa: ANN201
+        from robotwright.sensors.patterns import RayTable
+
+        rows = self.table_frames * self.num_rays
+        idx = (self.first + np.arange(self.num_rays)) % rows
+        dirs = self._fire(0, rows)[idx]
+        return RayTable(np.zeros_like(dirs), dirs, self.num_rays)
 
 
 def _check_labels(sensor, data) -> None:
@@ -509,7 +531,9 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
     table = sensor.table
     generator = torch.Generator().manual_seed(1)
     seen: set[int] = set()
-    frames, dirs_prev = [], None
+    frames, starts, dirs_prev = [], [], None
+    rows = table.directions.shape[0]
+    fired_per_step = LivoxPatternCfg(sensor_type="mid360").firing_rate() * env.step_dt
     for _ in range(12):
         action = torch.rand(env.num_envs, env.action_manager.total_action_dim, generator=generator)
         obs, *_ = env.step(action * 2.0 - 1.0)
@@ -521,9 +545,17 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
             assert t.device == device
         assert data.distances.shape == (3, table.rays_per_frame) == data.geom_ids.shape
         assert data.hit_pos_w.shape == (3, table.rays_per_frame, 3)
-        # The Mid-360 window advances one frame per step: the directions change and, in
-        # the sensor frame, are the table rows of this frame.
+        # The Mid-360 fires in simulated time: its window moves by the rays fired in a
+        # step (200 000/s x step_dt), the same for every env (same phase); the
+        # directions change and, in the sensor frame, are the window's table rows.
         frames.append(int(data.frame[0]))
+        start = data.window_start.numpy().copy()
+        assert (start == start[0]).all()
+        if starts:
+            moved = (int(start[0]) - starts[-1]) % rows
+            assert abs(moved - fired_per_step) <= 1, (moved, fired_per_step)
+        starts.append(int(start[0]))
+        window = table.directions[(starts[-1] + np.arange(table.rays_per_frame)) % rows]
         dirs = data.ray_directions_w.numpy().copy()
         if dirs_prev is not None:
             assert not np.allclose(dirs, dirs_prev)
@@ -533,7 +565,7 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
             rot = np.empty(9)
             mujoco.mju_quat2Mat(rot, q[e] / np.linalg.norm(q[e]))
             local = dirs[e] @ rot.reshape(3, 3)
-            np.testing.assert_allclose(local, table.window(frames[-1])[1], atol=2e-5)
+            np.testing.assert_allclose(local, window, atol=2e-5)
         _check_labels(sensor, data)
         hit = data.hit_mask.numpy()
         seen |= set(np.unique(data.semantic_labels.numpy()[hit]).tolist())
@@ -557,12 +589,12 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
     stacked = rw_mjlab.lidar_semantic_obs(env, "lidar")
     assert obs["actor"].shape[1] > 2 * n and torch.equal(obs["actor"][:, -2 * n :], stacked)
     # The core sensor (MuJoCo engine, float64) on host MjData made from the sim state,
-    # at the same pattern frame, with the same hittable geoms.
+    # casting the same window of the same pattern, with the same hittable geoms.
     model = env.sim.mj_model
     ref = SemanticLidarSensor(
         SemanticLidarCfg(
             prim_path="robot/trunk",
-            pattern_cfg=LivoxPatternCfg(sensor_type="mid360"),
+            pattern_cfg=_FixedWindow(first=starts[-1]),
             offset_pos=sensor.cfg.offset_pos,
             max_distance=example.MAX_DISTANCE,
             semantic_class_mapping=sensor.semantic_class_mapping,
@@ -574,9 +606,7 @@ def test_go1_example_env_labels_every_class_and_matches_the_core_sensor(example)
     assert (ref.hittable_geom_mask == sensor.hittable_geom_mask).all()
     robot = np.flatnonzero(model.body_rootid == model.body("robot/trunk").id)
     assert not sensor.hittable_geom_mask[np.isin(model.geom_bodyid, robot)].any()
-    for _ in range(frames[-1] + 1):
-        ref.update()
-    assert ref.data.frame == frames[-1]
+    ref.update()
     np.testing.assert_allclose(data.sensor_pos_w.numpy(), ref.data.pos_w, atol=1e-4)
     _compare_with_core(data, ref)
     env.close()

@@ -37,6 +37,37 @@ def advance_frame(
     window[0] = (f % num_frames) * rays_per_frame
 
 
+@wp.func
+def _pose(
+    carrier_pos: wp.vec3,
+    r: wp.mat33,
+    offset_pos: wp.vec3,
+    offset_mat: wp.mat33,
+    alignment: wp.int32,
+    e: wp.int32,
+    pos_w: wp.array(dtype=wp.vec3),
+    quat_w: wp.array(dtype=wp.vec4),
+    sensor_mat: wp.array(dtype=wp.mat33),
+    ray_rot: wp.array(dtype=wp.mat33),
+):
+    """Write environment ``e``'s sensor pose: carrier pose ``(carrier_pos, r)`` and the
+    sensor's offset in the carrier frame."""
+    m = r @ offset_mat
+    pos_w[e] = carrier_pos + r @ offset_pos
+    sensor_mat[e] = m
+    q = wp.quat_from_matrix(m)  # warp order: x, y, z, w
+    quat_w[e] = wp.vec4(q[3], q[0], q[1], q[2])
+    if alignment == ALIGN_BASE:
+        ray_rot[e] = m
+    elif alignment == ALIGN_YAW:
+        yaw = wp.atan2(m[1, 0], m[0, 0])
+        c = wp.cos(yaw)
+        s = wp.sin(yaw)
+        ray_rot[e] = wp.mat33(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+    else:
+        ray_rot[e] = wp.identity(n=3, dtype=wp.float32)
+
+
 @wp.kernel
 def sensor_pose(
     carrier_pos: wp.array2d(dtype=wp.vec3),
@@ -52,21 +83,47 @@ def sensor_pose(
 ):
     """Sensor pose of each environment from its carrier body/site pose ``[e, carrier]``."""
     e = wp.tid()
-    r = carrier_mat[e, carrier]
-    m = r @ offset_mat
-    pos_w[e] = carrier_pos[e, carrier] + r @ offset_pos
-    sensor_mat[e] = m
-    q = wp.quat_from_matrix(m)  # warp order: x, y, z, w
-    quat_w[e] = wp.vec4(q[3], q[0], q[1], q[2])
-    if alignment == ALIGN_BASE:
-        ray_rot[e] = m
-    elif alignment == ALIGN_YAW:
-        yaw = wp.atan2(m[1, 0], m[0, 0])
-        c = wp.cos(yaw)
-        s = wp.sin(yaw)
-        ray_rot[e] = wp.mat33(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
-    else:
-        ray_rot[e] = wp.identity(n=3, dtype=wp.float32)
+    _pose(
+        carrier_pos[e, carrier],
+        carrier_mat[e, carrier],
+        offset_pos,
+        offset_mat,
+        alignment,
+        e,
+        pos_w,
+        quat_w,
+        sensor_mat,
+        ray_rot,
+    )
+
+
+@wp.kernel
+def sensor_pose_per_env(
+    carrier_pos: wp.array2d(dtype=wp.vec3),
+    carrier_mat: wp.array2d(dtype=wp.mat33),
+    carrier: wp.int32,
+    offset_pos: wp.array(dtype=wp.vec3),
+    offset_mat: wp.array(dtype=wp.mat33),
+    alignment: wp.int32,
+    pos_w: wp.array(dtype=wp.vec3),
+    quat_w: wp.array(dtype=wp.vec4),
+    sensor_mat: wp.array(dtype=wp.mat33),
+    ray_rot: wp.array(dtype=wp.mat33),
+):
+    """As :func:`sensor_pose`, each environment with its own mount offset ``[e]``."""
+    e = wp.tid()
+    _pose(
+        carrier_pos[e, carrier],
+        carrier_mat[e, carrier],
+        offset_pos[e],
+        offset_mat[e],
+        alignment,
+        e,
+        pos_w,
+        quat_w,
+        sensor_mat,
+        ray_rot,
+    )
 
 
 @wp.kernel

@@ -16,6 +16,7 @@ import torch
 from robotwright.errors import SensorError
 
 __all__ = [
+    "ScanHistory",
     "check_image_size",
     "check_point_cloud_args",
     "direction_bounds",
@@ -142,6 +143,7 @@ def range_image(
     *,
     cells: torch.Tensor | None = None,
     scanned: bool = False,
+    valid: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """``(E, 1 + C, height, width)`` nearest distance and class occupancy per direction
     cell (``(E, 2 + C, height, width)`` with ``scanned``).
@@ -156,7 +158,8 @@ def range_image(
     one whose rays all missed (as a real range image with no return does); with it, a
     last channel says which cells this step's rays scanned (1) and which none did (0),
     so an obstacle in a pattern's blind part of this step is not free space.
-    ``distances`` may hold anything where ``hit`` is False.
+    ``distances`` may hold anything where ``hit`` is False. ``valid`` ``(E, N)`` (bool)
+    leaves out the rays where it is False altogether (not scanned, no distance, no class).
     """
     e = hit.shape[0]
     if cells is None:
@@ -166,11 +169,13 @@ def range_image(
     cell = cells.expand(hit.shape)
     n_cells = height * width
     dev = hit.device
+    if valid is not None:
+        hit = hit & valid
     scaled = torch.where(hit, distances / float(max_distance), 1.0).clamp(0.0, 1.0)
     depth = torch.ones(e, n_cells, device=dev)
     depth.scatter_reduce_(1, cell, scaled, reduce="amin", include_self=True)
     rays = torch.zeros(e, n_cells, device=dev)
-    rays.scatter_add_(1, cell, torch.ones_like(scaled))
+    rays.scatter_add_(1, cell, torch.ones_like(scaled) if valid is None else valid.float())
     per_class = torch.zeros(e, classes * n_cells, device=dev)
     slot = labels.long().clamp(0, classes - 1) * n_cells + cell
     per_class.scatter_add_(1, slot, hit.float())
@@ -179,3 +184,50 @@ def range_image(
     if scanned:
         parts.append((rays > 0).float()[:, None])
     return torch.cat(parts, dim=1).view(e, 1 + classes + int(scanned), height, width)
+
+
+class ScanHistory:
+    """The last ``k`` scans of every environment, for observations that accumulate
+    frames (a rotating or rosette pattern fills a range image over several steps).
+
+    Stores per scan the rays' hit mask, distance [m], class and image cell; a slot never
+    filled since the environment's last reset is not valid (left out of the image).
+    """
+
+    def __init__(self, k: int, envs: int, rays: int, device: torch.device | str) -> None:
+        if not isinstance(k, int) or isinstance(k, bool) or not 1 <= k <= 64:
+            raise SensorError(
+                f"lidar_range_image: accumulate must be an integer in [1, 64], got {k!r}"
+            )
+        self.k = k
+        self.hit = torch.zeros(envs, k, rays, dtype=torch.bool, device=device)
+        self.distances = torch.zeros(envs, k, rays, device=device)
+        self.labels = torch.zeros(envs, k, rays, dtype=torch.int32, device=device)
+        self.cells = torch.zeros(envs, k, rays, dtype=torch.long, device=device)
+        self.filled = torch.zeros(envs, k, dtype=torch.bool, device=device)
+        self.scans = 0
+        self.last_key: object = None
+
+    def push(
+        self, hit: torch.Tensor, distances: torch.Tensor, labels: torch.Tensor, cells: torch.Tensor
+    ) -> None:
+        """Store this step's scan ``(E, N)`` in place of the oldest."""
+        slot = self.scans % self.k
+        self.hit[:, slot] = hit
+        self.distances[:, slot] = distances
+        self.labels[:, slot] = labels
+        self.cells[:, slot] = cells.expand(hit.shape)
+        self.filled[:, slot] = True
+        self.scans += 1
+
+    def clear_envs(self, env_ids: torch.Tensor) -> None:
+        """Forget the scans of ``env_ids`` (a reset): their slots become not valid."""
+        self.filled[env_ids] = False
+
+    def flat(self) -> tuple[torch.Tensor, ...]:
+        """(hit, distances, labels, cells, valid), each ``(E, k * N)``."""
+        e = self.hit.shape[0]
+        valid = self.filled[:, :, None].expand(self.hit.shape)
+        return tuple(
+            t.reshape(e, -1) for t in (self.hit, self.distances, self.labels, self.cells, valid)
+        )

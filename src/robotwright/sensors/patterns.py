@@ -109,6 +109,11 @@ class PatternCfg:
         """Number of rays per frame."""
         return int(self._directions(0).shape[0])
 
+    def firing_rate(self) -> float | None:
+        """Rays fired per second when the table is a stream in time (a sensor then moves
+        its window with simulated time); ``None``: one frame per scan."""
+        return None
+
     def rays(self, frame: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Ray origins ``(N, 3)`` [m] and unit directions ``(N, 3)`` in the sensor frame."""
         self.validate()
@@ -281,6 +286,10 @@ class LivoxPatternCfg(PatternCfg):
             raise SensorError(
                 f"{name}.prism_rpm: expected two different finite rates, got {self.prism_rpm}"
             )
+
+    def firing_rate(self) -> float | None:
+        """The published (or given) points per second: the table is the firing stream."""
+        return float(self.effective("points_per_second"))
 
     def _directions(self, frame: int) -> np.ndarray:
         first = (int(frame) % self.table_frames) * int(self.num_rays)

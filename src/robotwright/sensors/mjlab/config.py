@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from mjlab.sensor.builtin_sensor import ObjRef
 from mjlab.sensor.raycast_sensor import RayCastSensorCfg
@@ -116,6 +116,30 @@ class SemanticLidarSensorCfg(RayCastSensorCfg):
             default: terrain and props, not the robot's visual and collision groups).
         debug_vis: draw hit points coloured by class in mjlab's viewer.
         debug_vis_max_points: most hit points drawn per environment (evenly spaced).
+
+    Scan timing (simulated time, as the real sensor):
+        update_period: seconds between published scans (Isaac Lab's idiom; ``0``: every
+            step). Between them the data hold the last scan.
+        scan_phase: where each environment's scan starts at a reset: ``"zero"`` (the
+            pattern's start) or ``"random"`` (anywhere in the pattern, seeded per env).
+            A timed pattern (a Livox rosette, ``points_per_second``) fires in simulated
+            time: each scan returns the latest ``N`` rays fired, its window moving by
+            ``points_per_second x`` the time since the last step; an untimed pattern
+            moves one frame per published scan. A reset of some environments touches
+            only theirs.
+
+    Realism, each off by default and seeded per environment (``seed``):
+        range_noise_per_meter: extra Gaussian range noise whose standard deviation
+            grows with the distance (``x d``), on top of ``range_noise_std``.
+        angular_jitter_std: Gaussian tilt of every ray's direction, per axis [rad].
+        class_dropout: class name -> probability that a hit on that class is dropped
+            (on top of ``dropout_prob``), e.g. ``{"valuable": 0.3}``.
+        mount_pos_range: half-ranges (x, y, z) [m] of a uniform offset added to
+            ``offset_pos`` per environment at each reset.
+        mount_rot_range: half-ranges (roll, pitch, yaw) [rad] of a uniform rotation
+            applied after ``offset_rot`` per environment at each reset.
+        drift_range: (low, high) [m] of a uniform drift of the ray origins along x, y
+            and z, drawn per environment at each reset (Isaac Lab's ``drift_range``).
     """
 
     frame: ObjRef
@@ -135,6 +159,14 @@ class SemanticLidarSensorCfg(RayCastSensorCfg):
     num_threads: int | None = None
     include_geom_groups: tuple[int, ...] | None = (0,)
     debug_vis_max_points: int = 2000
+    update_period: float = 0.0
+    scan_phase: Literal["zero", "random"] = "zero"
+    range_noise_per_meter: float = 0.0
+    angular_jitter_std: float = 0.0
+    class_dropout: dict[str, float] | None = None
+    mount_pos_range: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mount_rot_range: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    drift_range: tuple[float, float] = (0.0, 0.0)
 
     def build(self) -> MjlabSemanticLidarSensor:
         from robotwright.sensors.mjlab.sensor import MjlabSemanticLidarSensor
@@ -154,6 +186,8 @@ class ResolvedLidarCfg:
         miss_distance: the miss value of ``get_distances()`` [m].
         offset_pos: sensor position on the frame object [m].
         offset_rot: unit quaternion (w, x, y, z).
+        class_dropout: dropout probability per class id (``len(class_names)`` values).
+        (the other fields as the config's, checked)
     """
 
     mapping: dict[str, list[str]]
@@ -162,6 +196,19 @@ class ResolvedLidarCfg:
     miss_distance: float
     offset_pos: tuple[float, float, float]
     offset_rot: tuple[float, float, float, float]
+    update_period: float = 0.0
+    random_phase: bool = False
+    range_noise_per_meter: float = 0.0
+    angular_jitter_std: float = 0.0
+    class_dropout: tuple[float, ...] = ()
+    mount_pos_range: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mount_rot_range: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    drift_range: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def randomised_mount(self) -> bool:
+        """Some mount offset or drift is drawn per environment."""
+        return any(self.mount_pos_range) or any(self.mount_rot_range) or any(self.drift_range)
 
 
 def resolve(cfg: Any) -> ResolvedLidarCfg:
@@ -248,7 +295,73 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
         miss_distance=miss,
         offset_pos=tuple(float(v) for v in core.offset_pos),  # type: ignore[arg-type]
         offset_rot=tuple(float(v) for v in core.offset_rot),  # type: ignore[arg-type]
+        **_timing_and_realism(cfg, name, names),
     )
+
+
+def _number(cfg: Any, name: str, key: str, low: float, high: float = math.inf) -> float:
+    value = getattr(cfg, key)
+    if (
+        not isinstance(value, (int, float))
+        or isinstance(value, bool)
+        or not low <= float(value) <= high
+    ):
+        bound = f"in [{low}, {high}]" if math.isfinite(high) else f">= {low}"
+        raise SensorError(f"{name}.{key}: expected a finite number {bound}, got {value!r}")
+    return float(value)
+
+
+def _numbers(cfg: Any, name: str, key: str, n: int, low: float, what: str) -> tuple[float, ...]:
+    value = getattr(cfg, key)
+    if (
+        isinstance(value, (str, bytes))
+        or not hasattr(value, "__len__")
+        or len(value) != n
+        or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value
+        )
+        or any(v < low for v in value)
+    ):
+        raise SensorError(f"{name}.{key}: expected {n} finite numbers ({what}), got {value!r}")
+    return tuple(float(v) for v in value)
+
+
+def _timing_and_realism(cfg: Any, name: str, class_names: tuple[str, ...]) -> dict[str, Any]:
+    """The checked scan-timing and realism fields of ``cfg`` (see the config's docs)."""
+    if cfg.scan_phase not in ("zero", "random"):
+        raise SensorError(f"{name}.scan_phase: expected 'zero' or 'random', got {cfg.scan_phase!r}")
+    drops = [0.0] * len(class_names)
+    given = cfg.class_dropout
+    if given is not None:
+        if not isinstance(given, dict):
+            raise SensorError(f"{name}.class_dropout: expected None or a dict class -> probability")
+        for cls, p in given.items():
+            if cls not in class_names or cls == UNKNOWN_CLASS:
+                raise SensorError(
+                    f"{name}.class_dropout: unknown class {cls!r}; expected one of "
+                    f"{list(class_names[1:])}"
+                )
+            if not isinstance(p, (int, float)) or isinstance(p, bool) or not 0.0 <= p <= 1.0:
+                raise SensorError(
+                    f"{name}.class_dropout[{cls!r}]: expected a probability in [0, 1], got {p!r}"
+                )
+            drops[class_names.index(cls)] = float(p)
+    drift = _numbers(cfg, name, "drift_range", 2, -math.inf, "low, high [m]")
+    if drift[0] > drift[1]:
+        raise SensorError(f"{name}.drift_range: expected low <= high, got {cfg.drift_range!r}")
+    return {
+        "update_period": _number(cfg, name, "update_period", 0.0, 3600.0),
+        "random_phase": cfg.scan_phase == "random",
+        "range_noise_per_meter": _number(cfg, name, "range_noise_per_meter", 0.0, 10.0),
+        "angular_jitter_std": _number(cfg, name, "angular_jitter_std", 0.0, math.pi),
+        "class_dropout": tuple(drops),
+        "mount_pos_range": _numbers(cfg, name, "mount_pos_range", 3, 0.0, "x, y, z >= 0 [m]"),
+        "mount_rot_range": _numbers(
+            cfg, name, "mount_rot_range", 3, 0.0, "roll, pitch, yaw >= 0 [rad]"
+        ),
+        "drift_range": drift,
+    }
 
 
 def _core_config(cfg: Any, mapping: dict[str, list[str]]) -> SemanticLidarCfg:

@@ -129,19 +129,22 @@ def _image_bounds(s: MjlabSemanticLidarSensor) -> tuple[float, float, float, flo
 
 
 def _frame_cells(s: MjlabSemanticLidarSensor, width: int, height: int) -> torch.Tensor:
-    """``(N,)`` range-image cells of the rays of the pattern frame last cast. The rays of
-    every frame have fixed directions in the ray frame (whatever ``ray_alignment``), so
-    their cells are computed once per image size for the whole table and only looked
-    up each step (on the device, no copy to the host)."""
+    """Range-image cells of the rays each environment cast last: ``(N,)`` for a pattern
+    of one frame, else ``(E, N)``. A table row has a fixed direction in the ray frame
+    (whatever ``ray_alignment``), so the cells of all rows are computed once per image
+    size and each step only looked up at the environments' windows (on the device)."""
     key = ("range_image_cells", width, height)
     data = s.data
     if key not in s._obs_cache:
-        table = s.table
-        dirs = torch.as_tensor(table.directions).view(table.num_frames, -1, 3)
+        dirs = torch.as_tensor(s.table.directions)
         cells = learning_obs.ray_cells(dirs, _image_bounds(s), width, height)
         s._obs_cache[key] = cells.to(data.hit_mask.device)
-    frame = data.frame.long().clamp(min=0) % s.table.num_frames
-    return s._obs_cache[key].index_select(0, frame).squeeze(0)
+    cells = s._obs_cache[key]
+    n = int(s.table.rays_per_frame)
+    if cells.numel() == n:
+        return cells
+    rays = torch.arange(n, device=cells.device)
+    return cells[(data.window_start.long()[:, None] + rays) % cells.numel()]
 
 
 def lidar_range_image(
@@ -151,6 +154,7 @@ def lidar_range_image(
     height: int,
     flatten: bool = False,
     scanned: bool = False,
+    accumulate: int = 1,
 ) -> torch.Tensor:
     """``(E, 1 + C, height, width)`` distances and class occupancy binned by direction
     (``(E, 2 + C, height, width)`` with ``scanned``).
@@ -167,6 +171,11 @@ def lidar_range_image(
     whatever the pattern, so a CNN or a flattened MLP can learn from it; a rosette fills
     different cells each step. The rays' cells are computed once per pattern frame.
 
+    ``accumulate=k`` bins the rays of the last ``k`` steps' scans together (a rosette or
+    rotating pattern covers more cells over several steps; distance: the nearest of
+    them, classes: their shares); scans from before an environment's reset are left
+    out. The sensor keeps those ``k`` scans per environment (``k x N x 17`` bytes).
+
     Size per env: ``(1 + C) * height * width`` floats; 32 x 8 with 5 classes: 1 536
     floats (6 KiB), 24 MiB per step for 4096 envs (576 MiB of PPO rollout at 24 steps).
     ``flatten=True`` returns it as ``(E, channels * height * width)`` (channel-major), the
@@ -175,18 +184,32 @@ def lidar_range_image(
     learning_obs.check_image_size(width, height)
     s = _sensor(env, sensor_name)
     data = s.data
+    cells = _frame_cells(s, width, height)
+    hit, dist, labels, valid = data.hit_mask, data.distances, data.semantic_labels, None
+    if accumulate != 1:
+        key = ("range_image_history", width, height, accumulate)
+        history = s._obs_cache.get(key)
+        if history is None:
+            e, n = hit.shape
+            history = learning_obs.ScanHistory(accumulate, e, n, hit.device)
+            s._obs_cache[key] = history
+        if history.last_key != s._casts:  # once per sensed step, whatever reads it
+            history.push(hit, dist, labels, cells)
+            history.last_key = s._casts
+        hit, dist, labels, cells, valid = history.flat()
     out = learning_obs.range_image(
         None,
-        data.hit_mask,
-        data.distances,
+        hit,
+        dist,
         float(s.cfg.max_distance),
-        data.semantic_labels,
+        labels,
         len(s.class_names),
         _image_bounds(s),
         width,
         height,
-        cells=_frame_cells(s, width, height),
+        cells=cells,
         scanned=scanned,
+        valid=valid,
     )
     if flatten:
         return out.reshape(out.shape[0], -1)

@@ -1,5 +1,6 @@
-"""mjlab task ``Mjlab-Velocity-Rough-Unitree-Go1-SemanticLidar`` (loaded by mjlab's
-``mjlab.tasks`` entry point, so ``train`` / ``play`` list it).
+"""mjlab tasks (loaded by mjlab's ``mjlab.tasks`` entry point, so ``train`` / ``play``
+list them): ``Mjlab-Velocity-Rough-Unitree-Go1-SemanticLidar``, below, and the semantic
+seeker ``Mjlab-Semantic-Seeker-PointMass`` (and ``-NoLabels``), :mod:`.seeker`.
 
 mjlab's rough-terrain Go1 velocity task, plus obstacles of the three default classes on
 the terrain around every robot, and a semantic Mid-360 on the trunk whose range image
@@ -34,6 +35,7 @@ from mjlab.tasks.velocity.rl import VelocityOnPolicyRunner
 
 from robotwright.sensors.mjlab.config import SemanticLidarSensorCfg
 from robotwright.sensors.mjlab.observations import lidar_range_image
+from robotwright.sensors.mjlab.seeker import register as register_seeker
 from robotwright.sensors.patterns import LivoxPatternCfg
 
 __all__ = ["TASK_ID", "semantic_lidar_go1_rough_env_cfg"]
@@ -139,3 +141,5 @@ if TASK_ID not in list_tasks():  # importing twice (entry point, then by name) i
         rl_cfg=_runner_cfg(),
         runner_cls=VelocityOnPolicyRunner,
     )
+
+register_seeker()

@@ -1,0 +1,132 @@
+"""The semantic seeker tasks (marked ``mjlab``): registered through mjlab's entry point,
+the labels variant sees classes the other does not, the layout and rewards mean what
+they say, and a short PPO run of each goes through mjlab's runner.
+
+Runs in the MuJoCo 3.11 environment of ``.ci/run`` on warp's CPU device; skipped with a
+reason where mjlab is not installed.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.mjlab
+pytest.importorskip("mjlab", reason="mjlab not installed (the MuJoCo 3.11 environment of .ci/run)")
+
+import mjlab  # noqa: E402, F401 - loads the entry points
+import torch  # noqa: E402
+from mjlab.envs import ManagerBasedRlEnv  # noqa: E402
+from mjlab.tasks.registry import list_tasks, load_env_cfg, load_rl_cfg  # noqa: E402
+
+from robotwright.sensors.mjlab import seeker  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _env(task_id: str, envs: int = 3) -> ManagerBasedRlEnv:
+    cfg = load_env_cfg(task_id)
+    cfg.scene.num_envs = envs
+    return ManagerBasedRlEnv(cfg=cfg, device="cpu")
+
+
+@pytest.fixture(scope="module")
+def labelled():
+    env = _env(seeker.TASK_ID)
+    yield env
+    env.close()
+
+
+def test_both_variants_are_registered_with_the_same_network_and_budget() -> None:
+    assert {seeker.TASK_ID, seeker.NO_LABELS_TASK_ID} <= set(list_tasks())
+    a, b = load_rl_cfg(seeker.TASK_ID), load_rl_cfg(seeker.NO_LABELS_TASK_ID)
+    assert a.actor.hidden_dims == b.actor.hidden_dims == (128, 64)
+    assert a.num_steps_per_env == b.num_steps_per_env
+    assert a.algorithm == b.algorithm
+
+
+def test_only_the_labels_variant_observes_classes(labelled) -> None:
+    obs, _ = labelled.reset()
+    sensor = labelled.scene["lidar"]
+    classes = len(sensor.class_names)
+    rays = seeker.RING_RAYS
+    assert obs["actor"].shape == (3, rays + rays * classes + 2)
+    other = _env(seeker.NO_LABELS_TASK_ID)
+    try:
+        obs_b, _ = other.reset()
+        assert obs_b["actor"].shape == (3, rays + 2)
+    finally:
+        other.close()
+
+
+def test_the_ring_sees_the_target_as_valuable_and_the_obstacles_as_dynamic(labelled) -> None:
+    """Every ray that hits a cylinder carries the class of the cylinder it hit; the target
+    and both obstacles are seen (placed at least 1 m apart, within 6 m range)."""
+    labelled.reset()
+    sensor = labelled.scene["lidar"]
+    names = sensor.class_names
+    data = sensor.data
+    target = labelled.scene["target"].data.root_link_pos_w[:, :2]
+    hits = data.hit_pos_w[..., :2]
+    near_target = (hits - target[:, None]).norm(dim=2) < seeker.CYLINDER_RADIUS + 1e-3
+    labels = data.semantic_labels
+    assert near_target.any()
+    assert (labels[near_target & data.hit_mask] == names.index("valuable")).all()
+    assert (labels[~near_target & data.hit_mask] == names.index("dynamic_obstacle")).all()
+
+
+def test_reset_places_everything_apart_inside_the_arena(labelled) -> None:
+    for _ in range(3):
+        labelled.reset()
+        agent, target, obstacles = seeker._positions(labelled)
+        pts = torch.cat([agent[:, None], target[:, None], obstacles], dim=1)
+        assert pts.abs().max() <= seeker.ARENA_HALF
+        gaps = torch.cdist(pts, pts) + torch.eye(4) * 1e3
+        # 16 tries per env: with 4 points in a 5 m square the layout nearly always fits
+        assert (gaps.amin(dim=(1, 2)) >= seeker.MIN_SEPARATION).float().mean() >= 2 / 3
+
+
+def test_rewards_follow_the_distance_to_the_target(labelled) -> None:
+    """Pushing toward the target earns progress; sitting on it counts as at target."""
+    labelled.reset()
+    agent_ent = labelled.scene["agent"]
+    _, target, _ = seeker._positions(labelled)
+    assert (seeker.near_target(labelled) == 0).all()
+    speed = seeker.progress_to_target(labelled)
+    assert torch.allclose(speed, torch.zeros(3), atol=1e-6)  # at rest after the reset
+    agent, target, _ = seeker._positions(labelled)
+    toward = (target - agent) / (target - agent).norm(dim=1, keepdim=True)
+    for _ in range(3):
+        labelled.step(toward)
+    assert (seeker.progress_to_target(labelled) > 0).all()
+    agent_ent.write_joint_state_to_sim(target.clone(), torch.zeros_like(target))
+    labelled.sim.forward()
+    assert (seeker.near_target(labelled) == 1).all()
+
+
+def test_the_benchmark_trains_both_variants_and_prints_the_comparison(tmp_path) -> None:
+    """Two short runs through the benchmark script: it finishes, writes its files and
+    prints the summary line with two shares in [0, 1]."""
+    done = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "benchmarks" / "semantic_seeker.py"),
+            "--iterations",
+            "2",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    last = done.stdout.strip().splitlines()[-1]
+    assert last.startswith("at target: labels ")
+    values = [float(v.split()[-1]) for v in last.split(":", 1)[1].split(",")]
+    assert len(values) == 2 and all(0.0 <= v <= 1.0 and not math.isnan(v) for v in values)
+    assert (tmp_path / "seeker_runs.json").is_file()
