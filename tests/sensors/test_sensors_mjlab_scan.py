@@ -276,3 +276,32 @@ def test_bad_timing_and_realism_fields_are_refused_naming_them(field, value, mat
     setattr(cfg, field, value)  # as tyro or a user would, after construction
     with pytest.raises(SensorError, match=f"SemanticLidarSensorCfg.{match}"):
         cfg.build()
+
+
+def test_timing_and_realism_fields_are_set_from_mjlab_s_command_line() -> None:
+    """tyro (mjlab's ``train``/``play``) reads the new fields, the class dropout as
+    ``CLASS PROBABILITY`` pairs."""
+    import tyro
+
+    args = [
+        "--class-dropout",
+        "valuable",
+        "0.3",
+        "--update-period",
+        "0.1",
+        "--scan-phase",
+        "random",
+        "--mount-rot-range",
+        "0",
+        "0",
+        "0.1",
+        "--drift-range",
+        "-0.01",
+        "0.01",
+    ]
+    cfg = tyro.cli(type(_cfg()), default=_cfg(), args=args)
+    assert cfg.class_dropout == {"valuable": 0.3} and cfg.update_period == 0.1
+    assert cfg.scan_phase == "random" and cfg.mount_rot_range == (0.0, 0.0, 0.1)
+    assert cfg.drift_range == (-0.01, 0.01)
+    res = rw_mjlab.resolve(cfg)
+    assert res.class_dropout[res.class_names.index("valuable")] == pytest.approx(0.3)

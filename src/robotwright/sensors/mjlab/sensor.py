@@ -665,7 +665,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         ``debug_vis_max_points`` evenly spaced hits per drawn environment.
 
         MuJoCo's native viewer gets the spheres written into its scene in one pass (2 000
-        points in about 2 ms); other viewers (viser) through ``add_sphere``, each call
+        points in 2-3 ms); other viewers (viser) through ``add_sphere``, each call
         with prepared arrays."""
         if not self.cfg.debug_vis or not self._debug_vis_enabled or not self._buffers:
             return
