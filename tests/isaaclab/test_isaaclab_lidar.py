@@ -438,3 +438,13 @@ def test_observation_terms_in_isaac_lab_style(world):
         lidar_point_cloud(env, cfg, max_points=0)
     with pytest.raises(SensorError, match="not a robotwright"):
         lidar_semantic_obs(env, SceneEntityCfg("multi_mesh"))
+    # The cells looked up from the table equal those of this step's local directions.
+    from robotwright.sensors import learning_obs
+    from robotwright.sensors.isaaclab.observations import _window_cells
+
+    for _ in range(2):
+        want = learning_obs.ray_cells(
+            sensor.data.ray_directions_local.torch, sensor.direction_bounds(), 64, 16
+        )
+        assert torch.equal(_window_cells(sensor, 64, 16), want)
+        _step(sim, scene, 1)

@@ -305,3 +305,28 @@ def test_timing_and_realism_fields_are_set_from_mjlab_s_command_line() -> None:
     assert cfg.drift_range == (-0.01, 0.01)
     res = rw_mjlab.resolve(cfg)
     assert res.class_dropout[res.class_names.index("valuable")] == pytest.approx(0.3)
+
+
+def test_point_cloud_accumulates_the_hits_of_the_last_scans(clutter_model):
+    env = _make(clutter_model, _cfg(pattern=LivoxPatternCfg(num_rays=400)))
+    env.scene = {"lidar": env.sensor}
+    data = env.sensor.data
+    hits = []
+    _step(env, 0.0)
+    for _ in range(3):
+        hits.append(data.hit_mask.numpy().sum(axis=1))
+        cloud = rw_mjlab.lidar_point_cloud(env, "lidar", 4096, frame="world", accumulate=3)
+        _step(env, 0.002)
+    hits.append(data.hit_mask.numpy().sum(axis=1))
+    cloud = rw_mjlab.lidar_point_cloud(env, "lidar", 4096, frame="world", accumulate=3)
+    used = (cloud[..., 3:].sum(-1) > 0).sum(dim=1).numpy()
+    np.testing.assert_array_equal(used, np.sum(hits[-3:], axis=0))
+    now = data.hit_pos_w.numpy()[0][data.hit_mask.numpy()[0]]
+    got = cloud[0, : used[0], :3].numpy()
+    # this step's hits are among the accumulated points, in the world frame
+    assert all(np.abs(got - p).sum(axis=1).min() < 1e-5 for p in now[:50])
+    env.sensor.reset(torch.tensor([0]))
+    _step(env, 0.002)
+    cloud = rw_mjlab.lidar_point_cloud(env, "lidar", 4096, frame="world", accumulate=3)
+    used = (cloud[..., 3:].sum(-1) > 0).sum(dim=1).numpy()
+    assert used[0] == data.hit_mask.numpy()[0].sum() and used[1] > data.hit_mask.numpy()[1].sum()

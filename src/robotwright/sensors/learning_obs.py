@@ -188,46 +188,48 @@ def range_image(
 
 class ScanHistory:
     """The last ``k`` scans of every environment, for observations that accumulate
-    frames (a rotating or rosette pattern fills a range image over several steps).
+    frames (a rotating or rosette pattern fills a range image or a point cloud over
+    several steps).
 
-    Stores per scan the rays' hit mask, distance [m], class and image cell; a slot never
-    filled since the environment's last reset is not valid (left out of the image).
+    Stores per scan the per-ray tensors it is given (``(E, N, ...)`` each, by name); a
+    slot not filled since the environment's last reset is not valid (left out).
     """
 
-    def __init__(self, k: int, envs: int, rays: int, device: torch.device | str) -> None:
+    def __init__(self, k: int, what: str) -> None:
         if not isinstance(k, int) or isinstance(k, bool) or not 1 <= k <= 64:
-            raise SensorError(
-                f"lidar_range_image: accumulate must be an integer in [1, 64], got {k!r}"
-            )
+            raise SensorError(f"{what}: accumulate must be an integer in [1, 64], got {k!r}")
         self.k = k
-        self.hit = torch.zeros(envs, k, rays, dtype=torch.bool, device=device)
-        self.distances = torch.zeros(envs, k, rays, device=device)
-        self.labels = torch.zeros(envs, k, rays, dtype=torch.int32, device=device)
-        self.cells = torch.zeros(envs, k, rays, dtype=torch.long, device=device)
-        self.filled = torch.zeros(envs, k, dtype=torch.bool, device=device)
+        self.arrays: dict[str, torch.Tensor] = {}
+        self.filled: torch.Tensor | None = None
         self.scans = 0
         self.last_key: object = None
 
-    def push(
-        self, hit: torch.Tensor, distances: torch.Tensor, labels: torch.Tensor, cells: torch.Tensor
-    ) -> None:
-        """Store this step's scan ``(E, N)`` in place of the oldest."""
+    def push(self, **rays: torch.Tensor) -> None:
+        """Store this step's scan (each ``(E, N, ...)``) in place of the oldest."""
+        if self.filled is None:
+            first = next(iter(rays.values()))
+            e = first.shape[0]
+            self.arrays = {
+                name: torch.zeros((e, self.k, *t.shape[1:]), dtype=t.dtype, device=t.device)
+                for name, t in rays.items()
+            }
+            self.filled = torch.zeros(e, self.k, dtype=torch.bool, device=first.device)
         slot = self.scans % self.k
-        self.hit[:, slot] = hit
-        self.distances[:, slot] = distances
-        self.labels[:, slot] = labels
-        self.cells[:, slot] = cells.expand(hit.shape)
+        for name, t in rays.items():
+            self.arrays[name][:, slot] = t
         self.filled[:, slot] = True
         self.scans += 1
 
     def clear_envs(self, env_ids: torch.Tensor) -> None:
         """Forget the scans of ``env_ids`` (a reset): their slots become not valid."""
-        self.filled[env_ids] = False
+        if self.filled is not None:
+            self.filled[env_ids] = False
 
-    def flat(self) -> tuple[torch.Tensor, ...]:
-        """(hit, distances, labels, cells, valid), each ``(E, k * N)``."""
-        e = self.hit.shape[0]
-        valid = self.filled[:, :, None].expand(self.hit.shape)
-        return tuple(
-            t.reshape(e, -1) for t in (self.hit, self.distances, self.labels, self.cells, valid)
-        )
+    def flat(self) -> dict[str, torch.Tensor]:
+        """Each stored tensor as ``(E, k * N, ...)``, and ``"valid"`` ``(E, k * N)``."""
+        assert self.filled is not None, "push a scan first"
+        out = {name: t.flatten(1, 2) for name, t in self.arrays.items()}
+        first = next(iter(self.arrays.values()))
+        valid = self.filled[:, :, None].expand(first.shape[:3])
+        out["valid"] = valid.flatten(1, 2)
+        return out

@@ -93,6 +93,19 @@ def lidar_point_cloud(
     )
 
 
+def _window_cells(s: Any, width: int, height: int) -> torch.Tensor:
+    """``(E, N)`` range-image cells of each environment's window: the cells of every row
+    of the pattern table are computed once per image size (a row's direction in the
+    sensor frame never changes) and only looked up each step at ``data.frame``."""
+    cache = s.__dict__.setdefault("_robotwright_cells", {})
+    key = (width, height)
+    if key not in cache:
+        local = torch.as_tensor(s._table_local.numpy(), dtype=torch.float32)
+        cells = learning_obs.ray_cells(local, s.direction_bounds(), width, height)
+        cache[key] = cells.view(int(s.num_frames), -1).to(s.data.hit_mask.torch.device)
+    return cache[key][s.data.frame.torch.long()]
+
+
 def lidar_range_image(
     env: Any,
     sensor_cfg: SceneEntityCfg,
@@ -104,13 +117,14 @@ def lidar_range_image(
     """``(E, 1 + C, height, width)`` nearest distance and class occupancy per direction
     cell of the sensor frame, over the pattern's whole field of view (every window);
     ``scanned=True`` adds a last channel saying which cells this step's rays scanned;
+    the cells of the pattern's rays are computed once and looked up each step;
     ``flatten=True`` gives ``(E, channels * height * width)`` for an MLP. See
     :func:`robotwright.sensors.learning_obs.range_image`."""
     learning_obs.check_image_size(width, height)
     s = _sensor(env, sensor_cfg)
     data = s.data
     out = learning_obs.range_image(
-        data.ray_directions_local.torch,
+        None,
         data.hit_mask.torch,
         data.ray_distances.torch,
         float(s.cfg.max_distance),
@@ -119,6 +133,7 @@ def lidar_range_image(
         s.direction_bounds(),
         width,
         height,
+        cells=_window_cells(s, width, height),
         scanned=scanned,
     )
     return out.reshape(out.shape[0], -1) if flatten else out

@@ -85,6 +85,7 @@ def lidar_point_cloud(
     sensor_name: str,
     max_points: int,
     frame: Literal["sensor", "base", "world"] = "sensor",
+    accumulate: int = 1,
 ) -> torch.Tensor:
     """``(E, max_points, 3 + C)`` a fixed-size sample of the hit points, with one-hot classes.
 
@@ -99,6 +100,9 @@ def lidar_point_cloud(
     C)`` floats; 1024 points with 5 classes: 32 KiB, 128 MiB per step for 4096 envs
     (3 GiB of PPO rollout at 24 steps); flattened into an MLP it is as hard to learn as
     per-ray terms (slot ``j`` is not a direction), so pair it with an encoder.
+    ``accumulate=k`` samples the hits of the last ``k`` steps' scans (kept in the world
+    frame, shown in this step's ``frame``: a static scene stays in place as the robot
+    moves; hits from before an environment's reset are left out).
     """
     learning_obs.check_point_cloud_args(max_points, frame, ("sensor", "base", "world"))
     s = _sensor(env, sensor_name)
@@ -108,15 +112,44 @@ def lidar_point_cloud(
         origin, rot = data.sensor_pos_w, s._sensor_mat
     elif frame == "base":
         origin, rot = data.pos_w, s._frame_mat
+    hit, points, labels = data.hit_mask, data.hit_pos_w, data.semantic_labels
+    if accumulate != 1:
+        rays = _accumulated(
+            s,
+            ("point_cloud",),
+            accumulate,
+            "lidar_point_cloud",
+            hit=hit,
+            points=points,
+            labels=labels,
+        )
+        hit, points, labels = rays["hit"] & rays["valid"], rays["points"], rays["labels"]
     return learning_obs.point_cloud(
-        data.hit_mask,
-        data.hit_pos_w,
-        data.semantic_labels,
+        hit,
+        points,
+        labels,
         len(s.class_names),
         max_points,
         origin,
         rot,
     )
+
+
+def _accumulated(
+    s: MjlabSemanticLidarSensor, key: tuple, k: int, what: str, **rays: torch.Tensor
+) -> dict[str, torch.Tensor]:
+    """The last ``k`` steps' values of ``rays`` (each ``(E, N, ...)``) as ``(E, k * N,
+    ...)`` plus ``"valid"``: the sensor keeps them per observation term (``key``), adds
+    this step's once however often the term is read, and forgets an environment's at its
+    reset."""
+    history = s._obs_cache.get(("history", *key, k))
+    if history is None:
+        history = learning_obs.ScanHistory(k, what)
+        s._obs_cache[("history", *key, k)] = history
+    if history.last_key != s._casts:
+        history.push(**rays)
+        history.last_key = s._casts
+    return history.flat()
 
 
 def _image_bounds(s: MjlabSemanticLidarSensor) -> tuple[float, float, float, float, bool]:
@@ -187,16 +220,19 @@ def lidar_range_image(
     cells = _frame_cells(s, width, height)
     hit, dist, labels, valid = data.hit_mask, data.distances, data.semantic_labels, None
     if accumulate != 1:
-        key = ("range_image_history", width, height, accumulate)
-        history = s._obs_cache.get(key)
-        if history is None:
-            e, n = hit.shape
-            history = learning_obs.ScanHistory(accumulate, e, n, hit.device)
-            s._obs_cache[key] = history
-        if history.last_key != s._casts:  # once per sensed step, whatever reads it
-            history.push(hit, dist, labels, cells)
-            history.last_key = s._casts
-        hit, dist, labels, cells, valid = history.flat()
+        rays = _accumulated(
+            s,
+            ("range_image", width, height),
+            accumulate,
+            "lidar_range_image",
+            hit=hit,
+            dist=dist,
+            labels=labels,
+            cells=cells.expand(hit.shape),
+        )
+        hit, dist, labels, cells, valid = (
+            rays[k] for k in ("hit", "dist", "labels", "cells", "valid")
+        )
     out = learning_obs.range_image(
         None,
         hit,
