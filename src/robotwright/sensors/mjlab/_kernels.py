@@ -101,6 +101,22 @@ def world_rays_windowed(
 
 
 @wp.kernel
+def mjlab_misses(
+    hit_mask: wp.array2d(dtype=wp.bool),
+    pnt: wp.array2d(dtype=wp.vec3),
+    points: wp.array2d(dtype=wp.vec3),
+    normals: wp.array2d(dtype=wp.vec3),
+):
+    """A miss (nothing hit, out of range or dropped) gets mjlab's values: hit point = ray
+    origin, normal = 0 (the other miss values are the range model's). The plain case of
+    :func:`mjlab_finish`: no realism option, scans published every step."""
+    e, i = wp.tid()
+    if not hit_mask[e, i]:
+        points[e, i] = pnt[e, i]
+        normals[e, i] = wp.vec3(0.0, 0.0, 0.0)
+
+
+@wp.kernel
 def mjlab_finish(
     distances: wp.array2d(dtype=wp.float32),
     hit_mask: wp.array2d(dtype=wp.bool),
@@ -140,12 +156,27 @@ def mjlab_finish(
     hit = hit_mask[e, i]
     d = distances[e, i]
     lab = labels[e, i]
+    changed = False
     if hit and (noise_per_meter > wp.float32(0.0) or class_dropout[lab] > wp.float32(0.0)):
         state = wp.rand_init(_mix_seed(env_seed[e], frame[0]), REALISM_STREAM + ray_offset + i)
         if noise_per_meter > wp.float32(0.0):
             d = wp.clamp(d + noise_per_meter * d * wp.randn(state), min_distance, max_distance)
+            changed = True
         if wp.randf(state) < class_dropout[lab]:
             hit = False
+    if hold == 0:
+        # The published arrays are the ones read: write only what differs.
+        if not hit:
+            out_hit_mask[e, i] = False
+            out_distances[e, i] = wp.float32(-1.0)
+            out_geom_ids[e, i] = -1
+            out_labels[e, i] = 0
+            out_points[e, i] = pnt[e, i]
+            out_normals[e, i] = wp.vec3(0.0, 0.0, 0.0)
+        elif changed:
+            out_distances[e, i] = d
+            out_points[e, i] = pnt[e, i] + d * vec[e, i]
+        return
     out_pnt[e, i] = pnt[e, i]
     out_vec[e, i] = vec[e, i]
     out_hit_mask[e, i] = hit

@@ -625,6 +625,15 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             ],
             device=dev,
         )
+        if not (self._hold or res.range_noise_per_meter or any(res.class_dropout)):
+            wp.launch(
+                mjlab_kernels.mjlab_misses,
+                dim=(e, b_ - a),
+                inputs=[cols(work["hit_mask"]), pnt],
+                outputs=[cols(work["points"]), cols(self._ray_normal)],
+                device=dev,
+            )
+            return
         wp.launch(
             mjlab_kernels.mjlab_finish,
             dim=(e, b_ - a),
