@@ -130,3 +130,32 @@ def test_the_benchmark_trains_both_variants_and_prints_the_comparison(tmp_path) 
     values = [float(v.split()[-1]) for v in last.split(":", 1)[1].split(",")]
     assert len(values) == 2 and all(0.0 <= v <= 1.0 and not math.isnan(v) for v in values)
     assert (tmp_path / "seeker_runs.json").is_file()
+
+
+def test_mjlab_s_train_runs_the_seeker(tmp_path) -> None:
+    """mjlab's own ``train`` entry point on the registered task (2 iterations)."""
+    code = "import sys; from mjlab.scripts.train import main; sys.argv = ['train'] + sys.argv[1:]; main()"
+    args = [
+        seeker.NO_LABELS_TASK_ID,
+        "--env.scene.num-envs",
+        "4",
+        "--agent.max-iterations",
+        "2",
+        "--agent.num-steps-per-env",
+        "8",
+        "--gpu-ids",
+        "None",
+        "--log-root",
+        str(tmp_path),
+    ]
+    done = subprocess.run(
+        [sys.executable, "-c", code, *args],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, (done.stdout[-3000:], done.stderr[-3000:])
+    runs = list((tmp_path / "semantic_seeker_no_labels").iterdir())
+    assert len(runs) == 1 and (runs[0] / "model_1.pt").is_file()
+    assert "Learning iteration 1/2" in done.stdout
