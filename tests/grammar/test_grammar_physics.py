@@ -109,19 +109,34 @@ def test_payload_is_verified_by_hanging_the_mass(arm):
     data.qpos[:] = worst
     mujoco.mj_inverse(model, data)
     ratio = np.abs(data.qfrc_inverse) / np.array([j.peak_torque for j in arm.joints])
-    assert ratio.max() == pytest.approx(1.0, abs=1e-6)
-    # the closed form agrees with itself at that pose
-    assert P._max_mass(*P.holding_torques(P.mount(arm), worst), P.mount(arm).peak) == (
-        pytest.approx(res.mass)
+    # what binds is a motor at its peak torque or a bearing at its rating
+    mounted = P.mount(arm)
+    d2 = mujoco.MjData(mounted.model)
+    P.holding_torques(mounted, worst, d2)
+    used = [ratio.max()]
+    for joint, slide, force, moment, carried in mounted.bearings:
+        f0, f1, t0, t1 = P.bearing_loads(mounted, d2, joint, slide, carried)
+        used += [
+            np.linalg.norm(f0 + res.mass * f1) / force,
+            np.linalg.norm(t0 + res.mass * t1) / moment,
+        ]
+    assert max(used) == pytest.approx(1.0, abs=1e-6)
+    assert ratio.max() <= 1.0 + 1e-6
+    # the motors alone would hold at least that much at that pose
+    assert P._max_mass(*P.holding_torques(P.mount(arm), worst), P.mount(arm).peak) >= (
+        res.mass - 1e-9
     )
 
 
 def test_payload_grows_with_torque_and_is_zero_when_the_limb_cannot_hold_itself(arm, grammar):
     base = P.payload(arm, min_free_share=0.0).mass
     assert P.payload(scaled(arm, 2.0), min_free_share=0.0).mass >= base
+    # without bearing ratings the motors alone bound it: twice the torque, more payload
+    free = unrated(arm)
     assert (
-        P.payload(scaled(arm, 2.0), min_free_share=0.0).mass > base
-    )  # uncapped here: torque-limited
+        P.payload(scaled(free, 2.0), min_free_share=0.0).mass
+        > P.payload(free, min_free_share=0.0).mass
+    )
     assert P.payload(scaled(arm, 1e-4), min_free_share=0.0).mass == 0.0
     for d in some_designs(grammar):
         limb = build(grammar, d)
@@ -236,3 +251,96 @@ def test_payload_counts_every_pose_and_names_its_bound() -> None:
     assert lenient.bounded == (lenient.mass >= 100.0)
     with pytest.raises(ValueError, match="min_free_share"):
         P.payload(limb, min_free_share=1.5)
+
+
+SLIDES = """# grammar=srl
+r1 @0: B=base(diameter=0.08, thickness=0.04) P=pinned()
+r2 @0: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r3 @3: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.25, rotation=-1.5708)
+r3 @5: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.15, rotation=0.0)
+r3 @7: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r4 @9: E=gripper(finger_length=0.06)
+"""
+
+MIXED = """# grammar=srl
+r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()
+r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r3 @3: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r4 @5: E=tool(length=0.08)
+"""
+
+
+def unrated(limb: Limb) -> Limb:
+    """The same limb with no bearing ratings (as before they were modelled)."""
+    joints = [
+        dataclasses.replace(j, peak_bearing_force=np.inf, peak_bearing_moment=np.inf)
+        for j in limb.joints
+    ]
+    return dataclasses.replace(limb, joints=joints)
+
+
+def test_bearing_loads_equal_mujocos_joint_reaction(grammar) -> None:
+    """Force and moment a joint's bearing carries, with a mass hung at the tool, equal
+    MuJoCo's own interaction force between the joint's body and its parent
+    (``cfrc_int`` after ``mj_rnePostConstraint``, the mass applied as an external force),
+    without the part along the motor's axis."""
+    limb = build(grammar, Design.from_text(MIXED))
+    m = P.mount(limb)
+    model = m.model
+    assert {slide for _, slide, *_ in m.bearings} == {True, False}
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        q, hang = rng.uniform(m.lo, m.hi), rng.uniform(0.5, 5.0)
+        data = mujoco.MjData(model)
+        P.holding_torques(m, q, data)
+        ref = mujoco.MjData(model)
+        ref.qpos[:] = q
+        mujoco.mj_forward(model, ref)
+        for s in m.sites:
+            b = model.site_bodyid[s]
+            f = hang * model.opt.gravity
+            ref.xfrc_applied[b, :3] += f
+            ref.xfrc_applied[b, 3:] += np.cross(ref.site_xpos[s] - ref.xipos[b], f)
+        ref.qvel[:] = 0.0
+        ref.qacc[:] = 0.0
+        flags = model.opt.disableflags
+        model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+        mujoco.mj_inverse(model, ref)
+        model.opt.disableflags = flags
+        mujoco.mj_rnePostConstraint(model, ref)
+        for joint, slide, _, _, carried in m.bearings:
+            f0, f1, t0, t1 = P.bearing_loads(m, data, joint, slide, carried)
+            b = model.jnt_bodyid[joint]
+            c = ref.subtree_com[model.body_rootid[b]]
+            force, torque_c = ref.cfrc_int[b, 3:], ref.cfrc_int[b, :3]
+            anchor, axis = ref.xanchor[joint], ref.xaxis[joint]
+            torque = torque_c + np.cross(c - anchor, force)
+
+            def across(v, axis=axis):
+                return v - np.dot(v, axis) * axis
+
+            want_f, want_t = (across(force), torque) if slide else (force, across(torque))
+            np.testing.assert_allclose(f0 + hang * f1, want_f, atol=1e-9)
+            np.testing.assert_allclose(t0 + hang * t1, want_t, atol=1e-9)
+
+
+def test_horizontal_slides_carry_the_load_in_their_guides(grammar) -> None:
+    """The search's degenerate winner (slides only: their motors hold nothing) scored
+    the 100 kg bound; its guides now carry the load and bound the payload, exactly at a
+    guide's rating."""
+    limb = build(grammar, Design.from_text(SLIDES))
+    without = P.payload(unrated(limb))
+    assert without.bounded and without.mass == 100.0
+    res = P.payload(limb)
+    assert 0.0 < res.mass < 100.0 and not res.bounded
+    m = P.mount(limb)
+    data = mujoco.MjData(m.model)
+    P.holding_torques(m, res.poses[res.worst], data)
+    used = []
+    for joint, slide, force, moment, carried in m.bearings:
+        f0, f1, t0, t1 = P.bearing_loads(m, data, joint, slide, carried)
+        used += [
+            np.linalg.norm(f0 + res.mass * f1) / force,
+            np.linalg.norm(t0 + res.mass * t1) / moment,
+        ]
+    assert max(used) == pytest.approx(1.0, abs=1e-9)

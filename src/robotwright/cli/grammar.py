@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import random
 import sys
 import time
@@ -161,13 +162,42 @@ def register(sub: argparse._SubParsersAction) -> None:
     common(q)
     q.add_argument(
         "--objective",
-        default="reach",
-        choices=["reach", "workspace", "mass", "dof", "payload", "track", "energy"],
+        action="append",
+        default=None,
+        choices=_OBJECTIVE_NAMES,
         help="reach: farthest end point [m] (default); workspace: reachable volume "
         "estimate [m^3]; mass: lightest [kg]; dof: most joints; worn by the carrier "
         "(mini_humanoid's back): payload: heaviest load held at every sampled pose [kg]; "
         "track: smallest RMS error following a circle and a line [m]; energy: least mean "
-        "mechanical power on that path [W]",
+        "mechanical power on that path [W]. Repeatable: the first scores a design and the "
+        "second breaks ties (one objective alone: ties broken by --tie-break); with "
+        "--weights their weighted sum scores; with --pareto all of them make the front",
+    )
+    q.add_argument(
+        "--tie-break",
+        default="mass",
+        choices=[*_OBJECTIVE_NAMES, "none"],
+        help="with one --objective: the objective that orders designs of equal value, e.g. "
+        "two limbs both at payload's bound (default mass: the lighter first; none: the "
+        "first evaluated)",
+    )
+    q.add_argument(
+        "--weights",
+        type=_weights,
+        default=None,
+        metavar="W,W,...",
+        help="score by the weighted sum of the --objective values, one weight each, every "
+        "value oriented so that larger is better (a minimised one enters negated); the "
+        "weights carry the units' exchange rate (e.g. payload,mass with 1,2: 1 kg of limb "
+        "is worth 2 kg of payload)",
+    )
+    q.add_argument(
+        "--pareto",
+        action="store_true",
+        help="report the Pareto front of the --objective values (two or more) over every "
+        "design evaluated: the feasible designs no other beats in every objective; -o "
+        "writes front_1 ... and pareto.png. beam and mcts steer by the first objective, "
+        "random samples evenly",
     )
     q.add_argument(
         "--constraint",
@@ -407,9 +437,49 @@ _CARRIER_OBJECTIVES = ("payload", "track", "energy")
 
 
 def _default_constraints(args: argparse.Namespace) -> list[str]:
-    if args.objective in _CARRIER_OBJECTIVES:
+    if set(args.objective or ()) & set(_CARRIER_OBJECTIVES):
         return ["no-self-collision", "no-carrier-collision"]
     return ["no-self-collision"]
+
+
+_OBJECTIVE_NAMES = ["reach", "workspace", "mass", "dof", "payload", "track", "energy"]
+
+
+def _weights(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if not values or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(
+            f"expected finite numbers separated by commas, e.g. 1,2; got {text!r}"
+        )
+    return values
+
+
+def _objectives(args: argparse.Namespace) -> tuple[list, list] | str:
+    """(objectives the search evaluates, in order: the scoring one first, the tie-break
+    second; the objectives the user named), or the error message."""
+    from robotwright.grammar.objectives import OBJECTIVES, WeightedSum
+
+    names = args.objective or ["reach"]
+    if len(set(names)) != len(names):
+        return f"--objective: {', '.join(names)} names one twice; expected each once"
+    named = [OBJECTIVES[n]() for n in names]
+    if args.pareto:
+        if len(named) < 2 or args.weights is not None:
+            return "--pareto: expected two --objective or more, and no --weights"
+        return named, named
+    if args.weights is not None:
+        if len(args.weights) != len(named) or len(named) < 2:
+            return (
+                f"--weights: {len(args.weights)} weight(s) for {len(named)} objective(s); "
+                "expected one per --objective, two objectives or more"
+            )
+        return [WeightedSum(tuple(named), args.weights), *named], named
+    if len(named) == 1 and args.tie_break not in ("none", names[0]):
+        return [*named, OBJECTIVES[args.tie_break]()], named
+    return named, named
 
 
 def _value_text(objective: object, value: float) -> str:
@@ -427,10 +497,15 @@ def _value_text(objective: object, value: float) -> str:
 
 
 def _search(args: argparse.Namespace) -> int:
-    from robotwright.grammar.objectives import OBJECTIVES, make_constraint
+    from robotwright.grammar.objectives import make_constraint
     from robotwright.grammar.search import beam_search, check_workers, mcts_search, random_search
 
     g = _grammar(args)
+    chosen = _objectives(args)
+    if isinstance(chosen, str):
+        print(f"error: {chosen}", file=sys.stderr)
+        return 2
+    objectives, named = chosen
     if args.out:
         _check_design_dir(args.out, args.overwrite, kind="designs")
     try:
@@ -465,7 +540,7 @@ def _search(args: argparse.Namespace) -> int:
         except (ValueError, ImportError) as exc:
             print(f"error: --ray: {exc}", file=sys.stderr)
             return 2
-    objective = OBJECTIVES[args.objective]()
+    objective = objectives[0]
     t0 = time.perf_counter()
     kw = dict(
         budget=args.budget,
@@ -479,14 +554,14 @@ def _search(args: argparse.Namespace) -> int:
     with _ray_executor(args) as executor:
         kw.update(executor=executor)
         if args.method == "beam":
-            res = beam_search(g, [objective], constraints, beam_width=args.beam_width, **kw)
+            res = beam_search(g, objectives, constraints, beam_width=args.beam_width, **kw)
         elif args.method == "mcts":
             from robotwright.grammar.search import MCTS_BATCH
 
             batch = args.batch or MCTS_BATCH
-            res = mcts_search(g, [objective], constraints, batch=batch, **kw)
+            res = mcts_search(g, objectives, constraints, batch=batch, **kw)
         else:
-            res = random_search(g, [objective], constraints, **kw)
+            res = random_search(g, objectives, constraints, **kw)
     dt = time.perf_counter() - t0
     print(
         f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s "
@@ -495,9 +570,13 @@ def _search(args: argparse.Namespace) -> int:
     if res.best is None:
         print("no feasible design found")
         return 1
+    if args.pareto:
+        return _report_front(args, g, res, named)
     print(
         f"best {_value_text(objective, res.best.values[objective.name])} (design {res.best.design.hash()})"
     )
+    for other in objectives[1:]:
+        print(f"  {_value_text(other, res.best.values[other.name])}")
     print(res.best.design.to_text(), end="")
     if args.out:
         from robotwright.grammar.winners import write_winners
@@ -506,13 +585,49 @@ def _search(args: argparse.Namespace) -> int:
         folders = write_winners(
             g,
             res.evaluations,
-            [objective],
+            objectives,
             args.out,
             k=args.top,
             pictures=not args.no_picture,
             draw_carrier=draw_pose,
         )
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
+    return 0
+
+
+def _report_front(args: argparse.Namespace, g, res, objectives: list) -> int:  # noqa: ANN001
+    """Print the Pareto front (values with units) and write it with -o."""
+    from robotwright.grammar.objectives import pareto_front
+    from robotwright.grammar.winners import UNITS, write_front
+
+    front = pareto_front(res.evaluations, objectives)
+    feasible = sum(e.feasible for e in res.evaluations)
+    print(f"Pareto front: {len(front)} of {feasible} feasible designs")
+    header = "  ".join(
+        f"{o.name} [{UNITS[o.name]}]" if UNITS.get(o.name) else o.name for o in objectives
+    )
+    print(f"  #  {header}  design")
+    for i, ev in enumerate(front, 1):
+        cells = "  ".join(f"{ev.values[o.name]:.6g}" for o in objectives)
+        print(f"{i:>3}  {cells}  {ev.design.hash()}")
+    bounded = [o for o in objectives if getattr(o, "limit", None) is not None]
+    for o in bounded:
+        if any(ev.values[o.name] >= o.limit for ev in front):
+            print(f"note: {_value_text(o, o.limit)}")
+    if args.out:
+        from robotwright.render.api import draw_pose
+
+        folders = write_front(
+            g,
+            front,
+            objectives,
+            args.out,
+            evaluated=res.evaluations,
+            pictures=not args.no_picture,
+            draw_carrier=draw_pose,
+        )
+        extra = "" if args.no_picture else ", pareto.png"
+        print(f"written to {args.out}: {', '.join(f.name for f in folders)}, front.json{extra}")
     return 0
 
 

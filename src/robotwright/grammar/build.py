@@ -14,6 +14,7 @@ modified-DH row, and each branch (base to one end part) has a DH table.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import mujoco
@@ -125,6 +126,11 @@ class LimbJoint:
     peak_torque: float
     peak_velocity: float
     node: int
+    #: What the joint's bearing (hinge) or guide (slide) carries besides the motor's
+    #: axis: force [N] (a slide's: across its axis) and moment [N m] (a hinge's: about
+    #: the axes across its own); ``inf`` where the component gives no rating.
+    peak_bearing_force: float = math.inf
+    peak_bearing_moment: float = math.inf
 
 
 @dataclass
@@ -476,6 +482,8 @@ class _Builder:
                     jcomp.actuator["peak_torque"],
                     jcomp.actuator["peak_velocity"],
                     jnode.id,
+                    jcomp.actuator.get("peak_bearing_force", math.inf),
+                    jcomp.actuator.get("peak_bearing_moment", math.inf),
                 )
             )
             h = jcomp.housing

@@ -100,7 +100,10 @@ class Component:
         rgba: colour.
         dofs: joint DoFs (connectors only; one DoF per entry).
         housing: connector housing cylinder ``{"diameter": m, "length": m}``.
-        actuator: ``{"peak_torque": N m or N, "peak_velocity": rad/s or m/s}`` (connectors).
+        actuator: ``{"peak_torque": N m or N, "peak_velocity": rad/s or m/s}`` (connectors),
+            optionally ``"peak_bearing_force"`` [N] and ``"peak_bearing_moment"`` [N m]:
+            what the joint's bearing (hinge) or guide (slide) carries besides its axis
+            (the ``payload`` objective counts them; no rating: not limited).
     """
 
     name: str

@@ -49,6 +49,10 @@ _EXPECTED = {
 }
 
 
+#: The ratings a connector's actuator may give (N m or N, rad/s or m/s, N, N m).
+_ACTUATOR_KEYS = ("peak_torque", "peak_velocity", "peak_bearing_force", "peak_bearing_moment")
+
+
 def _name_error(name: object, pattern: re.Pattern[str]) -> str | None:
     """Why ``name`` cannot name a grammar part (``pattern``: what design files hold)."""
     text = str(name)
@@ -291,6 +295,12 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
             for need in ("peak_torque", "peak_velocity"):
                 if need not in (spec.get("actuator") or {}):
                     err(f"actuator needs '{need}'", "actuator")
+            for key in spec.get("actuator") or {}:
+                if key not in _ACTUATOR_KEYS:
+                    err(
+                        f"unknown actuator rating {key!r}; expected {', '.join(_ACTUATOR_KEYS)}",
+                        "actuator",
+                    )
         density = _num(spec.get("density", 1000.0))
         if density is None or not 0 < density <= MAX_DENSITY:
             err(

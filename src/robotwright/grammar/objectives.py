@@ -11,6 +11,7 @@ worn by its carrier (:mod:`robotwright.grammar.physics`).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Protocol, runtime_checkable
@@ -45,6 +46,14 @@ class EvalContext:
     @cached_property
     def limb(self) -> Limb:
         return build(self.grammar, self.design)
+
+    def value(self, objective: Objective) -> float:
+        """``objective`` on this design, computed once (a weighted sum and the values
+        reported beside it share one computation)."""
+        cache = self.__dict__.setdefault("_values", {})
+        if objective not in cache:
+            cache[objective] = float(objective(self))
+        return cache[objective]
 
     @cached_property
     def model(self) -> mujoco.MjModel:
@@ -358,6 +367,65 @@ class NoCarrierCollision:
         return f"touches the carrier at {poses} of {self.samples + 1} poses (first: pose {k}, {a} and {b})"
 
 
+def signed(objective: Objective, value: float) -> float:
+    """``value`` oriented so that larger is better (negated for a minimised objective)."""
+    return value if objective.maximize else -value
+
+
+@dataclass(frozen=True)
+class WeightedSum:
+    """Several objectives as one score: ``sum(w_i * v_i)``, each value oriented so that
+    larger is better (a minimised objective's value enters negated). Units differ
+    between objectives (m, kg, W, ...): the weights carry the exchange rate, e.g.
+    ``payload`` and ``mass`` with weights 1, 2 trade 2 kg of payload for 1 kg of limb."""
+
+    parts: tuple[Objective, ...]
+    weights: tuple[float, ...]
+    name: str = "weighted-sum"
+    maximize: bool = True
+
+    def __post_init__(self) -> None:
+        if len(self.parts) < 2 or len(self.parts) != len(self.weights):
+            raise ValueError(
+                f"weighted sum: expected one weight per objective and at least two objectives, "
+                f"got {len(self.weights)} weight(s) for {len(self.parts)}"
+            )
+        if not all(isinstance(w, (int, float)) and math.isfinite(w) for w in self.weights):
+            raise ValueError(f"weighted sum: weights must be finite numbers, got {self.weights}")
+
+    def __call__(self, ctx: EvalContext) -> float:
+        return sum(w * signed(o, ctx.value(o)) for o, w in zip(self.parts, self.weights))
+
+
+def dominates(a: Evaluation, b: Evaluation, objectives: Sequence[Objective]) -> bool:
+    """``a`` is at least as good as ``b`` in every objective and better in one."""
+    better = False
+    for o in objectives:
+        x, y = signed(o, a.values[o.name]), signed(o, b.values[o.name])
+        if x < y:
+            return False
+        better |= x > y
+    return better
+
+
+def pareto_front(
+    evaluations: Sequence[Evaluation], objectives: Sequence[Objective]
+) -> list[Evaluation]:
+    """The feasible evaluations no other feasible one dominates (first objective's best
+    first; of designs with equal values, the first evaluated)."""
+    feasible = [e for e in evaluations if e.feasible]
+    front: list[Evaluation] = []
+    seen: set[tuple[float, ...]] = set()
+    for e in feasible:
+        key = tuple(e.values[o.name] for o in objectives)
+        if key in seen or any(dominates(f, e, objectives) for f in feasible):
+            continue
+        seen.add(key)
+        front.append(e)
+    first = objectives[0]
+    return sorted(front, key=lambda e: -signed(first, e.values[first.name]))
+
+
 OBJECTIVES: dict[str, type] = {
     "reach": Reach,
     "workspace": WorkspaceVolume,
@@ -410,17 +478,38 @@ def make_constraint(text: str) -> Constraint:
 
 @dataclass(frozen=True)
 class Evaluation:
-    """Result of evaluating one design: objective values, violations, and the score
-    (the first objective, negated when minimised; ``-inf`` when infeasible)."""
+    """Result of evaluating one design: objective values, violations, the score (the
+    first objective, negated when minimised; ``-inf`` when infeasible) and the
+    tie-break (the second objective, oriented alike; 0 when there is none), which
+    orders designs of equal score (two limbs both at a physical bound)."""
 
     design: Design
     values: dict[str, float] = field(default_factory=dict)
     violations: tuple[str, ...] = ()
     score: float = float("-inf")
+    tiebreak: float = 0.0
 
     @property
     def feasible(self) -> bool:
         return not self.violations
+
+    @property
+    def rank_key(self) -> tuple[float, float]:
+        """What orders designs, larger first: (score, tie-break)."""
+        return (self.score, self.tiebreak)
+
+
+def scored(
+    design: Design,
+    values: dict[str, float],
+    violations: tuple[str, ...],
+    objectives: Sequence[Objective],
+) -> Evaluation:
+    """An :class:`Evaluation` with its score and tie-break from ``values``."""
+    first = objectives[0]
+    score = signed(first, values[first.name]) if not violations else float("-inf")
+    tie = signed(objectives[1], values[objectives[1].name]) if len(objectives) > 1 else 0.0
+    return Evaluation(design, values, violations, score, tie)
 
 
 def evaluate(
@@ -429,10 +518,9 @@ def evaluate(
     objectives: tuple[Objective, ...],
     constraints: tuple[Constraint, ...] = (),
 ) -> Evaluation:
-    """Evaluate a design: every objective and constraint on one shared context."""
+    """Evaluate a design: every objective and constraint on one shared context. The
+    first objective scores it, the second breaks ties (see :class:`Evaluation`)."""
     ctx = EvalContext(grammar, design)
-    values = {o.name: float(o(ctx)) for o in objectives}
+    values = {o.name: ctx.value(o) for o in objectives}
     violations = tuple(v for c in constraints if (v := c(ctx)) is not None)
-    first = objectives[0]
-    score = values[first.name] if first.maximize else -values[first.name]
-    return Evaluation(design, values, violations, score if not violations else float("-inf"))
+    return scored(design, values, violations, objectives)

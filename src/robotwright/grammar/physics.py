@@ -117,6 +117,9 @@ class Mounted:
     hi: np.ndarray
     sites: list[int]  # tool-point site ids, branch order
     limb_bodies: frozenset[int]
+    #: Rated joints: (joint id, is a slide, bearing force N, bearing moment N m, the
+    #: tool sites carried by the joint).
+    bearings: tuple[tuple[int, bool, float, float, tuple[int, ...]], ...] = ()
 
     def is_limb_geom(self, geom: int) -> bool:
         return int(self.model.geom_bodyid[geom]) in self.limb_bodies
@@ -135,14 +138,78 @@ def mount(limb: Limb, carrier: Carrier = Carrier()) -> Mounted:
     model = spec.compile()
     peak = np.array([j.peak_torque for j in limb.joints], dtype=float)
     rng = limb.joint_ranges()
+    sites = [model.site(carrier.prefix + br.site).id for br in limb.branches]
+    bearings = []
+    for j in limb.joints:
+        if math.isinf(j.peak_bearing_force) and math.isinf(j.peak_bearing_moment):
+            continue
+        jid = model.joint(carrier.prefix + j.name).id
+        body = int(model.jnt_bodyid[jid])
+        carried = tuple(s for s in sites if _in_subtree(model, int(model.site_bodyid[s]), body))
+        slide = int(model.jnt_type[jid]) == mujoco.mjtJoint.mjJNT_SLIDE
+        bearings.append((jid, slide, j.peak_bearing_force, j.peak_bearing_moment, carried))
     return Mounted(
         model,
         peak,
         rng[:, 0].copy(),
         rng[:, 1].copy(),
-        [model.site(carrier.prefix + br.site).id for br in limb.branches],
+        sites,
         frozenset(model.body(n).id for n in names),
+        tuple(bearings),
     )
+
+
+def _in_subtree(model: mujoco.MjModel, body: int, root: int) -> bool:
+    while body > 0:
+        if body == root:
+            return True
+        body = int(model.body_parentid[body])
+    return root == 0
+
+
+def bearing_loads(
+    m: Mounted, data: mujoco.MjData, joint: int, slide: bool, carried: tuple[int, ...]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """What a joint's bearing (hinge) or guide (slide) carries holding the pose in
+    ``data`` (kinematics and ``subtree_com`` computed) still, as ``(f0, f1, t0, t1)``:
+    the force [N] is ``f0 + M f1`` and the moment about the joint [N m] ``t0 + M t1``
+    with ``M`` kg hung at each tool point the joint carries (world frame). The weight
+    of everything beyond the joint is carried there; the motor takes what acts along
+    its axis (a slide's force along it, a hinge's moment about it), the bearing the
+    rest (a slide's force across its axis and its whole moment, a hinge's whole force
+    and its moment about the two axes across its own)."""
+    model = m.model
+    g = model.opt.gravity
+    body = int(model.jnt_bodyid[joint])
+    anchor, axis = data.xanchor[joint], data.xaxis[joint]
+    mass = float(model.body_subtreemass[body])
+    # Weights hang downward: the joint supports them with the opposite force.
+    f0 = -mass * g
+    t0 = np.cross(data.subtree_com[body] - anchor, -mass * g)
+    f1 = -len(carried) * g
+    t1 = np.zeros(3)
+    for s in carried:
+        t1 += np.cross(data.site_xpos[s] - anchor, -g)
+
+    def across(v: np.ndarray) -> np.ndarray:
+        return v - np.dot(v, axis) * axis
+
+    if slide:
+        return across(f0), across(f1), t0, t1
+    return f0, f1, across(t0), across(t1)
+
+
+def _max_mass_norm(u: np.ndarray, v: np.ndarray, limit: float) -> float:
+    """Largest ``M >= 0`` with ``|u + M v| <= limit`` (0 when ``|u| > limit`` already;
+    ``inf`` when ``v`` is 0 or the limit infinite)."""
+    if math.isinf(limit):
+        return math.inf
+    uu, uv, vv = float(u @ u), float(u @ v), float(v @ v)
+    if uu > limit * limit:
+        return 0.0
+    if vv < 1e-24:
+        return math.inf
+    return max((-uv + math.sqrt(max(uv * uv - vv * (uu - limit * limit), 0.0))) / vv, 0.0)
 
 
 def sample_poses(m: Mounted, samples: int, seed: int) -> np.ndarray:
@@ -247,9 +314,12 @@ def payload(
     some pose. Every sampled pose counts: a pose where the limb touches itself or the
     carrier is one it cannot take, and when fewer than ``min_free_share`` of the poses
     are free the payload is 0 (a limb free at 2 poses of 33 does not score on those
-    two). The payload is at most ``limit`` kg, a physical bound reported as such
-    (``bounded``): a limb whose joints bear no load (no joint, or horizontal slides)
-    holds anything its carrier carries.
+    two). Each joint's bearing or guide must carry its share as well, within the
+    component's ``peak_bearing_force`` and ``peak_bearing_moment`` (see
+    :func:`bearing_loads`): a horizontal slide whose motor holds nothing still carries
+    the load across its axis. The payload is at most ``limit`` kg, a physical bound
+    reported as such (``bounded``): a limb whose joints have no ratings and bear no load
+    (no joint, or horizontal slides) holds anything its carrier carries.
     """
     check_settings(
         "payload", samples=samples, seed=seed, limit=limit, min_free_share=min_free_share
@@ -271,7 +341,11 @@ def payload(
     per_pose = np.empty(len(poses))
     for k, qk in enumerate(poses):
         tau0, a = holding_torques(m, qk, data)
-        per_pose[k] = _max_mass(tau0, a, m.peak)
+        best = _max_mass(tau0, a, m.peak)
+        for joint, slide, force, moment, carried in m.bearings:
+            f0, f1, t0, t1 = bearing_loads(m, data, joint, slide, carried)
+            best = min(best, _max_mass_norm(f0, f1, force), _max_mass_norm(t0, t1, moment))
+        per_pose[k] = best
     worst = int(np.argmin(per_pose))
     mass = float(per_pose[worst])
     return PayloadResult(min(mass, limit), worst, poses, per_pose, share, mass >= limit)

@@ -184,7 +184,7 @@ def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
 
 def _best(evals: list[Evaluation]) -> Evaluation | None:
     feasible = [e for e in evals if e.feasible]
-    return max(feasible, key=lambda e: e.score) if feasible else None
+    return max(feasible, key=lambda e: e.rank_key) if feasible else None
 
 
 def random_search(

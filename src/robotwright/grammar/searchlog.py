@@ -41,7 +41,7 @@ from typing import IO, Any
 from robotwright._inputs import MAX_NESTING, read_text
 from robotwright.errors import GrammarError, InputFileError
 from robotwright.grammar.design import Design
-from robotwright.grammar.objectives import Constraint, Evaluation, Objective
+from robotwright.grammar.objectives import Constraint, Evaluation, Objective, scored
 
 __all__ = ["FORMAT", "MAX_LOG_BYTES", "SearchLog", "read_log"]
 
@@ -201,7 +201,6 @@ def read_log(
     text = read_text(path, MAX_LOG_BYTES)
     want_obj = _settings(objectives)
     want_con = _settings(constraints)
-    first = objectives[0]
     found: dict[str, tuple[int, Evaluation]] = {}
     header_seen = False
     lines = text.split("\n")
@@ -248,7 +247,7 @@ def read_log(
             if not header_seen:
                 raise _Bad("an evaluation before any 'search' line; expected a search line first")
             _keys(rec, _EVAL_KEYS, "evaluation")
-            ev = _evaluation(rec, grammar, first, [o["name"] for o in want_obj])
+            ev = _evaluation(rec, grammar, objectives, [o["name"] for o in want_obj])
             h = rec.get("hash")
             if h != ev.design.hash():
                 raise _Bad(
@@ -284,7 +283,7 @@ def _same_values(a: Mapping[str, float], b: Mapping[str, float]) -> bool:
 
 
 def _evaluation(
-    rec: dict[str, Any], grammar: str, first: Objective, names: list[str]
+    rec: dict[str, Any], grammar: str, objectives: Sequence[Objective], names: list[str]
 ) -> Evaluation:
     _int(rec.get("iteration"), "iteration")
     if rec.get("seed") is not None:
@@ -319,6 +318,4 @@ def _evaluation(
         raise _Bad("violations is not a list of strings")
     if "feasible" in rec and rec["feasible"] is not (not violations):
         raise _Bad("feasible disagrees with violations (feasible means no violation)")
-    v0 = vals[first.name]
-    score = (v0 if first.maximize else -v0) if not violations else -math.inf
-    return Evaluation(design, vals, tuple(violations), score)
+    return scored(design, vals, tuple(violations), objectives)

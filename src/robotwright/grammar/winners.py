@@ -14,7 +14,8 @@ URDF, design text/JSON, tree, picture of the limb alone), readable by
   reference, seen from the front (y-z) and from above (x-y).
 
 ``OUT/winners.txt`` lists the ranking. The whole folder is written at once (a failure
-leaves the earlier output, or none).
+leaves the earlier output, or none). A Pareto search writes ``front_1`` ... instead, with
+``front.json`` and ``pareto.png`` (:func:`write_front`).
 """
 
 from __future__ import annotations
@@ -55,9 +56,10 @@ UNITS = {
 
 
 def ranked(evaluations: Sequence[Evaluation], k: int) -> list[Evaluation]:
-    """The ``k`` best feasible evaluations by score (earlier first on ties)."""
+    """The ``k`` best feasible evaluations by score, then tie-break (earlier first on
+    ties of both)."""
     feasible = [(i, e) for i, e in enumerate(evaluations) if e.feasible]
-    feasible.sort(key=lambda t: (-t[1].score, t[0]))
+    feasible.sort(key=lambda t: (-t[1].score, -t[1].tiebreak, t[0]))
     return [e for _, e in feasible[:k]]
 
 
@@ -81,16 +83,85 @@ def write_winners(
         OutputExistsError: ``out`` holds something other than an earlier folder of
             designs (callers check ``--overwrite`` before).
     """
+    return _write_designs(
+        grammar,
+        ranked(evaluations, k),
+        objectives,
+        Path(out),
+        "best",
+        carrier=carrier,
+        pictures=pictures,
+        draw_carrier=draw_carrier,
+    )
+
+
+def write_front(
+    grammar: Grammar,
+    front: Sequence[Evaluation],
+    objectives: Sequence[Objective],
+    out: str | Path,
+    *,
+    evaluated: Sequence[Evaluation] = (),
+    carrier: Carrier = DEFAULT_CARRIER,
+    pictures: bool = True,
+    draw_carrier: DrawPose | None = None,
+) -> list[Path]:
+    """Write a Pareto front into ``out``: ``front_1`` ... (design folders as
+    :func:`write_winners` writes them, in the front's order), ``front.json`` (each
+    design's values with units) and, with ``pictures`` and two objectives or more,
+    ``pareto.png``: the first two objectives of every feasible design ``evaluated``
+    (grey) and of the front (joined), numbered as the folders."""
+    names = [o.name for o in objectives]
+
+    def extra(tmp: Path) -> None:
+        rows = [
+            {
+                "folder": f"front_{i}",
+                "design_hash": ev.design.hash(),
+                "values": {n: {"value": ev.values[n], "unit": UNITS.get(n, "")} for n in names},
+            }
+            for i, ev in enumerate(front, 1)
+        ]
+        (tmp / "front.json").write_text(json.dumps(rows, indent=2) + "\n", "utf-8")
+        if pictures and len(objectives) >= 2:
+            plot_front(front, evaluated, objectives, tmp / "pareto.png")
+
+    return _write_designs(
+        grammar,
+        list(front),
+        objectives,
+        Path(out),
+        "front",
+        carrier=carrier,
+        pictures=pictures,
+        draw_carrier=draw_carrier,
+        extra=extra,
+    )
+
+
+def _write_designs(
+    grammar: Grammar,
+    chosen: Sequence[Evaluation],
+    objectives: Sequence[Objective],
+    out: Path,
+    prefix: str,
+    *,
+    carrier: Carrier,
+    pictures: bool,
+    draw_carrier: DrawPose | None,
+    extra: Callable[[Path], None] | None = None,
+) -> list[Path]:
+    """``out/<prefix>_N`` for each of ``chosen`` (folder, values, pictures), the list
+    ``winners.txt`` and whatever ``extra(tmp)`` adds, written at once."""
     from robotwright.grammar.export import export_design
 
-    out = Path(out)
-    best = ranked(evaluations, k)
     names = [o.name for o in objectives]
     lines = []
     written = []
     with atomic_dir(out, kind="designs") as tmp:
-        for rank, ev in enumerate(best, 1):
-            folder = tmp / f"best_{rank}"
+        for rank, ev in enumerate(chosen, 1):
+            label = f"{prefix}_{rank}"
+            folder = tmp / label
             export_design(grammar, ev.design, folder, picture=pictures, overwrite=True)
             values = {
                 "rank": rank,
@@ -108,19 +179,78 @@ def write_winners(
                 f"rank {rank}, design {ev.design.hash()}\n{text}", "utf-8"
             )
             summary = ", ".join(f"{n} {ev.values[n]:.4g} {UNITS.get(n, '')}" for n in names)
-            lines.append(f"best_{rank}: {ev.design.hash()}  {summary.strip()}\n")
+            lines.append(f"{label}: {ev.design.hash()}  {summary.strip()}\n")
             if pictures:
                 limb = build(grammar, ev.design)
                 m = mount(limb, carrier)
                 if draw_carrier is not None:
-                    title = f"best_{rank} on its carrier"
+                    title = f"{label} on its carrier"
                     draw_carrier(m.model, display_pose(limb), folder / "on_carrier.png", title)
                 if {"track", "energy"} & set(names):
                     run = track(limb, carrier, mounted=m)
-                    plot_track(run, folder / "track.png", f"best_{rank} ({ev.design.hash()})")
-            written.append(out / f"best_{rank}")
+                    plot_track(run, folder / "track.png", f"{label} ({ev.design.hash()})")
+            written.append(out / label)
         (tmp / "winners.txt").write_text("".join(lines) or "no feasible design\n", encoding="utf-8")
+        if extra is not None:
+            extra(tmp)
     return written
+
+
+def plot_front(
+    front: Sequence[Evaluation],
+    evaluated: Sequence[Evaluation],
+    objectives: Sequence[Objective],
+    path: Path,
+) -> None:
+    """The first two objectives (with units) of every feasible design evaluated and of
+    the Pareto front, the front's designs numbered as their folders."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only; never open a window
+    import matplotlib.pyplot as plt
+
+    from robotwright._atomic import atomic_open
+
+    a, b = objectives[0], objectives[1]
+
+    def label(o: Objective) -> str:
+        unit = UNITS.get(o.name, "")
+        better = "larger" if o.maximize else "smaller"
+        return f"{o.name}" + (f" [{unit}]" if unit else "") + f" ({better} is better)"
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    rest = [e for e in evaluated if e.feasible]
+    if rest:
+        ax.scatter(
+            [e.values[a.name] for e in rest],
+            [e.values[b.name] for e in rest],
+            s=10,
+            c="0.7",
+            label=f"feasible designs evaluated ({len(rest)})",
+        )
+    xs = [e.values[a.name] for e in front]
+    ys = [e.values[b.name] for e in front]
+    order = sorted(range(len(front)), key=lambda i: xs[i])
+    ax.plot(
+        [xs[i] for i in order],
+        [ys[i] for i in order],
+        "-o",
+        color="tab:red",
+        ms=6,
+        lw=1.2,
+        label=f"Pareto front ({len(front)})",
+    )
+    for i, (x, y) in enumerate(zip(xs, ys, strict=True), 1):
+        ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(5, 4), fontsize=8)
+    ax.set_xlabel(label(a))
+    ax.set_ylabel(label(b))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title("Pareto front (numbers: front_N folders)")
+    fig.tight_layout()
+    with atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format="png", dpi=90)
+    plt.close(fig)
 
 
 def plot_track(run: TrackResult, path: Path, title: str) -> None:
