@@ -25,7 +25,6 @@ from robotwright.grammar.objectives import (
 from robotwright.grammar.search import random_search
 from robotwright.grammar.winners import ranked
 
-
 REACH_MASS = (Reach(), Mass())
 
 
