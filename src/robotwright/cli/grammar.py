@@ -200,6 +200,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "random samples evenly",
     )
     q.add_argument(
+        "--task",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="a task YAML: the carrier and where the limb is worn, the payload test, the "
+        "path to track, the collision check (see docs/grammar.md); default: the built-in "
+        "task (mini_humanoid's back, the circle and line)",
+    )
+    q.add_argument(
         "--constraint",
         action="append",
         default=None,
@@ -457,15 +466,15 @@ def _weights(text: str) -> tuple[float, ...]:
     return values
 
 
-def _objectives(args: argparse.Namespace) -> tuple[list, list] | str:
+def _objectives(args: argparse.Namespace, task) -> tuple[list, list] | str:  # noqa: ANN001
     """(objectives the search evaluates, in order: the scoring one first, the tie-break
-    second; the objectives the user named), or the error message."""
-    from robotwright.grammar.objectives import OBJECTIVES, WeightedSum
+    second; the objectives the user named), set for ``task``, or the error message."""
+    from robotwright.grammar.objectives import WeightedSum
 
     names = args.objective or ["reach"]
     if len(set(names)) != len(names):
         return f"--objective: {', '.join(names)} names one twice; expected each once"
-    named = [OBJECTIVES[n]() for n in names]
+    named = [task.objective(n) for n in names]
     if args.pareto:
         if len(named) < 2 or args.weights is not None:
             return "--pareto: expected two --objective or more, and no --weights"
@@ -478,7 +487,7 @@ def _objectives(args: argparse.Namespace) -> tuple[list, list] | str:
             )
         return [WeightedSum(tuple(named), args.weights), *named], named
     if len(named) == 1 and args.tie_break not in ("none", names[0]):
-        return [*named, OBJECTIVES[args.tie_break]()], named
+        return [*named, task.objective(args.tie_break)], named
     return named, named
 
 
@@ -497,11 +506,12 @@ def _value_text(objective: object, value: float) -> str:
 
 
 def _search(args: argparse.Namespace) -> int:
-    from robotwright.grammar.objectives import make_constraint
     from robotwright.grammar.search import beam_search, check_workers, mcts_search, random_search
+    from robotwright.grammar.task import DEFAULT_TASK, load_task
 
     g = _grammar(args)
-    chosen = _objectives(args)
+    task = load_task(args.task) if args.task is not None else DEFAULT_TASK
+    chosen = _objectives(args, task)
     if isinstance(chosen, str):
         print(f"error: {chosen}", file=sys.stderr)
         return 2
@@ -509,7 +519,7 @@ def _search(args: argparse.Namespace) -> int:
     if args.out:
         _check_design_dir(args.out, args.overwrite, kind="designs")
     try:
-        constraints = [make_constraint(c) for c in (args.constraint or _default_constraints(args))]
+        constraints = [task.constraint(c) for c in (args.constraint or _default_constraints(args))]
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -66,13 +66,24 @@ class EvalContext:
             cache[carrier] = mount(self.limb, carrier)
         return cache[carrier]
 
-    def tracking(self, carrier: Carrier, duration: float, scale: float) -> TrackResult:
+    def tracking(
+        self,
+        carrier: Carrier,
+        duration: float,
+        scale: float,
+        path: tuple[tuple[float, float, float], ...] | None = None,
+    ) -> TrackResult:
         """One tracking run (shared by ``track`` and ``energy``)."""
-        key = (carrier, duration, scale)
+        key = (carrier, duration, scale, path)
         cache = self.__dict__.setdefault("_tracks", {})
         if key not in cache:
             cache[key] = track(
-                self.limb, carrier, duration=duration, scale=scale, mounted=self.mounted(carrier)
+                self.limb,
+                carrier,
+                duration=duration,
+                scale=scale,
+                mounted=self.mounted(carrier),
+                path=path,
             )
         return cache[key]
 
@@ -311,12 +322,15 @@ class _TrackingRun:
     duration: float = 2.0
     scale: float = 0.15
     carrier: Carrier = Carrier()
+    #: Waypoints [m] (offsets from the tool point at the display pose) to follow instead
+    #: of the circle and line; ``scale`` is then unused.
+    path: tuple[tuple[float, float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         check_settings(type(self).__name__, duration=self.duration, scale=self.scale)
 
     def _run(self, ctx: EvalContext) -> TrackResult:
-        return ctx.tracking(self.carrier, self.duration, self.scale)
+        return ctx.tracking(self.carrier, self.duration, self.scale, self.path)
 
 
 @dataclass(frozen=True)

@@ -389,6 +389,19 @@ def reference_path(center: np.ndarray, radius: float, duration: float, n: int) -
     return out
 
 
+def waypoint_path(center: np.ndarray, waypoints: np.ndarray, duration: float, n: int) -> np.ndarray:
+    """``n`` points (m) of a reference through ``center + waypoints[k]`` in order over
+    ``duration`` s, each leg given the same time and started and stopped at rest
+    (minimum-jerk timing); the first waypoint is where the reference starts."""
+    wp = center + np.asarray(waypoints, dtype=float)
+    legs = len(wp) - 1
+    t = np.linspace(0.0, duration, n)
+    u = np.clip(t / duration * legs, 0.0, legs)
+    k = np.minimum(u.astype(int), legs - 1)
+    s = _smooth(u - k)[:, None]
+    return wp[k] + s * (wp[k + 1] - wp[k])
+
+
 def ik_path(
     m: Mounted,
     targets: np.ndarray,
@@ -447,8 +460,11 @@ def track(
     omega: float = 30.0,
     reach: float | None = None,
     mounted: Mounted | None = None,
+    path: tuple[tuple[float, float, float], ...] | None = None,
 ) -> TrackResult:
-    """Follow the reference of :func:`reference_path` with the first tool point.
+    """Follow the reference of :func:`reference_path` with the first tool point (or,
+    given ``path``, the waypoints of :func:`waypoint_path`: offsets [m] from the tool
+    point at the display pose, world frame).
 
     Reference: centred on the tool point at the limb's display pose (revolute joints at
     +-0.5 rad, prismatic at mid-stroke), radius ``scale`` times the limb's reach (the
@@ -477,9 +493,18 @@ def track(
     data.qpos[:] = qn
     mujoco.mj_kinematics(model, data)
     center = data.site_xpos[m.sites[0]].copy()
-    if reach is None:
-        reach = _reach(limb)
-    ref = reference_path(center, scale * reach, duration, steps + 1)
+    if path is not None:
+
+        def reference(n: int) -> np.ndarray:
+            return waypoint_path(center, np.asarray(path), duration, n)
+
+    else:
+        radius = scale * (_reach(limb) if reach is None else reach)
+
+        def reference(n: int) -> np.ndarray:
+            return reference_path(center, radius, duration, n)
+
+    ref = reference(steps + 1)
     nv = model.nv
     if nv == 0:
         path = np.repeat(center[None], steps + 1, axis=0)
@@ -487,7 +512,7 @@ def track(
         return TrackResult(float(np.sqrt(np.mean(err**2))), 0.0, ref, path, dt)
     coarse = max(2, int(round(duration * 100)) + 1)
     tc = np.linspace(0.0, duration, coarse)
-    qc = ik_path(m, reference_path(center, scale * reach, duration, coarse), qn)
+    qc = ik_path(m, reference(coarse), qn)
     t = np.linspace(0.0, duration, steps + 1)
     # Velocities and accelerations from the 100 Hz samples, then interpolated: the
     # derivatives of the piecewise-linear interpolant would be spikes at every sample.
