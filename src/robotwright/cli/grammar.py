@@ -200,6 +200,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "random samples evenly",
     )
     q.add_argument(
+        "--refine",
+        type=_int_at_least(2),
+        default=None,
+        metavar="N",
+        help="then search the best design's continuous parameters (link lengths, strokes, "
+        "joint limits ...) anywhere within their ranges by CMA-ES for N evaluations, "
+        "keeping its structure (pip install 'robotwright[cma]'; not with --pareto)",
+    )
+    q.add_argument(
         "--task",
         type=Path,
         default=None,
@@ -536,6 +545,17 @@ def _search(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.refine is not None and args.pareto:
+        print("error: --refine: refines the best design of one score, not a front", file=sys.stderr)
+        return 2
+    if args.refine is not None:
+        from robotwright.grammar.refine import _cma
+
+        try:
+            _cma()
+        except ImportError as exc:
+            print(f"error: --refine: {exc}", file=sys.stderr)
+            return 2
     if args.batch is not None and args.method != "mcts":
         print(f"error: --batch: applies to --method mcts, not {args.method}", file=sys.stderr)
         return 2
@@ -572,11 +592,16 @@ def _search(args: argparse.Namespace) -> int:
             res = mcts_search(g, objectives, constraints, batch=batch, **kw)
         else:
             res = random_search(g, objectives, constraints, **kw)
+        refined = ""
+        if args.refine is not None and res.best is not None:
+            refined = _refine(args, g, res, objectives, constraints, executor)
     dt = time.perf_counter() - t0
     print(
         f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s "
         f"(stopped: {res.stopped})"
     )
+    if refined:
+        print(refined)
     if res.best is None:
         print("no feasible design found")
         return 1
@@ -603,6 +628,40 @@ def _search(args: argparse.Namespace) -> int:
         )
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
     return 0
+
+
+def _refine(args: argparse.Namespace, g, res, objectives, constraints, executor) -> str:  # noqa: ANN001
+    """CMA-ES over the best design's continuous parameters; its evaluations join the
+    search's, so the winners and the best include them. Returns the line to print."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from robotwright.grammar.refine import refine
+
+    before = res.best
+    pool = executor or ProcessPoolExecutor(args.workers or None)
+    try:
+        out = refine(
+            g,
+            before.design,
+            objectives,
+            constraints,
+            budget=args.refine,
+            seed=args.seed,
+            executor=pool,
+        )
+    finally:
+        if executor is None:
+            pool.shutdown()
+    res.evaluations.extend(out.evaluations[1:])
+    if out.best.rank_key > before.rank_key:
+        res.best = out.best
+    first = objectives[0]
+    return (
+        f"refined {len(out.parameters)} continuous parameter(s) of design "
+        f"{before.design.hash()} over {len(out.evaluations)} evaluations (CMA-ES): "
+        f"{_value_text(first, before.values[first.name])} -> "
+        f"{_value_text(first, res.best.values[first.name])}"
+    )
 
 
 def _report_front(args: argparse.Namespace, g, res, objectives: list) -> int:  # noqa: ANN001
