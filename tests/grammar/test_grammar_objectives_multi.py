@@ -141,3 +141,29 @@ def test_a_search_with_a_tie_break_gives_the_same_winner_on_any_worker_count() -
         b = random_search(g, objs, (), executor=two, **kw)
     assert a.best is not None and a.best.design.hash() == b.best.design.hash()
     assert a.best.rank_key == max(e.rank_key for e in a.evaluations if e.feasible)
+
+
+@pytest.mark.parametrize("method", ["beam", "mcts"])
+def test_payload_winners_neither_touch_the_carrier_nor_sit_at_the_bound(method) -> None:
+    """The audit's case: beam and MCTS (budget 150) found 100 kg winners on every seed,
+    limbs of horizontal slides or one joint touching the carrier. With every pose
+    counted, the carrier check on by default and the bearings carrying their share,
+    the winners hold a real payload below the bound and are free of the carrier."""
+    from robotwright.grammar import physics as P
+    from robotwright.grammar.build import build
+    from robotwright.grammar.objectives import NoCarrierCollision, NoSelfCollision
+    from robotwright.grammar.search import beam_search, mcts_search
+
+    g = default_grammar()
+    objs = [Payload(), Mass()]
+    cons = [NoSelfCollision(), NoCarrierCollision()]
+    search = beam_search if method == "beam" else mcts_search
+    for seed in (0, 1):
+        res = search(g, objs, cons, budget=150, max_links=4, seed=seed, workers=1)
+        best = res.best
+        assert best is not None and best.feasible
+        assert 0.0 < best.values["payload"] < 100.0
+        limb = build(g, best.design)
+        m = P.mount(limb)
+        assert P.carrier_collisions(m, P.sample_poses(m, 32, 0)) == []
+        assert not P.payload(limb, mounted=m).bounded
