@@ -38,3 +38,12 @@ def one_choice_library() -> dict[str, Any]:
         for p in (comp.get("params") or {}).values():
             p["values"] = p["values"][:1]
     return lib
+
+
+#: A 3-DoF arm of the bundled grammar (universal + revolute joints, a tool).
+ARM = """# grammar=srl
+r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()
+r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r3 @3: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r4 @5: E=tool(length=0.08)
+"""

@@ -28,12 +28,7 @@ from robotwright.grammar.objectives import (
     make_constraint,
 )
 
-ARM = """# grammar=srl
-r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()
-r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
-r3 @3: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
-r4 @5: E=tool(length=0.08)
-"""
+from .helpers import ARM
 
 
 @pytest.fixture(scope="module")

@@ -13,14 +13,9 @@ from robotwright.grammar.design import Design
 from robotwright.grammar.objectives import Mass, NoSelfCollision, Reach
 from robotwright.grammar.refine import parameters, refine, with_values
 
-pytest.importorskip("cma", reason="pycma not installed (robotwright[cma]; the test extra has it)")
+from .helpers import ARM
 
-ARM = """# grammar=srl
-r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()
-r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
-r3 @3: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
-r4 @5: E=tool(length=0.08)
-"""
+pytest.importorskip("cma", reason="pycma not installed (robotwright[cma]; the test extra has it)")
 
 
 @pytest.fixture(scope="module")

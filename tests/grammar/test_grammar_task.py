@@ -15,12 +15,7 @@ from robotwright.grammar.design import Design
 from robotwright.grammar.objectives import Energy, NoCarrierCollision, Payload, Track
 from robotwright.grammar.task import DEFAULT_TASK, load_task
 
-ARM = """# grammar=srl
-r1 @0: B=base(diameter=0.08, thickness=0.02) P=pinned()
-r2 @0: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
-r3 @3: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=0.0)
-r4 @5: E=tool(length=0.08)
-"""
+from .helpers import ARM
 
 GOOD = """task: side-trace
 carrier: {robot: arm6, at: tool0, pos: [0, 0, 0.02], quat: [2, 0, 0, 0]}

@@ -22,6 +22,7 @@ import mjlab  # noqa: E402, F401 - loads the entry points
 import torch  # noqa: E402
 from mjlab.envs import ManagerBasedRlEnv  # noqa: E402
 from mjlab.tasks.registry import list_tasks, load_env_cfg, load_rl_cfg  # noqa: E402
+from mjlab_train import run_train  # noqa: E402
 
 from robotwright.sensors.mjlab import seeker  # noqa: E402
 
@@ -134,7 +135,6 @@ def test_the_benchmark_trains_both_variants_and_prints_the_comparison(tmp_path) 
 
 def test_mjlab_s_train_runs_the_seeker(tmp_path) -> None:
     """mjlab's own ``train`` entry point on the registered task (2 iterations)."""
-    code = "import sys; from mjlab.scripts.train import main; sys.argv = ['train'] + sys.argv[1:]; main()"
     args = [
         seeker.NO_LABELS_TASK_ID,
         "--env.scene.num-envs",
@@ -148,14 +148,7 @@ def test_mjlab_s_train_runs_the_seeker(tmp_path) -> None:
         "--log-root",
         str(tmp_path),
     ]
-    done = subprocess.run(
-        [sys.executable, "-c", code, *args],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=tmp_path,
-    )
-    assert done.returncode == 0, (done.stdout[-3000:], done.stderr[-3000:])
+    done = run_train(args, tmp_path, timeout=600)
     runs = list((tmp_path / "semantic_seeker_no_labels").iterdir())
     assert len(runs) == 1 and (runs[0] / "model_1.pt").is_file()
     assert "Learning iteration 1/2" in done.stdout

@@ -30,6 +30,7 @@ from mjlab.tasks.registry import list_tasks, load_env_cfg  # noqa: E402
 from mjlab.tasks.velocity import mdp as velocity_mdp  # noqa: E402
 from mjlab.tasks.velocity.mdp.terrain_utils import terrain_normal_from_sensors  # noqa: E402
 from mjlab.viewer.debug_visualizer import NullDebugVisualizer  # noqa: E402
+from mjlab_train import run_train  # noqa: E402
 
 from robotwright.sensors import mjlab as rw_mjlab  # noqa: E402
 from robotwright.sensors.mjlab.tasks import TASK_ID  # noqa: E402
@@ -293,15 +294,7 @@ def test_train_runs_two_iterations_of_the_task_on_cpu(tmp_path):
         f"--env.scene.sensors.{i}.pattern.num-rays",
         "2000",
     ]
-    code = "import sys; from mjlab.scripts.train import main; sys.argv = ['train'] + sys.argv[1:]; main()"
-    done = subprocess.run(
-        [sys.executable, "-c", code, *args],
-        capture_output=True,
-        text=True,
-        timeout=900,
-        cwd=tmp_path,
-    )
-    assert done.returncode == 0, (done.stdout[-3000:], done.stderr[-3000:])
+    done = run_train(args, tmp_path)
     runs = list((tmp_path / "go1_velocity_semantic_lidar").iterdir())
     assert len(runs) == 1
     run = runs[0]
