@@ -191,6 +191,8 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         self._buffers: dict[str, Any] = {}
         self._pool: ThreadPoolExecutor | None = None
         self._blocks: list[tuple[int, int]] = []
+        self._elapsed = 0.0  # simulated seconds since the last sense
+        self._casts = 0
 
     @property
     def class_names(self) -> tuple[str, ...]:
@@ -536,7 +538,6 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             outputs=[b["frame_pos"], b["frame_quat"], b["frame_mat"], b["frame_rot"]],
             device=dev,
         )
-        self._casts += 1
         # Off CUDA nothing is captured: when no environment publishes a scan this step
         # (update_period), the cast is skipped (the held scans stay as they are).
         if self._hold and not dev.is_cuda and not wp.to_torch(b["due"]).any():
@@ -661,8 +662,10 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         )
 
     def postprocess_rays(self) -> None:
-        """Fresh results: drop data cached before this step's cast (nothing per ray)."""
+        """Fresh results: drop data cached before this step's cast (nothing per ray),
+        and count the scan (on the host: on CUDA the cast is a replayed graph)."""
         self._invalidate_cache()
+        self._casts += 1
 
     def _compute_data(self) -> MjlabSemanticLidarData:  # type: ignore[override]
         if not self._buffers:
