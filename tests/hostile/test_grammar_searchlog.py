@@ -13,7 +13,7 @@ import pytest
 from robotwright.cli import main
 
 ARGV = ["grammar", "search", "--budget", "4", "--max-links", "1", "--workers", "1"]
-ARGV += ["--objective", "reach", "--method", "random"]
+ARGV += ["--objective", "reach", "--tie-break", "none", "--method", "random"]
 
 
 @pytest.fixture(scope="module")
