@@ -49,6 +49,8 @@ def test_refine_improves_within_the_ranges_and_is_reproducible(grammar) -> None:
     assert a.best.rank_key == max(e.rank_key for e in a.evaluations if e.feasible)
     for p in parameters(grammar, a.best.design):
         assert p.low <= p.value <= p.high
+    own = refine(grammar, design, objs, cons, budget=40, seed=3, workers=2)  # its own pool
+    assert [e.design.hash() for e in own.evaluations] == [e.design.hash() for e in a.evaluations]
     c = refine(grammar, design, objs, cons, budget=40, seed=4)
     assert [e.design.hash() for e in c.evaluations] != [e.design.hash() for e in a.evaluations]
     with pytest.raises(ValueError, match="budget"):

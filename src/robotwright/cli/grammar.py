@@ -633,25 +633,19 @@ def _search(args: argparse.Namespace) -> int:
 def _refine(args: argparse.Namespace, g, res, objectives, constraints, executor) -> str:  # noqa: ANN001
     """CMA-ES over the best design's continuous parameters; its evaluations join the
     search's, so the winners and the best include them. Returns the line to print."""
-    from concurrent.futures import ProcessPoolExecutor
-
     from robotwright.grammar.refine import refine
 
     before = res.best
-    pool = executor or ProcessPoolExecutor(args.workers or None)
-    try:
-        out = refine(
-            g,
-            before.design,
-            objectives,
-            constraints,
-            budget=args.refine,
-            seed=args.seed,
-            executor=pool,
-        )
-    finally:
-        if executor is None:
-            pool.shutdown()
+    out = refine(
+        g,
+        before.design,
+        objectives,
+        constraints,
+        budget=args.refine,
+        seed=args.seed,
+        executor=executor,
+        workers=args.workers,
+    )
     res.evaluations.extend(out.evaluations[1:])
     if out.best.rank_key > before.rank_key:
         res.best = out.best

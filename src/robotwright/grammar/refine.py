@@ -14,12 +14,15 @@ on any executor.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from concurrent.futures import Executor
+import os
+from collections.abc import Callable, Sequence
+from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import partial
+from typing import Any
 
 from robotwright.grammar.design import Choice, Design, Step
+from robotwright.grammar.executors import die_with_parent, pool_size
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, evaluate
 from robotwright.grammar.rules import Grammar
 
@@ -100,10 +103,13 @@ def refine(
     seed: int = 0,
     sigma: float = 0.2,
     executor: Executor | None = None,
+    workers: int | None = 0,
 ) -> RefineResult:
     """Search the continuous parameters of ``design`` with CMA-ES for ``budget``
     evaluations (see the module docstring). ``sigma``: initial step, as a share of each
-    parameter's range.
+    parameter's range. Evaluations run on ``executor`` when given; else on a pool of
+    ``workers`` processes that die with this one (``None``: one per core; the default
+    0: in this process).
 
     Raises:
         ValueError: a budget below 1 or a ``sigma`` outside (0, 1].
@@ -121,6 +127,28 @@ def refine(
     if not params or budget <= 1:
         return result
     cma = _cma()
+    if executor is None and workers != 0:
+        with ProcessPoolExecutor(
+            max_workers=pool_size(workers, budget),
+            initializer=die_with_parent,
+            initargs=(os.getpid(),),
+        ) as pool:
+            return _search(cma, result, design, params, run, budget, seed, sigma, pool)
+    return _search(cma, result, design, params, run, budget, seed, sigma, executor)
+
+
+def _search(
+    cma: Any,
+    result: RefineResult,
+    design: Design,
+    params: list[Parameter],
+    run: Callable[[Design], Evaluation],
+    budget: int,
+    seed: int,
+    sigma: float,
+    executor: Executor | None,
+) -> RefineResult:
+    """The CMA-ES loop of :func:`refine` (``executor`` ``None``: in this process)."""
     span = [p.high - p.low for p in params]
     x0 = [(p.value - p.low) / s for p, s in zip(params, span, strict=True)]
     options = {
