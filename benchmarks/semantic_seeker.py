@@ -36,7 +36,7 @@ VARIANTS = (("labels", True), ("no labels", False))
 LAST = 10
 
 
-def train(labels: bool, seed: int, iterations: int, device: str) -> dict:
+def train(labels: bool, seed: int, iterations: int, device: str, solid: bool = False) -> dict:
     """One training run in this process: per-iteration metrics and timing."""
     import torch
     from mjlab.envs import ManagerBasedRlEnv
@@ -45,7 +45,7 @@ def train(labels: bool, seed: int, iterations: int, device: str) -> dict:
     from robotwright.sensors.mjlab import seeker
 
     torch.manual_seed(seed)
-    env_cfg = seeker.seeker_env_cfg(labels)
+    env_cfg = seeker.seeker_env_cfg(labels, solid=solid)
     env_cfg.seed = seed
     rl_cfg = seeker.seeker_runner_cfg(labels)
     rl_cfg.seed = seed
@@ -143,6 +143,7 @@ def _run_worker(labels: bool, seed: int, args: argparse.Namespace, out: Path) ->
         str(args.iterations),
         args.device,
         str(result),
+        "1" if args.solid else "0",
     ]
     env = dict(os.environ)
     if args.jobs > 1:  # share the cores between the runs
@@ -156,12 +157,12 @@ def _run_worker(labels: bool, seed: int, args: argparse.Namespace, out: Path) ->
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv and argv[0] == "--worker":
-        labels, seed, iterations, device, path = argv[1:6]
+        labels, seed, iterations, device, path, solid = argv[1:7]
         if device == "cpu" and os.environ.get("OMP_NUM_THREADS") == "1":
             import torch
 
             torch.set_num_threads(1)
-        result = train(labels == "1", int(seed), int(iterations), device)
+        result = train(labels == "1", int(seed), int(iterations), device, solid == "1")
         Path(path).write_text(json.dumps(result), encoding="utf-8")
         return 0
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -170,6 +171,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jobs", type=int, default=1, help="runs at a time (processes)")
     parser.add_argument("--device", default="cpu", help="torch/warp device (cpu, cuda:0)")
     parser.add_argument("--out", type=Path, default=Path("seeker_out"), help="output folder")
+    parser.add_argument(
+        "--solid",
+        action="store_true",
+        help="contacts on: the agent bumps into the cylinders (both variants alike)",
+    )
     args = parser.parse_args(argv)
     if args.iterations < 1 or args.seeds < 1 or args.jobs < 1:
         parser.error("expected --iterations, --seeds and --jobs >= 1")
@@ -177,7 +183,8 @@ def main(argv: list[str] | None = None) -> int:
     plan = [(labels, seed) for _, labels in VARIANTS for seed in range(args.seeds)]
     print(
         f"training {len(plan)} runs of {args.iterations} iterations on {args.device} "
-        f"({args.jobs} at a time); cores: {os.cpu_count()}",
+        f"({args.jobs} at a time{', solid obstacles' if args.solid else ''}); "
+        f"cores: {os.cpu_count()}",
         flush=True,
     )
     with ThreadPoolExecutor(args.jobs) as pool:

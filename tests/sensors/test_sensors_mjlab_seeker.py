@@ -152,3 +152,27 @@ def test_mjlab_s_train_runs_the_seeker(tmp_path) -> None:
     runs = list((tmp_path / "semantic_seeker_no_labels").iterdir())
     assert len(runs) == 1 and (runs[0] / "model_1.pt").is_file()
     assert "Learning iteration 1/2" in done.stdout
+
+
+@pytest.mark.parametrize("solid", [False, True])
+def test_solid_obstacles_stop_the_agent_at_their_surface(solid) -> None:
+    """Pushed straight at the target for 4 s, the agent passes through it without
+    contacts and stops at its surface with them (centres 0.35 m apart: radii 0.25 and
+    0.1, less the contacts' softness)."""
+    cfg = seeker.seeker_env_cfg(True, solid=solid)
+    cfg.scene.num_envs = 2
+    env = ManagerBasedRlEnv(cfg=cfg, device="cpu")
+    try:
+        env.reset()
+        closest = float("inf")
+        for _ in range(40):
+            agent, target, _ = seeker._positions(env)
+            env.step((target - agent) / (target - agent).norm(dim=1, keepdim=True))
+            agent, target, _ = seeker._positions(env)
+            closest = min(closest, float((target - agent).norm(dim=1).min()))
+    finally:
+        env.close()
+    if solid:
+        assert 0.3 < closest < seeker.NEAR  # stopped at the surface, still "at the target"
+    else:
+        assert closest < 0.15  # through it

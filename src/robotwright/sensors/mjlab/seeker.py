@@ -176,9 +176,12 @@ def near_obstacle(env: Any) -> torch.Tensor:
     return ((agent[:, None] - obstacles).norm(dim=2).amin(dim=1) < NEAR).float()
 
 
-def seeker_env_cfg(labels: bool = True, play: bool = False) -> ManagerBasedRlEnvCfg:
+def seeker_env_cfg(
+    labels: bool = True, play: bool = False, solid: bool = False
+) -> ManagerBasedRlEnvCfg:
     """The seeker task; ``labels=False`` drops the class channels from the observations
-    (the ``-NoLabels`` variant), ``play`` makes episodes endless."""
+    (the ``-NoLabels`` variant), ``play`` makes episodes endless, ``solid`` turns
+    contacts on: the agent bumps into the cylinders instead of passing through them."""
     lidar = SemanticLidarSensorCfg(
         name="lidar",
         frame=ObjRef(type="body", name="agent", entity="agent"),
@@ -234,7 +237,10 @@ def seeker_env_cfg(labels: bool = True, play: bool = False) -> ManagerBasedRlEnv
             "near_obstacle": MetricsTermCfg(func=near_obstacle),
         },
         terminations={"time_out": TerminationTermCfg(func=time_out, time_out=True)},
-        sim=SimulationCfg(mujoco=MujocoCfg(timestep=TIMESTEP, disableflags=("contact",))),
+        sim=SimulationCfg(
+            mujoco=MujocoCfg(timestep=TIMESTEP, disableflags=() if solid else ("contact",)),
+            nconmax=8 if solid else None,
+        ),
         decimation=DECIMATION,
         episode_length_s=1e10 if play else EPISODE_S,
     )
