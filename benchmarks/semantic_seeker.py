@@ -14,7 +14,7 @@ and ``DIR/seeker_curves.png`` (needs matplotlib), and prints last:
     at target: labels X, no labels Y
 
 X and Y: ``at_target`` over the last 10 iterations (all of them when there are fewer),
-mean over seeds. Needs the mjlab
+mean over seeds. The cylinders are solid; ``--pass-through`` turns contacts off. Needs the mjlab
 environment (``pip install 'robotwright[mjlab]'``).
 """
 
@@ -36,7 +36,7 @@ VARIANTS = (("labels", True), ("no labels", False))
 LAST = 10
 
 
-def train(labels: bool, seed: int, iterations: int, device: str, solid: bool = False) -> dict:
+def train(labels: bool, seed: int, iterations: int, device: str, solid: bool = True) -> dict:
     """One training run in this process: per-iteration metrics and timing."""
     import torch
     from mjlab.envs import ManagerBasedRlEnv
@@ -143,7 +143,7 @@ def _run_worker(labels: bool, seed: int, args: argparse.Namespace, out: Path) ->
         str(args.iterations),
         args.device,
         str(result),
-        "1" if args.solid else "0",
+        "0" if args.pass_through else "1",
     ]
     env = dict(os.environ)
     if args.jobs > 1:  # share the cores between the runs
@@ -172,9 +172,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--device", default="cpu", help="torch/warp device (cpu, cuda:0)")
     parser.add_argument("--out", type=Path, default=Path("seeker_out"), help="output folder")
     parser.add_argument(
-        "--solid",
+        "--pass-through",
         action="store_true",
-        help="contacts on: the agent bumps into the cylinders (both variants alike)",
+        help="contacts off: the agent passes through the cylinders (both variants alike)",
     )
     args = parser.parse_args(argv)
     if args.iterations < 1 or args.seeds < 1 or args.jobs < 1:
@@ -183,7 +183,8 @@ def main(argv: list[str] | None = None) -> int:
     plan = [(labels, seed) for _, labels in VARIANTS for seed in range(args.seeds)]
     print(
         f"training {len(plan)} runs of {args.iterations} iterations on {args.device} "
-        f"({args.jobs} at a time{', solid obstacles' if args.solid else ''}); "
+        f"({args.jobs} at a time, "
+        f"{'obstacles passed through' if args.pass_through else 'solid obstacles'}); "
         f"cores: {os.cpu_count()}",
         flush=True,
     )

@@ -1,7 +1,7 @@
 """mjlab tasks ``Mjlab-Semantic-Seeker-PointMass`` and ``...-NoLabels``: a task small
 enough to train on a CPU in minutes whose only way to succeed is the LiDAR's labels.
 
-A point mass (x/y slide joints driven by motors; contacts off) on a plane among three
+A point mass (x/y slide joints driven by motors) on a plane among three solid,
 identical upright cylinders (radius :data:`CYLINDER_RADIUS`), placed at random in the
 arena at every reset:
 
@@ -177,11 +177,12 @@ def near_obstacle(env: Any) -> torch.Tensor:
 
 
 def seeker_env_cfg(
-    labels: bool = True, play: bool = False, solid: bool = False
+    labels: bool = True, play: bool = False, solid: bool = True
 ) -> ManagerBasedRlEnvCfg:
     """The seeker task; ``labels=False`` drops the class channels from the observations
-    (the ``-NoLabels`` variant), ``play`` makes episodes endless, ``solid`` turns
-    contacts on: the agent bumps into the cylinders instead of passing through them."""
+    (the ``-NoLabels`` variant), ``play`` makes episodes endless. The cylinders are
+    solid (the agent stops at their surface); ``solid=False`` turns contacts off and
+    lets it pass through them."""
     lidar = SemanticLidarSensorCfg(
         name="lidar",
         frame=ObjRef(type="body", name="agent", entity="agent"),
