@@ -513,6 +513,13 @@ class Evaluation:
         return (self.score, self.tiebreak)
 
 
+def best_of(evaluations: Sequence[Evaluation]) -> Evaluation | None:
+    """The best feasible evaluation by score, then tie-break (the first evaluated of
+    equals); ``None`` when none is feasible."""
+    feasible = [e for e in evaluations if e.feasible]
+    return max(feasible, key=lambda e: e.rank_key) if feasible else None
+
+
 def scored(
     design: Design,
     values: dict[str, float],

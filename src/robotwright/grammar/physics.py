@@ -18,7 +18,7 @@ import math
 import warnings
 import xml.etree.ElementTree as ET  # noqa: N817 (serialising our own tree, not parsing)
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import mujoco
 import numpy as np
@@ -493,17 +493,13 @@ def track(
     data.qpos[:] = qn
     mujoco.mj_kinematics(model, data)
     center = data.site_xpos[m.sites[0]].copy()
+    # The reference at n points (the tool path computed below is named ``path`` too:
+    # the waypoints are bound now).
     if path is not None:
-
-        def reference(n: int) -> np.ndarray:
-            return waypoint_path(center, np.asarray(path), duration, n)
-
+        reference = partial(waypoint_path, center, np.asarray(path, dtype=float), duration)
     else:
         radius = scale * (_reach(limb) if reach is None else reach)
-
-        def reference(n: int) -> np.ndarray:
-            return reference_path(center, radius, duration, n)
-
+        reference = partial(reference_path, center, radius, duration)
     ref = reference(steps + 1)
     nv = model.nv
     if nv == 0:

@@ -23,7 +23,7 @@ from typing import Any
 
 from robotwright.grammar.design import Choice, Design, Step
 from robotwright.grammar.executors import die_with_parent, pool_size
-from robotwright.grammar.objectives import Constraint, Evaluation, Objective, evaluate
+from robotwright.grammar.objectives import Constraint, Evaluation, Objective, best_of, evaluate
 from robotwright.grammar.rules import Grammar
 
 __all__ = ["Parameter", "RefineResult", "parameters", "refine", "with_values"]
@@ -181,7 +181,5 @@ def _search(
         if len(xs) < es.popsize:
             break  # the budget ended inside a generation: the last one is not told
         es.tell(xs, fitness)
-    feasible = [e for e in result.evaluations if e.feasible]
-    if feasible:
-        result.best = max(feasible, key=lambda e: e.rank_key)
+    result.best = best_of(result.evaluations) or result.start
     return result

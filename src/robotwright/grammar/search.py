@@ -22,7 +22,7 @@ from typing import Any
 from robotwright.grammar.derive import Counter, Partial, choices_at, options, random_step, sample
 from robotwright.grammar.design import Design
 from robotwright.grammar.executors import RayExecutor, die_with_parent, pool_size, usable_cores
-from robotwright.grammar.objectives import Constraint, Evaluation, Objective, evaluate
+from robotwright.grammar.objectives import Constraint, Evaluation, Objective, best_of, evaluate
 from robotwright.grammar.rules import Grammar
 from robotwright.grammar.searchlog import SearchLog, read_log
 
@@ -171,7 +171,7 @@ class _Evaluator:
             if self.log is not None and (known is None or self._log_known):
                 self.log.write(ev, len(self.order) - 1)
         if self.progress is not None and todo:
-            self.progress(len(self.order), _best(self.order))
+            self.progress(len(self.order), best_of(self.order))
         return [self.cache.get(d.hash()) for d in designs]
 
 
@@ -180,11 +180,6 @@ def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
         return os.path.samefile(a, b)
     except OSError:
         return Path(a).resolve() == Path(b).resolve()
-
-
-def _best(evals: list[Evaluation]) -> Evaluation | None:
-    feasible = [e for e in evals if e.feasible]
-    return max(feasible, key=lambda e: e.rank_key) if feasible else None
 
 
 def random_search(
@@ -238,7 +233,7 @@ def random_search(
             else f"{tries} draws found only {len(ev.order)} distinct designs (the grammar "
             f"has few within max_links {max_links})"
         )
-        return SearchResult(_best(ev.order), ev.order, stopped)
+        return SearchResult(best_of(ev.order), ev.order, stopped)
 
 
 def beam_search(
@@ -321,7 +316,7 @@ def beam_search(
         stopped = (
             "budget reached" if ev.left <= 0 else "the beam emptied: every design was complete"
         )
-        return SearchResult(_best(ev.order), ev.order, stopped)
+        return SearchResult(best_of(ev.order), ev.order, stopped)
 
 
 class _Node:
@@ -464,4 +459,4 @@ def mcts_search(
             )
         else:
             stopped = f"every derivation within max_links {max_links} was explored"
-        return SearchResult(_best(ev.order), ev.order, stopped)
+        return SearchResult(best_of(ev.order), ev.order, stopped)

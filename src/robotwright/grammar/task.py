@@ -35,11 +35,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from robotwright._inputs import load_yaml
-from robotwright.errors import GrammarError, InputFileError, Problem, RobotwrightError
-from robotwright.grammar.physics import BACKWARDS, MIN_FREE_SHARE, Carrier, _carrier_xml
+from robotwright.errors import GrammarError, Problem, RobotwrightError
+from robotwright.grammar.loader import _num, _read_yaml
+from robotwright.grammar.physics import BACKWARDS, Carrier, _carrier_xml
 
 __all__ = ["DEFAULT_TASK", "Task", "load_task"]
 
@@ -104,16 +102,9 @@ def load_task(path: str | os.PathLike[str]) -> Task:
     def bad(field_: str, message: str) -> None:
         problems.append(Problem(where, message, column=field_))
 
-    try:
-        data = load_yaml(path)
-    except InputFileError as exc:
-        raise GrammarError([Problem(where, f"cannot read file: it {exc.reason}")]) from None
-    except OSError as exc:
-        raise GrammarError([Problem(where, f"cannot read file: {exc.strerror or exc}")]) from None
-    except yaml.YAMLError as exc:
-        raise GrammarError([Problem(where, f"invalid YAML: {exc}")]) from None
-    if not isinstance(data, dict):
-        raise GrammarError([Problem(where, "expected a YAML mapping at top level")])
+    data = _read_yaml(path, problems)  # the grammar loader's checks and messages
+    if data is None:
+        raise GrammarError(problems, f"invalid task file {path}")
     for key in data:
         if key not in ("task", "carrier", *_SECTIONS):
             bad(str(key), f"unknown key; expected task, carrier, {', '.join(_SECTIONS)}")
@@ -143,16 +134,10 @@ def load_task(path: str | os.PathLike[str]) -> Task:
     return task
 
 
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    return float(value) if math.isfinite(value) else None
-
-
 def _vector(value: Any, n: int) -> tuple[float, ...] | None:
     if not isinstance(value, list) or len(value) != n:
         return None
-    out = tuple(_number(v) for v in value)
+    out = tuple(_num(v) for v in value)
     return None if any(v is None for v in out) else out  # type: ignore[return-value]
 
 
@@ -217,13 +202,11 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
             else:
                 out[name] = value
         else:
-            number = _number(value)
+            number = _num(value)
             if number is None:
                 bad(where, "expected a finite number")
             else:
                 out[name] = number
-    if key == "payload" and "min_free_share" not in out:
-        out["min_free_share"] = MIN_FREE_SHARE
     return out
 
 

@@ -48,7 +48,7 @@ from robotwright.sensors.isaaclab.config import (
     resolve,
 )
 from robotwright.sensors.isaaclab.scene_shapes import SceneShapes, scene_shapes
-from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
+from robotwright.sensors.patterns import PatternCfg
 from robotwright.sensors.semantic import classify_path
 
 __all__ = ["LidarSensor", "LidarSensorData", "SemanticLidarData", "SemanticLidarSensor"]
@@ -142,9 +142,10 @@ def _pattern_table(pattern: Any) -> tuple[np.ndarray, np.ndarray, int, float | N
     rays per frame ``N`` and the frame period [s] (``None`` for a repeating pattern)."""
     if isinstance(pattern, PatternCfg):
         table = pattern.ray_table()
+        rate = pattern.firing_rate()
         period = None
-        if table.num_frames > 1 and isinstance(pattern, LivoxPatternCfg):
-            period = table.rays_per_frame / float(pattern.effective("points_per_second"))
+        if table.num_frames > 1 and rate:
+            period = table.rays_per_frame / rate
         return table.origins, table.directions, table.rays_per_frame, period
     starts, dirs = pattern.func(pattern, "cpu")
     starts = starts.detach().cpu().double().numpy()

@@ -21,6 +21,7 @@ from robotwright.sensors.config import (
     DEFAULT_SEMANTIC_CLASS_MAPPING,
     UNKNOWN_CLASS,
     SemanticLidarCfg,
+    _is_number,
 )
 from robotwright.sensors.patterns import GridPatternCfg, LivoxPatternCfg, PatternCfg
 
@@ -301,11 +302,7 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
 
 def _number(cfg: Any, name: str, key: str, low: float, high: float = math.inf) -> float:
     value = getattr(cfg, key)
-    if (
-        not isinstance(value, (int, float))
-        or isinstance(value, bool)
-        or not low <= float(value) <= high
-    ):
+    if not _is_number(value) or not low <= float(value) <= high:
         bound = f"in [{low}, {high}]" if math.isfinite(high) else f">= {low}"
         raise SensorError(f"{name}.{key}: expected a finite number {bound}, got {value!r}")
     return float(value)
@@ -317,11 +314,7 @@ def _numbers(cfg: Any, name: str, key: str, n: int, low: float, what: str) -> tu
         isinstance(value, (str, bytes))
         or not hasattr(value, "__len__")
         or len(value) != n
-        or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-            for v in value
-        )
-        or any(v < low for v in value)
+        or not all(_is_number(v) and math.isfinite(v) and v >= low for v in value)
     ):
         raise SensorError(f"{name}.{key}: expected {n} finite numbers ({what}), got {value!r}")
     return tuple(float(v) for v in value)

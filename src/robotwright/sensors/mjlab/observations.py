@@ -202,7 +202,8 @@ def lidar_range_image(
     where none did (a rotating pattern leaves cells unscanned each step; without this
     channel they read as free space). Every cell means the same direction every step,
     whatever the pattern, so a CNN or a flattened MLP can learn from it; a rosette fills
-    different cells each step. The rays' cells are computed once per pattern frame.
+    different cells each step. The cells of the pattern's rays are computed once and
+    looked up each step.
 
     ``accumulate=k`` bins the rays of the last ``k`` steps' scans together (a rosette or
     rotating pattern covers more cells over several steps; distance: the nearest of

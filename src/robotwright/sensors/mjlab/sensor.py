@@ -401,10 +401,11 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         if not self._buffers:
             return
         self._place(env_ids)
-        for value in self._obs_cache.values():
-            clear = getattr(value, "clear_envs", None)
-            if clear is not None:
-                clear(self._env_index(env_ids))
+        histories = [v for v in self._obs_cache.values() if hasattr(v, "clear_envs")]
+        if histories:
+            idx = self._env_index(env_ids)
+            for history in histories:
+                history.clear_envs(idx)
 
     def update(self, dt: float) -> None:
         """Count the simulated time [s] that passes (mjlab calls this every physics step)."""
