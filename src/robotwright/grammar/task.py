@@ -38,6 +38,7 @@ from typing import Any
 from robotwright.errors import GrammarError, Problem, RobotwrightError
 from robotwright.grammar.loader import _num, _read_yaml
 from robotwright.grammar.physics import BACKWARDS, Carrier, _carrier_xml
+from robotwright.hrdf.assets import bundled_robot_names
 
 __all__ = ["DEFAULT_TASK", "Task", "load_task"]
 
@@ -155,6 +156,11 @@ def _carrier(raw: Any, bad: Any) -> Carrier:
         if not isinstance(value, str) or not value:
             bad(f"carrier.{key}", "expected a name")
             return Carrier()
+    # A name from an untrusted file: one of the bundled robots, never a path to follow.
+    bundled = bundled_robot_names()
+    if robot not in bundled:
+        bad("carrier.robot", f"{robot!r}: expected a bundled robot, one of {bundled}")
+        return Carrier()
     pos = _vector(raw.get("pos", [0.0, 0.0, 0.0]), 3)
     quat = _vector(raw.get("quat", list(BACKWARDS)), 4)
     if pos is None or any(abs(v) > MAX_OFFSET for v in pos):
@@ -169,7 +175,7 @@ def _carrier(raw: Any, bad: Any) -> Carrier:
         _carrier_xml(carrier)  # the robot and the body or site exist
     except ValueError as exc:
         bad("carrier.at", str(exc))
-    except RobotwrightError as exc:
+    except RobotwrightError as exc:  # $HURODES_ASSETS_PATH may hold another of that name
         bad("carrier.robot", str(exc))
     return carrier
 
