@@ -621,16 +621,25 @@ def test_messages_the_page_never_sends_are_refused(
     assert _children() <= before_children
 
 
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _block_signals() -> None:
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+
+
+@pytest.mark.parametrize("inherited", [_ignore_sigint, _block_signals])
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
-def test_view_stops_on_signals_even_when_sigint_was_ignored(sig: signal.Signals) -> None:
-    """A background job of a script starts with SIGINT ignored: Ctrl-C (or SIGTERM)
-    still stops the viewer, exit 0."""
+def test_view_stops_on_signals_even_when_sigint_was_ignored(sig: signal.Signals, inherited) -> None:
+    """A background job of a script starts with SIGINT ignored, and a process inherits
+    its parent's blocked signals: Ctrl-C (or SIGTERM) still stops the viewer, exit 0."""
     proc = subprocess.Popen(
         [sys.executable, "-m", "robotwright", "view", "arm6", "--port", "0"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+        preexec_fn=inherited,
     )
     try:
         assert proc.stdout is not None

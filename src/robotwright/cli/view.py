@@ -15,6 +15,8 @@ from robotwright.cli.options import ROBOT_SOURCE_HELP
 
 #: Geom groups accepted by ``--groups`` (MuJoCo has six).
 _GROUPS = range(6)
+#: The longest the serving thread sleeps between looks at a pending signal [s].
+_SIGNAL_POLL_S = 0.5
 
 
 def _port(text: str) -> int:
@@ -152,9 +154,11 @@ def _run(args: argparse.Namespace) -> int:
         # Inside the try: a Ctrl-C right after the address is printed still stops cleanly.
         print(f"open {viewer.url} in a browser (Ctrl-C to stop)", flush=True)
         while True:
-            time.sleep(3600)
+            # Short sleeps: a signal the kernel hands to another thread interrupts no
+            # sleep of this one, and its handler runs only when this one wakes.
+            time.sleep(_SIGNAL_POLL_S)
     except KeyboardInterrupt:
-        print("stopped")
+        print("stopped", flush=True)
     finally:
         viewer.stop()
     return 0
@@ -177,14 +181,16 @@ def note_lines(notes: list[str], skipped: list[str], verbose: bool) -> list[str]
 
 def _stop_on_signals() -> None:
     """Ctrl-C (SIGINT) and SIGTERM stop the viewer, also where SIGINT was inherited as
-    ignored (a background job of a script starts with it ignored)."""
-    import contextlib
+    ignored (a background job of a script starts with it ignored) or blocked."""
     import signal
+    import threading
 
     def stop(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
 
+    if threading.current_thread() is not threading.main_thread():
+        return  # a caller's thread: the caller's handlers and mask stay
     for sig in (signal.SIGINT, signal.SIGTERM):
-        # Not the main thread (a caller's thread): the caller's handlers stay.
-        with contextlib.suppress(ValueError, OSError):
-            signal.signal(sig, stop)
+        signal.signal(sig, stop)
+    # A blocked signal is never delivered, and a process inherits its parent's mask.
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
