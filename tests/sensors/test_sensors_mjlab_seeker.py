@@ -29,9 +29,8 @@ from robotwright.sensors.mjlab import seeker  # noqa: E402
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _env(task_id: str, envs: int = 3) -> ManagerBasedRlEnv:
-    """A seeded env: the layouts a test sees are the same on every run."""
-    cfg = load_env_cfg(task_id)
+def _env(cfg, envs: int = 3) -> ManagerBasedRlEnv:
+    """A seeded env of ``cfg``: the layouts a test sees are the same on every run."""
     cfg.scene.num_envs = envs
     cfg.seed = 7
     return ManagerBasedRlEnv(cfg=cfg, device="cpu")
@@ -41,23 +40,14 @@ def _place(env: ManagerBasedRlEnv, agent_x: float, target_x: float) -> None:
     """The agent and the target on the x axis, the obstacles 2 m off it on either side
     (nothing between the two), everything at rest."""
     n = env.num_envs
-    ids = torch.arange(n)
-    agent = torch.tensor([[agent_x, 0.0]]).expand(n, 2).clone()
-    env.scene["agent"].write_joint_state_to_sim(agent, torch.zeros_like(agent), env_ids=ids)
-    quat = torch.tensor([1.0, 0.0, 0.0, 0.0])
-    for name, xy in (
-        ("target", (target_x, 0.0)),
-        ("obstacle_a", (0.0, 2.0)),
-        ("obstacle_b", (0.0, -2.0)),
-    ):
-        pose = torch.cat([torch.tensor([*xy, 0.0]), quat]).expand(n, 7).clone()
-        env.scene[name].write_mocap_pose_to_sim(pose, env_ids=ids)
+    layout = torch.tensor([[agent_x, 0.0], [target_x, 0.0], [0.0, 2.0], [0.0, -2.0]])
+    seeker.place_layout(env, torch.arange(n), layout.expand(n, 4, 2).clone())
     env.sim.forward()
 
 
 @pytest.fixture(scope="module")
 def labelled():
-    env = _env(seeker.TASK_ID)
+    env = _env(load_env_cfg(seeker.TASK_ID))
     yield env
     env.close()
 
@@ -76,7 +66,7 @@ def test_only_the_labels_variant_observes_classes(labelled) -> None:
     classes = len(sensor.class_names)
     rays = seeker.RING_RAYS
     assert obs["actor"].shape == (3, rays + rays * classes + 2)
-    other = _env(seeker.NO_LABELS_TASK_ID)
+    other = _env(load_env_cfg(seeker.NO_LABELS_TASK_ID))
     try:
         obs_b, _ = other.reset()
         assert obs_b["actor"].shape == (3, rays + 2)
@@ -179,10 +169,7 @@ def test_solid_obstacles_stop_the_agent_at_their_surface(solid) -> None:
     """Pushed straight at the target for 4 s (2 m away, nothing between), the agent
     passes through it without contacts and stops at its surface with them (centres
     0.35 m apart: radii 0.25 and 0.1, less the contacts' softness)."""
-    cfg = seeker.seeker_env_cfg(True, solid=solid)
-    cfg.scene.num_envs = 2
-    cfg.seed = 7
-    env = ManagerBasedRlEnv(cfg=cfg, device="cpu")
+    env = _env(seeker.seeker_env_cfg(True, solid=solid), envs=2)
     try:
         env.reset()
         _place(env, -1.0, 1.0)

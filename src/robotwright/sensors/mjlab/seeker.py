@@ -147,12 +147,18 @@ def reset_layout(env: Any, env_ids: torch.Tensor | None) -> None:
     pick = torch.where(
         ok.any(1), ok.float().argmax(1), torch.full_like(ok[:, 0], tries - 1, dtype=torch.long)
     )
-    chosen = xy[torch.arange(n, device=env.device), pick]  # (n, 4, 2)
+    place_layout(env, env_ids, xy[torch.arange(n, device=env.device), pick])
+
+
+def place_layout(env: Any, env_ids: torch.Tensor, xy: torch.Tensor) -> None:
+    """Put the agent (at rest), the target and the two obstacles of ``env_ids`` at the
+    ``(n, 4, 2)`` world x/y positions ``xy`` [m], in that order."""
+    n = len(env_ids)
     agent = env.scene["agent"]
-    agent.write_joint_state_to_sim(chosen[:, 0], torch.zeros_like(chosen[:, 0]), env_ids=env_ids)
+    agent.write_joint_state_to_sim(xy[:, 0], torch.zeros_like(xy[:, 0]), env_ids=env_ids)
     quat = torch.tensor([1.0, 0.0, 0.0, 0.0], device=env.device).expand(n, 4)
     for k, name in enumerate(("target", *_OBSTACLES), start=1):
-        pos = torch.cat([chosen[:, k], torch.zeros(n, 1, device=env.device)], dim=1)
+        pos = torch.cat([xy[:, k], torch.zeros(n, 1, device=env.device)], dim=1)
         env.scene[name].write_mocap_pose_to_sim(torch.cat([pos, quat], dim=1), env_ids=env_ids)
 
 
