@@ -60,6 +60,19 @@ MJCF_MAX_BODY_DEPTH = 496
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
+class _Yaml12NumbersLoader(_YAML_LOADER):  # type: ignore[misc, valid-type]
+    """The safe loader, reading ``1e9`` and ``2E-3`` as numbers as YAML 1.2 does (YAML
+    1.1, PyYAML's, wants a dot: ``1.0e9``), so that a configuration's number is never
+    refused as text for its spelling."""
+
+
+_Yaml12NumbersLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+
+
 def _kind(mode: int) -> str:
     if stat.S_ISDIR(mode):
         return "a folder"
@@ -177,9 +190,12 @@ def _yaml_depth_ok(text: str) -> bool:
     return True
 
 
-def load_yaml(path: str | os.PathLike[str], limit: int = MAX_YAML_BYTES) -> Any:
+def load_yaml(
+    path: str | os.PathLike[str], limit: int = MAX_YAML_BYTES, *, exponent_floats: bool = False
+) -> Any:
     """The YAML document in file ``path`` (safe loader; regular file, size cap, UTF-8,
-    nesting checked).
+    nesting checked); with ``exponent_floats``, ``1e9`` is read as a number (YAML 1.2)
+    rather than as text (YAML 1.1).
 
     Raises:
         InputFileError: see :func:`read_bytes`, not UTF-8, or nested too deep.
@@ -191,7 +207,7 @@ def load_yaml(path: str | os.PathLike[str], limit: int = MAX_YAML_BYTES) -> Any:
         raise InputFileError(
             path, f"nests more than {MAX_NESTING} levels of lists/mappings; refused"
         )
-    return yaml.load(text, Loader=_YAML_LOADER)
+    return yaml.load(text, Loader=_Yaml12NumbersLoader if exponent_floats else _YAML_LOADER)
 
 
 def load_json(text: str, source: str | os.PathLike[str]) -> Any:

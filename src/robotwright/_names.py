@@ -24,10 +24,15 @@ from typing import Any, TextIO
 
 __all__ = [
     "MAX_NAME_LENGTH",
+    "MAX_SHOWN_CHARS",
+    "MAX_STEM_CHARS",
     "UNSAFE_CHARS",
     "PrintableStream",
+    "file_stem",
     "name_problem",
     "printable",
+    "shown",
+    "shown_key",
 ]
 
 #: Longest name accepted [characters]. Real robots' names are under 100 characters;
@@ -52,6 +57,67 @@ def name_problem(name: str) -> str | None:
             "not hold control or bidirectional formatting characters"
         )
     return None
+
+
+#: Longest file or folder name made from a name read from an input [characters]; file
+#: systems allow 255 bytes, and a suffix or a counter is often added.
+MAX_STEM_CHARS = 64
+_NOT_IN_STEM = re.compile(r"[^A-Za-z0-9_.-]")
+
+
+def file_stem(name: object, fallback: str) -> str:
+    """A single, harmless file or folder name made from ``name``, a name read from an
+    input file (a URDF ``<robot name="../../x">``, a model's name): the one rule by which
+    a name becomes part of a path. Every character but ASCII letters, digits, ``_``,
+    ``-`` and ``.`` becomes ``_`` (so no separator, ``\\``, NUL or control character
+    survives), runs of dots become ``_`` (no ``..``), leading and trailing dots go (no
+    hidden file, never ``.``), and the result is cut to :data:`MAX_STEM_CHARS`.
+    ``fallback`` (itself a safe stem) is used where nothing is left."""
+    text = name if isinstance(name, str) else ""
+    safe = _NOT_IN_STEM.sub("_", text[: 4 * MAX_STEM_CHARS])
+    safe = re.sub(r"\.{2,}", "_", safe).strip(".")[:MAX_STEM_CHARS].rstrip(".")
+    return safe or fallback
+
+
+#: Longest piece of an input's value shown in a message [characters].
+MAX_SHOWN_CHARS = 200
+
+
+def shown(value: object, limit: int = MAX_SHOWN_CHARS, _depth: int = 0) -> str:
+    """``value`` as a message shows a value read from an input: its ``repr``, cut to
+    about ``limit`` characters. Mappings and lists show their first items, two levels
+    deep, and their size, so that a huge or deeply aliased value (a YAML alias bomb)
+    costs no more to show than a few items."""
+    if isinstance(value, (dict, list, tuple)):
+        kind = {dict: "mapping", list: "list"}.get(type(value), "tuple")
+        if _depth >= 2:
+            text = f"(a {kind} of {len(value)})"
+        else:
+            items = list(value.items())[:4] if isinstance(value, dict) else list(value[:4])
+            parts = [
+                f"{shown(i[0], 40, _depth + 1)}: {shown(i[1], 40, _depth + 1)}"
+                if isinstance(value, dict)
+                else shown(i, 40, _depth + 1)
+                for i in items
+            ]
+            more = ", ..." if len(value) > 4 else ""
+            opening, closing = ("{", "}") if isinstance(value, dict) else ("[", "]")
+            text = f"{opening}{', '.join(parts)}{more}{closing} (a {kind} of {len(value)})"
+    elif isinstance(value, str):
+        text = repr(value[: limit + 1])
+    elif isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 600:
+        text = f"an integer of {value.bit_length()} bits"
+    else:
+        text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def shown_key(key: object, limit: int = 80) -> str:
+    """A mapping key read from an input, as a message names a field: a text as it is,
+    anything else as :func:`shown` gives it; cut to ``limit`` characters."""
+    if isinstance(key, str):
+        return key if len(key) <= limit else key[: limit - 3] + "..."
+    return shown(key, limit)
 
 
 def _escape(char: str) -> str:

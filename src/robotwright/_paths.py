@@ -23,6 +23,7 @@ are the caller's own.
 from __future__ import annotations
 
 import os
+import re
 import stat
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
@@ -173,6 +174,18 @@ _SPEC_ASSETS = (("meshes", "mesh", "meshdir"), ("hfields", "hfield", "meshdir"))
 _SPEC_ASSETS += (("skins", "skin", "meshdir"), ("textures", "texture", "texturedir"))
 #: How deep ``<include>`` may nest (MuJoCo refuses include cycles itself, later).
 MAX_INCLUDE_DEPTH = 20
+
+
+def mjcf_asset_file(value: str, folder: str | None, *, strip: bool) -> Path:
+    """The path MuJoCo opens for an asset's file attribute ``value`` (a mesh, height
+    field, skin or texture file), before it is taken from the model's folder: with
+    ``<compiler strippath="true">`` the file name alone (MuJoCo cuts at the last ``/``
+    or ``\\``), else the value; an absolute one as is, a relative one under ``folder``
+    (``meshdir``/``texturedir``). The one rule that both the checks
+    (:func:`check_mjcf_spec`) and the mesh stager of the MJCF reader use, so that the
+    path checked is the path read."""
+    file = re.split(r"[/\\]", value)[-1] if strip else value
+    return Path(folder or "") / file
 
 
 def _element(tag: str, name: str | None, attr: str, value: str) -> str:
@@ -432,12 +445,14 @@ def check_mjcf_spec(
             for attr, value in files:
                 if not value:
                     continue
-                file = os.path.basename(value) if strip else value
                 elem = _element(tag, item.name, attr, value)
                 try:
                     found = check_regular(
                         resolve_inside(
-                            Path(folder or "") / file, base=model_dir, root=root, trusted=trusted
+                            mjcf_asset_file(value, folder, strip=strip),
+                            base=model_dir,
+                            root=root,
+                            trusted=trusted,
                         )
                     )
                 except UnsafePathError as exc:

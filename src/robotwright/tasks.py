@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+from robotwright._names import file_stem
 from robotwright.errors import GeneratorError
 from robotwright.generators.composite import MJCFGeneratorComposite
 from robotwright.generators.composite_urdf import URDFGeneratorComposite
@@ -34,15 +35,17 @@ def export_robot(
 ) -> dict[str, Path]:
     """Write ``<out_dir>/<name>.xml`` (MJCF) and ``<out_dir>/<name>.urdf`` (URDF with the
     MuJoCo tag) for one robot; meshes are copied to ``<out_dir>/meshes/<name>/`` so the
-    folder is self-contained.
+    folder is self-contained. ``<name>`` is the robot's name made a safe file name
+    (:func:`~robotwright._names.file_stem`: a name read from a file never becomes a path).
 
     Returns:
         ``{"mjcf": path, "urdf": path}``.
     """
     hrdf = load_robot(robot)
     out = Path(out_dir)
-    mjcf_path = out / f"{hrdf.name}.xml"
-    urdf_path = out / f"{hrdf.name}.urdf"
+    stem = file_stem(hrdf.name, "robot")
+    mjcf_path = out / f"{stem}.xml"
+    urdf_path = out / f"{stem}.urdf"
     MJCFHumanoidGenerator.from_hrdf(hrdf).export(
         mjcf_path, copy_meshes=copy_meshes, prefix=prefix, add_scene=add_scene
     )

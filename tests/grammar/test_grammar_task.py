@@ -76,7 +76,7 @@ def test_a_path_of_waypoints_is_the_reference_followed() -> None:
         ("task: t\ncarrier: {quat: [0, 0, 0, 0]}\n", "carrier.quat"),
         ("task: t\npayload: {samples: -1}\n", "payload.samples"),
         ("task: t\npayload: {limit: .nan}\n", "payload.limit"),
-        ("task: t\npayload: {limit: 0}\n", "payload"),
+        ("task: t\npayload: {limit: 0}\n", "payload.limit"),
         ("task: t\ntrack: {path: [[0, 0, 0]]}\n", "track.path"),
         ("task: t\ntrack: {path: [[0, 0, 0], [0, 0, 99]]}\n", "track.path"),
         ("task: t\ntrack: {speed: 2}\n", "track.speed"),

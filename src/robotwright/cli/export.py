@@ -86,8 +86,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="write an Isaac Lab ArticulationCfg module and the robot's USD",
         description="Write a Python module with an Isaac Lab ArticulationCfg (ROBOT_CFG: "
         "USD spawn, initial state, ImplicitActuatorCfg groups from the robot's actuators) "
-        "and the robot's USD beside it (as `export -o ROBOT.usd`). Isaac Lab's environment "
-        "(Python 3.12).",
+        "and the robot's USD beside it, named after the module (robot_cfg.py: robot_cfg.usd; "
+        "as `export -o robot_cfg.usd` writes it). Isaac Lab's environment (Python 3.12).",
         epilog="Example: robotwright isaaclab-cfg mini_humanoid -o robots/mini_humanoid_cfg.py",
     )
     p.add_argument("robot", help=ROBOT_SOURCE_HELP)
@@ -223,7 +223,7 @@ def _isaaclab_cfg(args: argparse.Namespace) -> int:
 
     if Path(args.output).suffix != ".py":
         raise GeneratorError(f"{args.output}: expected a Python module file name ending in .py")
-    check_overwrite(args.output, args.overwrite)
+    check_overwrite([args.output, str(Path(args.output).with_suffix(".usd"))], args.overwrite)
     hrdf = load_robot(args.robot)
     module, usd = write_articulation_cfg(
         hrdf, args.output, overwrite=args.overwrite, strict=args.strict, layout=args.usd_layout

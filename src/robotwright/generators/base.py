@@ -8,13 +8,13 @@ undoes ``load`` (and calls ``destroy``); ``destroy`` undoes ``generate`` only.
 from __future__ import annotations
 
 import os
-import re
 import xml.etree.ElementTree as ET
 from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import Any
 
 from robotwright._atomic import atomic_files, check_output_path, write_text_atomic
+from robotwright._names import file_stem
 from robotwright._progress import steps
 from robotwright.errors import GeneratorError
 from robotwright.generators.xmlfmt import to_xml_string
@@ -216,18 +216,6 @@ class GeneratorBase(ABC):
         return str(path).replace(os.sep, "/")
 
 
-#: Longest folder name made from a robot name (file systems allow 255 bytes).
-_MAX_GROUP_CHARS = 64
-
-
-def _group_folder(group: str) -> str:
-    """A single, harmless folder name for robot name ``group``: the name comes from the
-    input file (a URDF ``<robot name="../../x">``), so every character but letters,
-    digits, ``_``, ``-`` and inner ``.`` becomes ``_`` and it never is ``..``."""
-    safe = re.sub(r"[^\w.-]", "_", group, flags=re.ASCII).strip(".")[:_MAX_GROUP_CHARS]
-    return safe or "robot"
-
-
 def _output_path(file_path: str | Path) -> Path:
     """``file_path`` made absolute with its folder's links resolved (its own name kept)."""
     p = Path(file_path)
@@ -236,7 +224,8 @@ def _output_path(file_path: str | Path) -> Path:
 
 def _plan_mesh_copies(sources: list[tuple[str, Path]], out_dir: Path) -> dict[Path, Path]:
     """Map each source mesh to ``out_dir/meshes/<group>/<file name>`` (suffix on clashes;
-    ``<group>`` is the robot name made a safe folder name, see :func:`_group_folder`)."""
+    ``<group>`` is the robot name made a safe folder name by
+    :func:`~robotwright._names.file_stem`)."""
     plan: dict[Path, Path] = {}
     taken: set[Path] = set()
     for group, src in sources:
@@ -244,7 +233,7 @@ def _plan_mesh_copies(sources: list[tuple[str, Path]], out_dir: Path) -> dict[Pa
             continue
         if not src.is_file():
             raise GeneratorError(f"mesh file '{src}' does not exist (robot '{group}')")
-        folder = out_dir / MESH_COPY_DIR / _group_folder(group)
+        folder = out_dir / MESH_COPY_DIR / file_stem(group, "robot")
         dst = folder / src.name
         n = 1
         while dst in taken:

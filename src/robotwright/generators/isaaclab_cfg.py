@@ -28,6 +28,8 @@ from pathlib import Path
 
 import mujoco
 
+from robotwright._atomic import write_text_atomic
+from robotwright._outputs import check_overwrite
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
 
@@ -172,8 +174,10 @@ def write_articulation_cfg(
     strict: bool = False,
     layout: str = "nested",
 ) -> tuple[Path, Path]:
-    """Write ``<output>`` (the module) and ``<robot name>.usd`` beside it (``layout``: see
-    :func:`~robotwright.generators.usd.to_usd`).
+    """Write ``<output>`` (the module) and the robot's USD beside it, named after the
+    module (``robots/go2_cfg.py`` and ``robots/go2_cfg.usd``: the robot file's own name
+    never chooses a file name; ``layout``: see :func:`~robotwright.generators.usd.to_usd`).
+    Both go through the output gate (a temporary of their own, then a rename).
 
     Returns:
         (module path, USD path).
@@ -183,16 +187,13 @@ def write_articulation_cfg(
     out = Path(output)
     if out.suffix != ".py":
         raise GeneratorError(f"{out}: expected a Python module file name ending in .py")
-    if out.exists() and not overwrite:
-        raise GeneratorError(f"{out} exists (pass overwrite=True / --overwrite)")
-    usd = out.with_name(f"{hrdf.name}.usd")
+    usd = out.with_suffix(".usd")
+    check_overwrite([out, usd], overwrite)
     done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout)
     try:  # the initial state comes from the MJCF the USD was made from
         text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name)
-    except GeneratorError:
+        write_text_atomic(out, text)
+    except BaseException:
         usd.unlink(missing_ok=True)  # no half of the pair without the other
         raise
-    partial = out.with_name(f".{out.name}.partial")
-    partial.write_text(text, encoding="utf-8")
-    partial.replace(out)
     return out, usd

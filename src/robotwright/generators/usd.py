@@ -32,6 +32,8 @@ from pathlib import Path
 
 import mujoco
 
+from robotwright._atomic import copy_file_atomic
+from robotwright._names import file_stem
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
@@ -89,7 +91,7 @@ def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
 
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
 
-    path = folder / "mjcf" / f"{hrdf.name}.xml"
+    path = folder / "mjcf" / f"{file_stem(hrdf.name, 'robot')}.xml"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         MJCFHumanoidGenerator.from_hrdf(hrdf).export(path, copy_meshes=True, add_scene=False)
@@ -302,21 +304,20 @@ def to_usd(
                 for p in flat_stage.Traverse()
                 if p.IsA(UsdPhysics.Joint) and p.GetName() in result.joint_prims
             }
-        out_path.parent.mkdir(parents=True, exist_ok=True)
-        partial = out_path.with_name(f".{out_path.name}.partial{out_path.suffix}")
-        try:
-            if not flat.Export(str(partial)):
-                raise GeneratorError(f"{out_path}: usd-core could not write the file")
-            found = list(result.notes)
-            if prove:
-                from robotwright.generators.usd_proof import prove_usd
+        # Written and proven in the private temporary folder, then copied into place
+        # through the output gate (a temporary of its own, renamed: nothing planted in
+        # the user's folder is followed, and a refused proof leaves nothing there).
+        written = Path(tmp) / f"robot{out_path.suffix.lower()}"
+        if not flat.Export(str(written)):
+            raise GeneratorError(f"{out_path}: usd-core could not write the file")
+        found = list(result.notes)
+        if prove:
+            from robotwright.generators.usd_proof import prove_usd
 
-                result.proof = prove_usd(partial, model, hrdf)
-                found += result.proof.differences
-            _report(found, out_path, strict)
-            partial.replace(out_path)
-        finally:
-            partial.unlink(missing_ok=True)
+            result.proof = prove_usd(written, model, hrdf)
+            found += result.proof.differences
+        _report(found, out_path, strict)
+        copy_file_atomic(written, out_path)
     return result
 
 

@@ -6,6 +6,7 @@ import math
 import warnings
 from pathlib import Path
 
+from robotwright._names import file_stem
 from robotwright.errors import ConversionWarning
 from robotwright.grammar import default_grammar, demo_limb_design
 from robotwright.grammar.export import export_design, export_mjcf, export_urdf
@@ -52,8 +53,9 @@ def write_mounted_limb(
         # the limb's folder records these in warnings.txt; the mounted robot repeats them
         warnings.simplefilter("ignore", ConversionWarning)
         limb_dir = export_design(g, design, out / "limb", overwrite=True)
-        xml = out / f"{robot.name}_with_srl.xml"
-        urdf = out / f"{robot.name}_with_srl.urdf"
+        stem = file_stem(robot.name, "robot")
+        xml = out / f"{stem}_with_srl.xml"
+        urdf = out / f"{stem}_with_srl.urdf"
         export_mjcf(both, xml)
         export_urdf(both, urdf)
     return {

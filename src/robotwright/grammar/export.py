@@ -8,6 +8,7 @@ import warnings
 from pathlib import Path
 
 from robotwright._atomic import atomic_dir
+from robotwright._names import file_stem
 from robotwright.errors import ConversionWarning
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.derive import replay
@@ -42,7 +43,8 @@ def export_design(
     picture: bool = True,
     overwrite: bool = False,
 ) -> Path:
-    """Write ``out_dir`` with ``<name>.xml`` (MJCF), ``<name>.urdf``, ``design.txt``,
+    """Write ``out_dir`` with ``<name>.xml`` (MJCF), ``<name>.urdf`` (``name`` made a safe
+    file name, :func:`~robotwright._names.file_stem`), ``design.txt``,
     ``design.json``, ``tree.dot`` and ``picture.png`` (if ``picture``).
 
     What a format cannot hold (for example actuator peak velocity in MJCF) is reported
@@ -61,8 +63,9 @@ def export_design(
     with atomic_dir(out, kind="design") as tmp:  # replaces only a design output
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ConversionWarning)
-            export_mjcf(hrdf, tmp / f"{name}.xml")
-            export_urdf(hrdf, tmp / f"{name}.urdf")
+            stem = file_stem(name, "srl")
+            export_mjcf(hrdf, tmp / f"{stem}.xml")
+            export_urdf(hrdf, tmp / f"{stem}.urdf")
         for w in caught:
             if not issubclass(w.category, ConversionWarning):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

@@ -9,6 +9,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
+from robotwright._names import shown
+
 ComponentKind = Literal["base", "mount", "connector", "link", "gripper", "tool"]
 COMPONENT_KINDS: tuple[str, ...] = ("base", "mount", "connector", "link", "gripper", "tool")
 
@@ -45,9 +47,9 @@ class ParamDomain:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low <= self.high):
-            raise ValueError(f"parameter {self.name!r}: range must be finite with low <= high")
+            raise ValueError(f"parameter {shown(self.name)}: range must be finite with low <= high")
         if not self.values:
-            raise ValueError(f"parameter {self.name!r}: needs at least one value")
+            raise ValueError(f"parameter {shown(self.name)}: needs at least one value")
 
     def contains(self, value: float) -> bool:
         """Whether ``value`` lies in the physical domain (inclusive)."""
@@ -71,7 +73,7 @@ class DofSpec:
 
     def __post_init__(self) -> None:
         if self.type not in ("hinge", "slide"):
-            raise ValueError(f"dof type must be 'hinge' or 'slide', got {self.type!r}")
+            raise ValueError(f"dof type must be 'hinge' or 'slide', got {shown(self.type)}")
 
     def resolve_range(self, params: dict[str, float]) -> tuple[float, float]:
         """The numeric joint range for the component's parameter values."""
@@ -121,10 +123,10 @@ class Component:
     def __post_init__(self) -> None:
         if self.kind not in COMPONENT_KINDS:
             raise ValueError(
-                f"component {self.name!r}: kind must be one of {COMPONENT_KINDS}, got {self.kind!r}"
+                f"component {shown(self.name)}: kind must be one of {COMPONENT_KINDS}, got {shown(self.kind)}"
             )
         if self.density <= 0:
-            raise ValueError(f"component {self.name!r}: density must be > 0 kg/m^3")
+            raise ValueError(f"component {shown(self.name)}: density must be > 0 kg/m^3")
 
     def n_choices(self) -> int:
         """Number of distinct parameter assignments (product of value counts)."""

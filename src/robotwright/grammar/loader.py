@@ -6,7 +6,6 @@ whose entries name the file, the rule or component, and the field.
 
 from __future__ import annotations
 
-import math
 import re
 import warnings
 from importlib import resources
@@ -15,8 +14,9 @@ from typing import Any
 
 import yaml
 
+from robotwright._bounds import Bound, finite_number
 from robotwright._inputs import load_yaml
-from robotwright._names import name_problem
+from robotwright._names import name_problem, shown, shown_key
 from robotwright._paths import resolve_inside
 from robotwright.errors import GrammarError, InputFileError, Problem, UnsafePathError
 from robotwright.grammar.library import (
@@ -55,12 +55,14 @@ _ACTUATOR_KEYS = ("peak_torque", "peak_velocity", "peak_bearing_force", "peak_be
 
 def _name_error(name: object, pattern: re.Pattern[str]) -> str | None:
     """Why ``name`` cannot name a grammar part (``pattern``: what design files hold)."""
-    text = str(name)
+    if not isinstance(name, str):
+        return f"name {shown(name)}: expected a text"
+    text = name
     problem = name_problem(text)
     if problem is not None:
-        return f"name {text!r} {problem}"
+        return f"name {shown(text)} {problem}"
     if pattern.match(text) is None:
-        return f"name {text!r}: expected {_EXPECTED[pattern]} (as design files write it)"
+        return f"name {shown(text)}: expected {_EXPECTED[pattern]} (as design files write it)"
     return None
 
 
@@ -99,7 +101,7 @@ def default_grammar() -> Grammar:
 def _read_yaml(path: Path, problems: list[Problem]) -> dict[str, Any] | None:
     # A regular file under the size cap, UTF-8, nested at most MAX_NESTING levels.
     try:
-        data = load_yaml(path)
+        data = load_yaml(path, exponent_floats=True)
     except InputFileError as exc:
         problems.append(Problem(str(path), f"cannot read file: it {exc.reason}"))
         return None
@@ -115,17 +117,28 @@ def _read_yaml(path: Path, problems: list[Problem]) -> dict[str, Any] | None:
     return data
 
 
-def _num(value: Any) -> float | None:
-    """``value`` as a float when it is a finite number (not a bool, NaN or infinity)."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, (int, float)) and math.isfinite(value):
-        return float(value)
-    return None
+_num = finite_number
+
+
+def _description(value: Any) -> str:
+    """A symbol's, rule's or component's description: a text, shown as given; anything
+    else (a list, an alias bomb) is summarised, never formatted whole."""
+    return value if isinstance(value, str) else "" if value is None else shown(value)
 
 
 #: Highest material density accepted (kg/m^3): osmium, the densest element, is 22,590.
 MAX_DENSITY = 100_000.0
+#: A component parameter's values and a DoF's range ends (m or rad: a limb's parts are
+#: centimetres to a metre or two, its angles a few radians).
+PARAM_BOUND = Bound(-1000.0, 1000.0)
+#: Most values one parameter may list (the search enumerates them).
+MAX_PARAM_VALUES = 1000
+#: A DoF's twist about the link axis [rad].
+TWIST_BOUND = Bound(-2 * 3.141592653589793, 2 * 3.141592653589793, unit="rad")
+#: Housing sizes [m] and actuator ratings (N m or N, rad/s or m/s).
+RATING_BOUND = Bound(0.0, 1e6, open_low=True)
+#: A colour channel.
+RGBA_BOUND = Bound(0.0, 1.0)
 
 
 def _reversed_range(dof: DofSpec, params: dict[str, ParamDomain]) -> dict[str, float] | None:
@@ -182,10 +195,10 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
             continue
         for key in spec:
             if key not in _COMPONENT_KEYS:
-                err(f"unknown field (expected one of {sorted(_COMPONENT_KEYS)})", key)
+                err(f"unknown field (expected one of {sorted(_COMPONENT_KEYS)})", shown_key(key))
         kind = spec.get("kind")
         if kind not in COMPONENT_KINDS:
-            err(f"kind must be one of {list(COMPONENT_KINDS)}, got {kind!r}", "kind")
+            err(f"kind must be one of {list(COMPONENT_KINDS)}, got {shown(kind)}", "kind")
             continue
         symbol = spec.get("symbol")
         if not isinstance(symbol, str) or not symbol:
@@ -199,7 +212,7 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 vals = []
             for p in vals:
                 if ports and p not in ports:
-                    err(f"unknown port type {p!r} (library declares {list(ports)})", key)
+                    err(f"unknown port type {shown(p)} (library declares {list(ports)})", key)
             port_lists[key] = tuple(str(p) for p in vals)
         params: dict[str, ParamDomain] = {}
         for pname, pspec in (spec.get("params") or {}).items():
@@ -213,23 +226,26 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 continue
             rng = pspec["range"]
             if not (
-                isinstance(rng, list) and len(rng) == 2 and all(_num(v) is not None for v in rng)
+                isinstance(rng, list)
+                and len(rng) == 2
+                and all(PARAM_BOUND.check(v) is not None for v in rng)
             ):
-                err(f"range must be two numbers [low, high], got {rng!r}", col)
+                err(f"range must be two numbers [low, high], each {PARAM_BOUND.expected()}, "
+                    f"got {shown(rng)}", col)
                 continue
             low, high = float(rng[0]), float(rng[1])
             if low > high:
                 err(f"range low {low} > high {high}", col)
                 continue
             values = pspec["values"]
-            if not isinstance(values, list) or not values:
-                err("values must be a non-empty list of numbers", col)
+            if not isinstance(values, list) or not 0 < len(values) <= MAX_PARAM_VALUES:
+                err(f"values must be a list of 1 to {MAX_PARAM_VALUES} numbers", col)
                 continue
             good = True
             for v in values:
                 x = _num(v)
                 if x is None:
-                    err(f"value {v!r} is not a number", col)
+                    err(f"value {shown(v)} is not a number", col)
                     good = False
                 elif not low <= x <= high:
                     err(f"value {x} is out of the domain [{low}, {high}]", col)
@@ -255,10 +271,10 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 if not isinstance(d, dict):
                     err("expected {type, twist, range}", col)
                     continue
-                twist = _num(d.get("twist", 0.0))
+                twist = TWIST_BOUND.check(d.get("twist", 0.0))
                 rng = d.get("range")
                 if twist is None:
-                    err(f"twist must be a number (rad), got {d.get('twist')!r}", col)
+                    err(f"twist must be a number: {TWIST_BOUND.expected()}, got {shown(d.get('twist'))}", col)
                     continue
                 if not (isinstance(rng, list) and len(rng) == 2):
                     err("range must be [lower, upper] (numbers or parameter names)", col)
@@ -267,12 +283,16 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 for item in rng:
                     if isinstance(item, str):
                         if item.lstrip("-") not in params:
-                            err(f"range refers to unknown parameter {item!r}", col)
+                            err(f"range refers to unknown parameter {shown(item)}", col)
                         items.append(item)
-                    elif _num(item) is not None:
+                    elif PARAM_BOUND.check(item) is not None:
                         items.append(float(item))
                     else:
-                        err(f"range item {item!r} is neither a number nor a parameter", col)
+                        err(
+                            f"range item {shown(item)} is neither a parameter nor a number "
+                            f"({PARAM_BOUND.expected()})",
+                            col,
+                        )
                 try:
                     dof = DofSpec(d.get("type"), twist, (items[0], items[1]))
                 except (ValueError, IndexError) as exc:
@@ -286,9 +306,9 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
             for key in ("housing", "actuator"):
                 val = spec.get(key)
                 if not isinstance(val, dict) or any(
-                    _num(v) is None or _num(v) <= 0 for v in val.values()
+                    RATING_BOUND.check(v) is None for v in val.values()
                 ):
-                    err("expected a mapping of positive numbers", key)
+                    err(f"expected a mapping of numbers, each {RATING_BOUND.expected()}", key)
             for need in ("diameter", "length"):
                 if need not in (spec.get("housing") or {}):
                     err(f"housing needs '{need}' (m)", "housing")
@@ -298,22 +318,24 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
             for key in spec.get("actuator") or {}:
                 if key not in _ACTUATOR_KEYS:
                     err(
-                        f"unknown actuator rating {key!r}; expected {', '.join(_ACTUATOR_KEYS)}",
+                        f"unknown actuator rating {shown(key)}; expected {', '.join(_ACTUATOR_KEYS)}",
                         "actuator",
                     )
         density = _num(spec.get("density", 1000.0))
         if density is None or not 0 < density <= MAX_DENSITY:
             err(
                 f"density must be a number in (0, {MAX_DENSITY:g}] kg/m^3, got "
-                f"{spec.get('density')!r}",
+                f"{shown(spec.get('density'))}",
                 "density",
             )
             density = 1000.0
         rgba = spec.get("rgba", [0.7, 0.7, 0.7, 1.0])
         if not (
-            isinstance(rgba, list) and len(rgba) == 4 and all(_num(v) is not None for v in rgba)
+            isinstance(rgba, list)
+            and len(rgba) == 4
+            and all(RGBA_BOUND.check(v) is not None for v in rgba)
         ):
-            err(f"rgba must be 4 numbers, got {rgba!r}", "rgba")
+            err(f"rgba must be 4 numbers, each {RGBA_BOUND.expected()}, got {shown(rgba)}", "rgba")
             rgba = [0.7, 0.7, 0.7, 1.0]
         try:
             comps[cname] = Component(
@@ -357,8 +379,10 @@ def load_grammar(path: str | Path, library: str | Path | Library | None = None) 
         if library is None and data.get("library"):
             # Named by the (untrusted) grammar file: it must stay in the grammar's folder.
             try:
+                if not isinstance(data["library"], str):
+                    raise UnsafePathError(f"{shown(data['library'])}: expected a file name")
                 lib_path = resolve_inside(
-                    str(data["library"]),
+                    data["library"],
                     base=path.parent,
                     root=path.parent,
                     what="the grammar's folder",
@@ -391,7 +415,7 @@ def _parse_grammar(
     for key in data:
         if key not in _GRAMMAR_KEYS:
             problems.append(
-                Problem(f, f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})", column=key)
+                Problem(f, f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})", column=shown_key(key))
             )
     symbols: dict[str, Symbol] = {}
     raw_syms = data.get("symbols")
@@ -406,21 +430,25 @@ def _parse_grammar(
         spec = spec if isinstance(spec, dict) else {"kind": spec}
         try:
             symbols[str(sname)] = Symbol(
-                str(sname), spec.get("kind"), str(spec.get("description", ""))
+                str(sname), spec.get("kind"), _description(spec.get("description"))
             )
         except ValueError as exc:
             problems.append(Problem(f, str(exc), column="kind", element=f"symbol '{sname}'"))
     start = data.get("start")
-    if start not in symbols:
+    if not isinstance(start, str) or start not in symbols:
         problems.append(
-            Problem(f, f"start symbol {start!r} is not a declared symbol", column="start")
+            Problem(f, f"start symbol {shown(start)} is not a declared symbol", column="start")
         )
     elif symbols[start].kind != "nonterminal":
-        problems.append(Problem(f, f"start symbol {start!r} must be a nonterminal", column="start"))
-    link_symbols = tuple(str(s) for s in (data.get("link_symbols") or []))
-    for s in link_symbols:
-        if s not in symbols:
-            problems.append(Problem(f, f"unknown symbol {s!r}", column="link_symbols"))
+        problems.append(Problem(f, f"start symbol {shown(start)} must be a nonterminal", column="start"))
+    raw_links = data.get("link_symbols") or []
+    if not isinstance(raw_links, list):
+        problems.append(Problem(f, "expected a list of symbols", column="link_symbols"))
+        raw_links = []
+    link_symbols = tuple(s for s in raw_links if isinstance(s, str) and s in symbols)
+    for s in raw_links:
+        if not isinstance(s, str) or s not in symbols:
+            problems.append(Problem(f, f"unknown symbol {shown(s)}", column="link_symbols"))
     rules: dict[str, Rule] = {}
     raw_rules = data.get("rules")
     if not isinstance(raw_rules, dict) or not raw_rules:
@@ -441,7 +469,7 @@ def _parse_grammar(
                     Problem(
                         f,
                         f"unknown field (expected one of {sorted(_RULE_KEYS)})",
-                        column=key,
+                        column=shown_key(key),
                         element=where,
                     )
                 )
@@ -461,7 +489,7 @@ def _parse_grammar(
                 problems.append(
                     Problem(
                         f,
-                        f"unknown symbol {node.symbol!r} (declared: {sorted(symbols)})",
+                        f"unknown symbol {shown(node.symbol)} (declared: {sorted(symbols)})",
                         column=col,
                         element=where,
                     )
@@ -482,7 +510,7 @@ def _parse_grammar(
             problems.append(
                 Problem(
                     f,
-                    f"'{rhs[0]}' keeps the matched node, so it must be the left side's symbol {lhs.symbol!r}",
+                    f"'{rhs[0]}' keeps the matched node, so it must be the left side's symbol {shown(lhs.symbol)}",
                     column="rhs",
                     element=where,
                 )
@@ -492,7 +520,7 @@ def _parse_grammar(
                 problems.append(
                     Problem(
                         f,
-                        f"terminal {node.symbol!r} cannot be left open ('{node}')",
+                        f"terminal {shown(node.symbol)} cannot be left open ('{node}')",
                         column="rhs",
                         element=where,
                     )
@@ -502,32 +530,34 @@ def _parse_grammar(
             problems.append(
                 Problem(
                     f,
-                    f"branching must be true or false, got {branching!r}",
+                    f"branching must be true or false, got {shown(branching)}",
                     column="branching",
                     element=where,
                 )
             )
             branching = False
-        rules[str(rname)] = Rule(str(rname), lhs, rhs, branching, str(spec.get("description", "")))
+        rules[str(rname)] = Rule(
+            str(rname), lhs, rhs, branching, _description(spec.get("description"))
+        )
     for comp in lib.components.values():
         if comp.symbol not in symbols:
             problems.append(
                 Problem(
                     lib.source,
-                    f"symbol {comp.symbol!r} is not declared by grammar {f}",
+                    f"symbol {shown(comp.symbol)} is not declared by grammar {f}",
                     column="symbol",
                     element=f"component '{comp.name}'",
                 )
             )
-    name = str(data.get("name", path.stem))
+    name = data.get("name", path.stem)
     bad = _name_error(name, _NO_BLANK)
     if bad is not None:
         # The name of the file when it has no 'name' field.
         problems.append(Problem(f, bad, column="name"))
-    if start not in symbols:
+    if not isinstance(start, str) or start not in symbols:
         return None
     return Grammar(
-        name=name,
+        name=str(name),
         start=str(start),
         symbols=symbols,
         rules=rules,
@@ -548,7 +578,7 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
                 problems.append(
                     Problem(
                         f,
-                        f"'{node}' is finished here but the library has no component for symbol {node.symbol!r} (mark it open or add a component)",
+                        f"'{node}' is finished here but the library has no component for symbol {shown(node.symbol)} (mark it open or add a component)",
                         column="rhs",
                         element=where,
                     )
@@ -593,13 +623,13 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
         # States the start or any *other* rule creates (a rule cannot feed itself first).
         produced = {g.start_state}.union(*(v for k, v in produced_by.items() if k != r.name))
         if not any(r.matches(s) for s in produced):
-            shown = (
+            occurring = (
                 ", ".join(sorted(str(s) for s in produced if s.symbol == r.lhs.symbol)) or "none"
             )
             problems.append(
                 Problem(
                     f,
-                    f"left side '{r.lhs}' can never match: no rule creates such a node (nodes of {r.lhs.symbol!r} that occur: {shown})",
+                    f"left side '{r.lhs}' can never match: no rule creates such a node (nodes of {shown(r.lhs.symbol)} that occur: {occurring})",
                     column="lhs",
                     element=where,
                 )
@@ -608,7 +638,7 @@ def _check_grammar(g: Grammar, problems: list[Problem]) -> None:
             problems.append(
                 Problem(
                     f,
-                    f"rule is unreachable from the start symbol {g.start!r}",
+                    f"rule is unreachable from the start symbol {shown(g.start)}",
                     column="lhs",
                     element=where,
                 )

@@ -23,6 +23,8 @@ from functools import lru_cache, partial
 import mujoco
 import numpy as np
 
+from robotwright._bounds import Bound
+from robotwright._names import shown
 from robotwright.grammar.build import Limb
 
 #: The limb's z axis (its base normal) along the site's -x: worn on the back, pointing
@@ -42,36 +44,33 @@ class Carrier:
     prefix: str = "srl_"
 
 
+#: The range of every setting of the physics objectives (payload, track, energy,
+#: collision), from the Python API and task files alike: each has an upper bound, so
+#: that no setting can ask for minutes of work or gigabytes per design.
+SETTING_BOUNDS: dict[str, Bound] = {
+    "samples": Bound(0, 10_000, integer=True, unit="poses"),
+    "seed": Bound(0, 2**32 - 1, integer=True),
+    "duration": Bound(0.0, 60.0, unit="s", open_low=True),
+    "omega": Bound(0.0, 1000.0, unit="rad/s", open_low=True),
+    "limit": Bound(0.0, 10_000.0, unit="kg", open_low=True),
+    "min_free_share": Bound(0.0, 1.0),
+    "scale": Bound(0.0, 10.0),
+    "reach": Bound(0.0, 1000.0, unit="m"),
+}
+
+
 def check_settings(what: str, **values: float) -> None:
-    """Refuse a setting that is not a finite number, or is out of its range: ``samples``
-    (>= 0, whole), ``duration``/``omega``/``limit`` (> 0), ``min_free_share`` (in
-    [0, 1]), ``scale`` (>= 0).
+    """Refuse a setting that is not a number of its kind in its range
+    (:data:`SETTING_BOUNDS`).
 
     Raises:
         ValueError: naming ``what``, the setting and the expectation.
     """
     for name, v in values.items():
-        whole = name in ("samples", "seed")
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-        if ok and whole:
-            ok = float(v).is_integer() and v >= 0
-        elif ok and name == "min_free_share":
-            ok = 0 <= v <= 1
-        elif ok:
-            ok = v > 0 if name in ("duration", "omega", "limit") else v >= 0
-        if not ok:
-            floor = (
-                "a whole number >= 0"
-                if whole
-                else "in [0, 1]"
-                if name == "min_free_share"
-                else (
-                    "a finite number > 0"
-                    if name in ("duration", "omega", "limit")
-                    else "a finite number >= 0"
-                )
-            )
-            raise ValueError(f"{what}: {name} must be {floor}, got {v!r}")
+        bound = SETTING_BOUNDS[name]
+        whole = bound.integer and isinstance(v, float) and v.is_integer()
+        if bound.check(int(v) if whole else v) is None:
+            raise ValueError(f"{what}: {name} {bound.expected()}, got {shown(v)}")
 
 
 #: The default carrier: the bundled humanoid, the limb on its back.

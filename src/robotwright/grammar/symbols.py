@@ -6,6 +6,8 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
+from robotwright._names import shown
+
 SymbolKind = Literal["terminal", "nonterminal"]
 
 _PATTERN = re.compile(r"^\s*(-?)\s*([A-Za-z_][A-Za-z0-9_]*)\s*(\*?)\s*$")
@@ -28,7 +30,7 @@ class Symbol:
     def __post_init__(self) -> None:
         if self.kind not in ("terminal", "nonterminal"):
             raise ValueError(
-                f"symbol {self.name!r}: kind must be 'terminal' or 'nonterminal', got {self.kind!r}"
+                f"symbol {shown(self.name)}: kind must be 'terminal' or 'nonterminal', got {shown(self.kind)}"
             )
 
 
@@ -49,10 +51,10 @@ class NodePattern:
     @classmethod
     def parse(cls, text: str) -> NodePattern:
         """Parse ``"-L*"``-style text; raises ``ValueError`` naming the text."""
-        m = _PATTERN.match(str(text))
+        m = _PATTERN.match(text) if isinstance(text, str) else None
         if m is None:
             raise ValueError(
-                f"cannot parse node {text!r}: expected SYMBOL with optional leading '-' "
+                f"cannot parse node {shown(text)}: expected SYMBOL with optional leading '-' "
                 "and trailing '*', e.g. '-L*'"
             )
         return cls(symbol=m.group(2), keep=m.group(1) == "-", open=m.group(3) == "*")
@@ -75,13 +77,15 @@ class NodeState:
 
 def parse_chain(text: str) -> tuple[NodePattern, ...]:
     """Parse a right side ``"-B -> C -> L*"`` into node patterns (``ValueError`` if bad)."""
-    parts = [p for p in str(text).split("->")]
+    if not isinstance(text, str):
+        raise ValueError(f"cannot parse chain {shown(text)}: expected a text 'A -> B'")
+    parts = text.split("->")
     if any(not p.strip() for p in parts):
-        raise ValueError(f"cannot parse chain {text!r}: empty node between '->'")
+        raise ValueError(f"cannot parse chain {shown(text)}: empty node between '->'")
     nodes = tuple(NodePattern.parse(p) for p in parts)
     for i, node in enumerate(nodes[1:], start=1):
         if node.keep:
             raise ValueError(
-                f"chain {text!r}: only the first node may be written '-X' (node {i} is {node})"
+                f"chain {shown(text)}: only the first node may be written '-X' (node {i} is {node})"
             )
     return nodes

@@ -35,9 +35,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from robotwright._names import MAX_NAME_LENGTH, name_problem, shown, shown_key
 from robotwright.errors import GrammarError, Problem, RobotwrightError
 from robotwright.grammar.loader import _num, _read_yaml
-from robotwright.grammar.physics import BACKWARDS, Carrier, _carrier_xml
+from robotwright.grammar.physics import SETTING_BOUNDS, BACKWARDS, Carrier, _carrier_xml
 from robotwright.hrdf.assets import bundled_robot_names
 
 __all__ = ["DEFAULT_TASK", "Task", "load_task"]
@@ -82,11 +83,15 @@ class Task:
 #: poses, the circle and line at 0.15 of the reach over 2 s, 32 collision poses.
 DEFAULT_TASK = Task()
 
+#: The fields of each section; the ranges of numbers are the objectives' own
+#: (:data:`~robotwright.grammar.physics.SETTING_BOUNDS`), ``path`` is the waypoints.
 _SECTIONS = {
-    "payload": {"samples": int, "seed": int, "limit": float, "min_free_share": float},
-    "track": {"duration": float, "scale": float, "path": list},
-    "collision": {"samples": int, "seed": int},
+    "payload": ("samples", "seed", "limit", "min_free_share"),
+    "track": ("duration", "scale", "path"),
+    "collision": ("samples", "seed"),
 }
+#: Largest quaternion component accepted (the quaternion is normalised).
+MAX_QUAT_COMPONENT = 1e6
 _CARRIER_KEYS = ("robot", "at", "pos", "quat")
 
 
@@ -108,10 +113,11 @@ def load_task(path: str | os.PathLike[str]) -> Task:
         raise GrammarError(problems, f"invalid task file {path}")
     for key in data:
         if key not in ("task", "carrier", *_SECTIONS):
-            bad(str(key), f"unknown key; expected task, carrier, {', '.join(_SECTIONS)}")
+            bad(shown_key(key), f"unknown key; expected task, carrier, {', '.join(_SECTIONS)}")
     name = data.get("task")
-    if not isinstance(name, str) or not name.strip():
-        bad("task", "expected the task's name (a non-empty string)")
+    if not isinstance(name, str) or not name.strip() or name_problem(name) is not None:
+        bad("task", "expected the task's name (a non-empty string, a name without control "
+            f"characters, at most {MAX_NAME_LENGTH} characters)")
         name = "task"
     carrier = _carrier(data.get("carrier"), bad)
     sections = {key: _section(key, data.get(key), bad) for key in _SECTIONS}
@@ -150,7 +156,7 @@ def _carrier(raw: Any, bad: Any) -> Carrier:
         return Carrier()
     for key in raw:
         if key not in _CARRIER_KEYS:
-            bad(f"carrier.{key}", f"unknown key; expected {', '.join(_CARRIER_KEYS)}")
+            bad(f"carrier.{shown_key(key)}", f"unknown key; expected {', '.join(_CARRIER_KEYS)}")
     robot, at = raw.get("robot", "mini_humanoid"), raw.get("at", "back_mount")
     for key, value in (("robot", robot), ("at", at)):
         if not isinstance(value, str) or not value:
@@ -159,16 +165,22 @@ def _carrier(raw: Any, bad: Any) -> Carrier:
     # A name from an untrusted file: one of the bundled robots, never a path to follow.
     bundled = bundled_robot_names()
     if robot not in bundled:
-        bad("carrier.robot", f"{robot!r}: expected a bundled robot, one of {bundled}")
+        bad("carrier.robot", f"{shown(robot)}: expected a bundled robot, one of {bundled}")
         return Carrier()
     pos = _vector(raw.get("pos", [0.0, 0.0, 0.0]), 3)
     quat = _vector(raw.get("quat", list(BACKWARDS)), 4)
     if pos is None or any(abs(v) > MAX_OFFSET for v in pos):
         bad("carrier.pos", f"expected 3 finite numbers [m], each within +-{MAX_OFFSET:g}")
         return Carrier()
-    norm = math.sqrt(sum(v * v for v in quat)) if quat is not None else 0.0
+    if quat is not None and any(abs(v) > MAX_QUAT_COMPONENT for v in quat):
+        quat = None
+    norm = math.hypot(*quat) if quat is not None else 0.0  # hypot: no overflow on squares
     if quat is None or norm < 1e-9:
-        bad("carrier.quat", "expected 4 finite numbers (w, x, y, z), not all 0")
+        bad(
+            "carrier.quat",
+            f"expected 4 finite numbers (w, x, y, z), each within +-{MAX_QUAT_COMPONENT:g}, "
+            "not all 0",
+        )
         return Carrier()
     carrier = Carrier(robot, at, pos, tuple(v / norm for v in quat))  # type: ignore[arg-type]
     try:
@@ -188,11 +200,10 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
         return {}
     out: dict[str, Any] = {}
     for name, value in raw.items():
-        kind = _SECTIONS[key].get(name)
-        where = f"{key}.{name}"
-        if kind is None:
+        where = f"{key}.{shown_key(name)}"
+        if name not in _SECTIONS[key]:
             bad(where, f"unknown key; expected {', '.join(_SECTIONS[key])}")
-        elif kind is list:
+        elif name == "path":
             waypoints = _waypoints(value)
             if waypoints is None:
                 bad(
@@ -202,15 +213,11 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
                 )
             else:
                 out[name] = waypoints
-        elif kind is int:
-            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-                bad(where, "expected a whole number >= 0")
-            else:
-                out[name] = value
         else:
-            number = _num(value)
+            bound = SETTING_BOUNDS[name]
+            number = bound.check(value)
             if number is None:
-                bad(where, "expected a finite number")
+                bad(where, f"{bound.expected()}, got {shown(value)}")
             else:
                 out[name] = number
     return out

@@ -10,7 +10,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from robotwright.errors import ConversionError, Problem
+from robotwright._paths import mjcf_asset_file, resolve_inside
+from robotwright.errors import ConversionError, Problem, UnsafePathError
 from robotwright.hrdf.model import (
     MeshGeom,
     SimpleGeom,
@@ -53,18 +54,32 @@ def _keep_interleaved_order(
 
 
 def _mesh_source(
-    m_spec: mujoco.MjsMesh, meshdir: str, base_dir: Path, sub_dirs: list[Path]
+    m_spec: mujoco.MjsMesh, spec: mujoco.MjSpec, base_dir: Path, sub_dirs: list[Path]
 ) -> Path:
-    """The file of mesh ``m_spec`` as MuJoCo finds it: under its own model's mesh folder
-    (a sub-model's meshes keep their ``<compiler meshdir>``), from the main file's folder
-    or the sub-model's."""
+    """The file of mesh ``m_spec`` as MuJoCo finds it (:func:`mjcf_asset_file`: under its
+    own model's mesh folder, a sub-model's meshes keeping their ``<compiler meshdir>``;
+    ``strippath``), from the main file's folder or the sub-model's, resolved inside the
+    main file's folder or a trusted one: the path the checks passed is the path staged,
+    whether or not the reader is confined.
+
+    Raises:
+        UnsafePathError: the file leaves those folders (naming the mesh element).
+    """
     own = getattr(getattr(m_spec, "compiler", None), "meshdir", None)
-    folder = meshdir if own is None else own
+    folder = (spec.compiler.meshdir or "") if own is None else own
+    file = mjcf_asset_file(m_spec.file, folder, strip=bool(spec.strippath))
+    element = f'<mesh name="{m_spec.name}" file="{m_spec.file}">'
+    found = None
     for base in (base_dir, *sub_dirs):
-        candidate = (base / folder / m_spec.file).resolve()
+        try:
+            candidate = resolve_inside(file, base=base, root=base_dir)
+        except UnsafePathError as exc:
+            raise UnsafePathError(exc.reason, element=element) from None
         if candidate.is_file():
             return candidate
-    return (base_dir / folder / m_spec.file).resolve()
+        found = found or candidate
+    assert found is not None
+    return found
 
 
 def _geoms(
@@ -79,8 +94,6 @@ def _geoms(
 ) -> tuple[list[MeshGeom], list[SimpleGeom]]:
     """Mesh geoms (files staged, authored poses restored) and primitive geoms;
     ``sub_dirs``: the folders of the sub-models, whose meshes are named from there."""
-    # Relative to the main file's folder (MuJoCo folds <compiler assetdir> into meshdir).
-    meshdir = spec.compiler.meshdir or ""
     base_dir = path.resolve().parent
     mesh_files: dict[int, tuple[str, str]] = {}
     meshes: list[MeshGeom] = []
@@ -154,7 +167,7 @@ def _geoms(
                         "column); MuJoCo may centre the mesh differently",
                         where,
                     )
-                src = _mesh_source(m_spec, meshdir, base_dir, sub_dirs)
+                src = _mesh_source(m_spec, spec, base_dir, sub_dirs)
                 signs = tuple(-1.0 if v < 0 else 1.0 for v in m_spec.scale)
                 try:
                     if -1.0 in signs:
