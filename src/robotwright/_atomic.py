@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from robotwright._limits import limit_for_block, megabytes
+from robotwright._temporaries import running
 from robotwright.errors import InputFileError, OutputPathError
 
 __all__ = [
@@ -174,18 +175,6 @@ def _umask() -> int:
     return mask
 
 
-def _running(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OSError):
-        return True  # another user's process, or no way to tell: leave its files alone
-    return True
-
-
 def remove_stale_temporaries(folder: str | os.PathLike[str], target: str) -> None:
     """Remove the temporaries for ``target`` in ``folder`` left by killed processes."""
     try:
@@ -194,7 +183,7 @@ def remove_stale_temporaries(folder: str | os.PathLike[str], target: str) -> Non
         return
     for entry in entries:
         match = _TEMP_NAME.match(entry.name)
-        if match is None or match["target"] != target or _running(int(match["pid"])):
+        if match is None or match["target"] != target or running(int(match["pid"])):
             continue
         if entry.is_dir(follow_symlinks=False):
             shutil.rmtree(entry.path, ignore_errors=True)
@@ -218,7 +207,7 @@ def _restore_moved_aside(target: Path) -> None:
             match is not None
             and match["target"] == target.name
             and entry.is_dir(follow_symlinks=False)
-            and not _running(int(match["pid"]))
+            and not running(int(match["pid"]))
             and os.path.lexists(os.path.join(entry.path, "x"))
         ):
             os.replace(os.path.join(entry.path, "x"), target)

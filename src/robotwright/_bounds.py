@@ -44,12 +44,16 @@ class Bound:
     unit: str = ""
     open_low: bool = False
 
-    def expected(self) -> str:
-        """What the field expects, as a message says it."""
+    def describe(self) -> str:
+        """The type and range: ``a whole number in [0, 10000] poses``."""
         kind = "a whole number" if self.integer else "a finite number"
         left = "(" if self.open_low else "["
         unit = f" {self.unit}" if self.unit else ""
-        return f"expected {kind} in {left}{self.low:g}, {self.high:g}]{unit}"
+        return f"{kind} in {left}{self.low:g}, {self.high:g}]{unit}"
+
+    def expected(self) -> str:
+        """What the field expects, as a message says it."""
+        return f"expected {self.describe()}"
 
     def check(self, value: Any) -> int | float | None:
         """``value`` when it has the type and lies in the range, else ``None`` (the caller

@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from robotwright._landlock import LandlockError, abi_version, restrict_self
+from robotwright._temporaries import die_with_parent, prefix
 from robotwright.errors import RobotwrightError
 
 __all__ = [
@@ -86,7 +87,7 @@ class _Staging:
         import tempfile
         import weakref
 
-        self.path = Path(tempfile.mkdtemp(prefix="robotwright-read-"))
+        self.path = Path(tempfile.mkdtemp(prefix=prefix("read")))
         self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.path), True)
 
 
@@ -285,6 +286,7 @@ def start_confined(
     for folder in writable:  # a rule needs the folder: make it as the step would
         Path(folder).mkdir(parents=True, exist_ok=True)
     staging = _Staging()
+    parent = os.getpid()
     read_fd, write_fd = os.pipe()
     with warnings.catch_warnings():
         # The copy runs one step of Python code and ends with os._exit; it uses no
@@ -292,6 +294,7 @@ def start_confined(
         warnings.simplefilter("ignore", DeprecationWarning)
         pid = os.fork()
     if pid == 0:  # pragma: no cover - the copy's code runs in another process
+        die_with_parent(parent)  # never an orphan reader running on under PID 1
         os.close(read_fd)
         _child(write_fd, readable, [staging.path, *writable], _BUDGET.get(), step, args, kwargs)
     os.close(write_fd)

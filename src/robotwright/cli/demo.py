@@ -19,6 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from robotwright._names import file_stem
 from robotwright._notes import notes_of
 
 if TYPE_CHECKING:  # MuJoCo and Things load when the demo runs, not with `robotwright --help`
@@ -57,7 +58,7 @@ def step_hrdf(out: Path, ctx: dict[str, Any]) -> str:
             hrdf = HRDF.from_robot_name(name)
         ctx[name] = hrdf
         text = format_info(hrdf)
-        (out / f"{name}_info.txt").write_text(text + "\n", encoding="utf-8")
+        (out / f"{file_stem(name, 'robot')}_info.txt").write_text(text + "\n", encoding="utf-8")
         s = hrdf.summary()
         lines.append(f"{name}: {s['bodies']} bodies, {s['dof']} DoF, {s['total_mass']:.2f} kg")
     return "; ".join(lines)

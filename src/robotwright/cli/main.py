@@ -27,6 +27,7 @@ from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
 from robotwright._progress import shown as progress_shown
 from robotwright._suggest import did_you_mean
+from robotwright._temporaries import Terminated, sweep_stale, terminate_like_interrupt
 from robotwright.cli.options import source_options
 from robotwright.errors import ProblemsError, RobotwrightError
 from robotwright.parsers.packages import given_packages
@@ -270,7 +271,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         # messages and listings: control and bidirectional characters are shown escaped
         # (``\x1b``), never sent raw to the terminal.
         sys.stdout, sys.stderr = PrintableStream(out), PrintableStream(err)
-        code = _run(args)
+        sweep_stale()  # what commands killed with SIGKILL left in the temporary folder
+        with terminate_like_interrupt():  # SIGTERM unwinds: temporaries go, readers stop
+            code = _run(args)
         # Flushed here, not at exit: a reader that closed the pipe ends it quietly.
         out.flush()
         return code
@@ -321,6 +324,15 @@ def _error_text(exc: RobotwrightError) -> str:
     return _one_line(str(exc))
 
 
+def _interrupted(exc: KeyboardInterrupt) -> int:
+    """Exit status and line of a command stopped by Ctrl-C (130) or SIGTERM (143)."""
+    if isinstance(exc, Terminated):
+        print("terminated", file=sys.stderr)
+        return 143
+    print("interrupted", file=sys.stderr)
+    return 130
+
+
 def _run(args: argparse.Namespace) -> int:
     try:
         roots = getattr(args, "asset_roots", None) or []
@@ -362,10 +374,16 @@ def _run(args: argparse.Namespace) -> int:
     except RobotwrightError as exc:
         print(f"error: {_error_text(exc)}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        # Ctrl-C on long work (grammar enumeration, search): a line, not a traceback.
-        print("interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        # Ctrl-C or SIGTERM on long work (grammar enumeration, search): a line, not a
+        # traceback; every temporary was removed on the way out.
+        return _interrupted(exc)
+    except ImportError as exc:
+        # The signal came while an extension module initialised (MuJoCo's, loaded
+        # lazily): Python reports the interrupted import as its cause.
+        if isinstance(exc.__cause__, KeyboardInterrupt):
+            return _interrupted(exc.__cause__)
+        raise
     except BrokenPipeError:
         raise  # main ends quietly: the reader of stdout closed the pipe
     except OSError as exc:

@@ -26,6 +26,7 @@ mujoco-usd-converter 0.6.1 beside MuJoCo 3.12).
 from __future__ import annotations
 
 import math
+import re
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +35,7 @@ import mujoco
 
 from robotwright._atomic import copy_file_atomic
 from robotwright._names import file_stem
+from robotwright._temporaries import prefix
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
@@ -84,17 +86,32 @@ def _converter():
     return mujoco_usd_converter
 
 
+def converter_model_name(name: str) -> str:
+    """The MJCF model name handed to mujoco-usd-converter for a robot named ``name``: the
+    converter names its output file and the root prim after the model, so the name is
+    made a safe file name (:func:`~robotwright._names.file_stem`) and a USD identifier
+    (what the converter's ``getValidPrimName`` would make of it: the root prim keeps the
+    name it always had for an ordinary robot name)."""
+    stem = re.sub(r"\W", "_", file_stem(name, "robot"), flags=re.ASCII)
+    return f"_{stem}" if stem[0].isdigit() else stem
+
+
 def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
-    """Our MJCF of the robot alone, meshes copied beside it, and the values the MJCF could
-    not hold that the USD does not get either (``peak_velocity`` it does get)."""
+    """Our MJCF of the robot alone (its model named by :func:`converter_model_name`),
+    meshes copied beside it, and the values the MJCF could not hold that the USD does
+    not get either (``peak_velocity`` it does get)."""
+    import dataclasses
     import warnings
 
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
 
-    path = folder / "mjcf" / f"{file_stem(hrdf.name, 'robot')}.xml"
+    model = converter_model_name(hrdf.name)
+    path = folder / "mjcf" / f"{model}.xml"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        MJCFHumanoidGenerator.from_hrdf(hrdf).export(path, copy_meshes=True, add_scene=False)
+        MJCFHumanoidGenerator.from_hrdf(dataclasses.replace(hrdf, name=model)).export(
+            path, copy_meshes=True, add_scene=False
+        )
     lost = []
     for w in caught:
         lines = str(w.message).splitlines()
@@ -272,11 +289,13 @@ def to_usd(
     converter = _converter()
     from pxr import Usd
 
-    with tempfile.TemporaryDirectory(prefix="robotwright-usd-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         mjcf, lost = _robot_mjcf(hrdf, Path(tmp))
         asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
         stage = Usd.Stage.Open(asset.path)
         root = stage.GetDefaultPrim()
+        if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
+            root.SetDisplayName(hrdf.name)
         model = mujoco.MjModel.from_xml_path(str(mjcf))
         result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost, mjcf_model=model)
         for body in _zero_inertia_bodies(model):

@@ -18,6 +18,8 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Executor, Future
 from typing import Any
 
+from robotwright._temporaries import die_with_parent
+
 __all__ = [
     "RayExecutor",
     "check_ray_address",
@@ -43,34 +45,6 @@ def pool_size(workers: int | None, budget: int) -> int:
     beyond the number of evaluations would only sit idle."""
     wanted = workers or usable_cores()
     return max(1, min(wanted, budget))
-
-
-def die_with_parent(parent: int) -> None:
-    """Initializer of a search's pool processes: each is killed when the process that
-    started it dies, even by ``kill -9`` (Linux's parent-death signal), instead of
-    running on as an orphan. ``parent`` is the search's process id: a worker that finds
-    it gone once the signal is set (it died in between) exits at once. Under a fork
-    server (Python's default from 3.14) the signal follows the server, which ends with
-    the search. Elsewhere than Linux it does nothing."""
-    import signal
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        return
-    import ctypes
-
-    pr_set_pdeathsig = 1
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
-    except (OSError, AttributeError):
-        return
-    try:
-        os.kill(parent, 0)  # is the search still there?
-    except ProcessLookupError:
-        os._exit(1)
-    except PermissionError:
-        pass  # there, under another user (cannot happen for our own parent)
 
 
 def import_ray() -> Any:

@@ -230,8 +230,11 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 and len(rng) == 2
                 and all(PARAM_BOUND.check(v) is not None for v in rng)
             ):
-                err(f"range must be two numbers [low, high], each {PARAM_BOUND.expected()}, "
-                    f"got {shown(rng)}", col)
+                err(
+                    f"range must be two numbers [low, high], each {PARAM_BOUND.describe()}, "
+                    f"got {shown(rng)}",
+                    col,
+                )
                 continue
             low, high = float(rng[0]), float(rng[1])
             if low > high:
@@ -274,7 +277,10 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 twist = TWIST_BOUND.check(d.get("twist", 0.0))
                 rng = d.get("range")
                 if twist is None:
-                    err(f"twist must be a number: {TWIST_BOUND.expected()}, got {shown(d.get('twist'))}", col)
+                    err(
+                        f"twist must be a number: {TWIST_BOUND.expected()}, got {shown(d.get('twist'))}",
+                        col,
+                    )
                     continue
                 if not (isinstance(rng, list) and len(rng) == 2):
                     err("range must be [lower, upper] (numbers or parameter names)", col)
@@ -308,7 +314,7 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 if not isinstance(val, dict) or any(
                     RATING_BOUND.check(v) is None for v in val.values()
                 ):
-                    err(f"expected a mapping of numbers, each {RATING_BOUND.expected()}", key)
+                    err(f"expected a mapping of numbers, each {RATING_BOUND.describe()}", key)
             for need in ("diameter", "length"):
                 if need not in (spec.get("housing") or {}):
                     err(f"housing needs '{need}' (m)", "housing")
@@ -335,7 +341,7 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
             and len(rgba) == 4
             and all(RGBA_BOUND.check(v) is not None for v in rgba)
         ):
-            err(f"rgba must be 4 numbers, each {RGBA_BOUND.expected()}, got {shown(rgba)}", "rgba")
+            err(f"rgba must be 4 numbers, each {RGBA_BOUND.describe()}, got {shown(rgba)}", "rgba")
             rgba = [0.7, 0.7, 0.7, 1.0]
         try:
             comps[cname] = Component(
@@ -415,7 +421,11 @@ def _parse_grammar(
     for key in data:
         if key not in _GRAMMAR_KEYS:
             problems.append(
-                Problem(f, f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})", column=shown_key(key))
+                Problem(
+                    f,
+                    f"unknown field (expected one of {sorted(_GRAMMAR_KEYS)})",
+                    column=shown_key(key),
+                )
             )
     symbols: dict[str, Symbol] = {}
     raw_syms = data.get("symbols")
@@ -440,7 +450,9 @@ def _parse_grammar(
             Problem(f, f"start symbol {shown(start)} is not a declared symbol", column="start")
         )
     elif symbols[start].kind != "nonterminal":
-        problems.append(Problem(f, f"start symbol {shown(start)} must be a nonterminal", column="start"))
+        problems.append(
+            Problem(f, f"start symbol {shown(start)} must be a nonterminal", column="start")
+        )
     raw_links = data.get("link_symbols") or []
     if not isinstance(raw_links, list):
         problems.append(Problem(f, "expected a list of symbols", column="link_symbols"))

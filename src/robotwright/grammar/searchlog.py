@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from robotwright._inputs import MAX_NESTING, read_text
-from robotwright.errors import GrammarError, InputFileError
+from robotwright.errors import GrammarError, InputFileError, OutputPathError
 from robotwright.grammar.design import Design
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, scored
 
@@ -82,6 +82,26 @@ def _number(v: float) -> float | str:
     return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
 
 
+def open_log(path: Path, append: bool) -> IO[str]:
+    """The log file opened for writing (``append``: at its end), never through a symbolic
+    link at its name (a link planted there would be written through): a log grows line
+    by line as the search runs, so it cannot be written to a temporary and renamed.
+
+    Raises:
+        OutputPathError: the name is a link, or the file cannot be opened.
+    """
+    flags = os.O_WRONLY | os.O_CREAT | (os.O_APPEND if append else os.O_TRUNC)
+    flags |= getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(path, flags, 0o666)
+    except OSError as exc:
+        link = " (a symbolic link: not followed)" if path.is_symlink() else ""
+        raise OutputPathError(
+            f"{path}: cannot write the search log{link}: {exc.strerror}"
+        ) from None
+    return os.fdopen(fd, "a" if append else "w", encoding="utf-8")
+
+
 class SearchLog:
     """Appends a search's evaluations to a JSON-lines file, one flushed line each.
 
@@ -104,7 +124,7 @@ class SearchLog:
         self.path = Path(path)
         self.seed = header.get("seed")
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: IO[str] = open(self.path, "a" if append else "w", encoding="utf-8")  # noqa: SIM115
+        self._file: IO[str] = open_log(self.path, append)
         self._write(
             {
                 "kind": "search",

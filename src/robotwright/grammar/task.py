@@ -38,7 +38,7 @@ from typing import Any
 from robotwright._names import MAX_NAME_LENGTH, name_problem, shown, shown_key
 from robotwright.errors import GrammarError, Problem, RobotwrightError
 from robotwright.grammar.loader import _num, _read_yaml
-from robotwright.grammar.physics import SETTING_BOUNDS, BACKWARDS, Carrier, _carrier_xml
+from robotwright.grammar.physics import BACKWARDS, SETTING_BOUNDS, Carrier, _carrier_xml
 from robotwright.hrdf.assets import bundled_robot_names
 
 __all__ = ["DEFAULT_TASK", "Task", "load_task"]
@@ -116,8 +116,11 @@ def load_task(path: str | os.PathLike[str]) -> Task:
             bad(shown_key(key), f"unknown key; expected task, carrier, {', '.join(_SECTIONS)}")
     name = data.get("task")
     if not isinstance(name, str) or not name.strip() or name_problem(name) is not None:
-        bad("task", "expected the task's name (a non-empty string, a name without control "
-            f"characters, at most {MAX_NAME_LENGTH} characters)")
+        bad(
+            "task",
+            "expected the task's name (a non-empty string, a name without control "
+            f"characters, at most {MAX_NAME_LENGTH} characters)",
+        )
         name = "task"
     carrier = _carrier(data.get("carrier"), bad)
     sections = {key: _section(key, data.get(key), bad) for key in _SECTIONS}

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from robotwright._names import file_stem
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import HRDF, MeshGeom
 
@@ -167,7 +168,7 @@ def repair_collision_meshes(
     if out_dir is None:
         from robotwright.parsers.meshes import TempFolder
 
-        holder = TempFolder(prefix="robotwright-collision-")
+        holder = TempFolder("collision")
         folder = holder.path  # type: ignore[attr-defined]
     else:
         folder = Path(out_dir)
@@ -284,8 +285,13 @@ def _unique(taken: set[str], base: str) -> str:
 
 
 def _write(mesh: Any, folder: Path, name: str) -> str:
-    """``mesh`` as ``folder/<name>.stl`` (binary); returns the path."""
-    path = folder / f"{name}.stl"
+    """``mesh`` as ``folder/<stem>.stl`` (binary), ``<stem>`` the mesh name made a safe
+    file name (a geom name comes from the robot file) and numbered when taken; returns
+    the path."""
+    stem = file_stem(name, "mesh")
+    path, k = folder / f"{stem}.stl", 1
+    while path.exists():
+        path, k = folder / f"{stem}_{k}.stl", k + 1
     mesh.export(str(path), file_type="stl")
     return str(path)
 

@@ -15,6 +15,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from robotwright._temporaries import prefix
 from robotwright._usd_format import USD_SUFFIXES
 from robotwright.errors import ConversionError, HRDFError, OutputExistsError, Problem
 from robotwright.hrdf.model import HRDF
@@ -115,7 +116,7 @@ def convert(
     if "work_dir" in options or file_kind(src_p, existing=True) == "hrdf":
         return _convert(src_p, dst_p, out_kind, strict, overwrite, options, proof, scene)
     # The output gets its own copies of the meshes: staging lives only for the call.
-    with tempfile.TemporaryDirectory(prefix="robotwright-convert-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=prefix("convert")) as tmp:
         return _convert(
             src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp}, proof, scene
         )

@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from robotwright._atomic import atomic_path
+from robotwright._temporaries import prefix
 
 #: Extensions MuJoCo decodes itself.
 MUJOCO_MESH_EXTENSIONS = frozenset({".stl", ".obj", ".msh"})
@@ -77,8 +78,8 @@ class TempFolder:
     """A temporary folder that lives as long as this object (and is removed at exit at
     the latest). Whoever needs the folder's files holds the object."""
 
-    def __init__(self, prefix: str = "robotwright-mesh-") -> None:
-        self.path = Path(tempfile.mkdtemp(prefix=prefix))
+    def __init__(self, kind: str = "mesh") -> None:
+        self.path = Path(tempfile.mkdtemp(prefix=prefix(kind)))
         # The callback holds the path only, never self, so the object can be collected.
         self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.path), True)
         self._holder: object | None = None

@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from robotwright._rotations import quat_to_mat
+from robotwright._temporaries import prefix
 
 # -- URDF references ----------------------------------------------------------------------
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -133,7 +134,7 @@ def mujoco_urdf_keeps_mesh_files_apart() -> bool:
     a geom the first scale's mesh again from the third use on (scales a, b, a, b: the
     last geom gets a), and takes two files of one name in different folders for one
     mesh. 4.x gets both right. The probe tries both."""
-    with tempfile.TemporaryDirectory(prefix="robotwright-probe-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=prefix("probe")) as tmp:
         one, other = Path(tmp, "one", "probe.stl"), Path(tmp, "other", "probe.stl")
         for path, size in ((one, 1.0), (other, 2.0)):
             path.parent.mkdir()

@@ -23,6 +23,7 @@ from typing import Any
 
 import mujoco
 
+from robotwright._temporaries import prefix
 from robotwright.errors import ConversionError, InputFileError, Problem
 from robotwright.parsers.reference import (
     compile_urdf,
@@ -73,7 +74,7 @@ def roundtrip(
     _check_input(Path(source), configs)
     if "work_dir" in options:
         return _roundtrip(Path(source), configs, urdf, reference, options)
-    with tempfile.TemporaryDirectory(prefix="robotwright-rt-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
         return _roundtrip(Path(source), configs, urdf, reference, {**options, "work_dir": tmp})
 
 

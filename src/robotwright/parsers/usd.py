@@ -44,9 +44,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright._names import file_stem, shown
+from robotwright._paths import check_regular
 from robotwright._rotations import compose_pose
+from robotwright._temporaries import prefix
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES, prim_name
-from robotwright.errors import ConversionError, InputFileError, Problem
+from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.parsers.report import ParseResult, Reporter
 
 __all__ = ["USD_SUFFIXES", "USDOptions", "parse_usd", "prepare_confined_read"]
@@ -132,6 +135,10 @@ def check_usd_dependencies(path: Path, roots: list[Path]) -> None:
         if layer_path in seen:
             continue
         seen.add(layer_path)
+        try:  # usd-core opens it with a blocking open(): a FIFO would hang the reader
+            check_regular(layer_path)
+        except UnsafePathError as exc:
+            raise InputFileError(layer_path, exc.reason) from None
         if Sdf.Layer.FindOrOpen(str(layer_path)) is None:
             raise InputFileError(layer_path, "usd-core cannot read this file as a USD layer")
         sub, refs, payloads = UsdUtils.ExtractExternalReferences(str(layer_path))
@@ -141,13 +148,13 @@ def check_usd_dependencies(path: Path, roots: list[Path]) -> None:
                 continue
             if "://" in text or text.startswith("anon:"):
                 raise InputFileError(
-                    layer_path, f"asset path {text!r}: only files inside the folder are read"
+                    layer_path, f"asset path {shown(text)}: only files inside the folder are read"
                 )
             target = (layer_path.parent / text).resolve()
             if not any(target.is_relative_to(r) for r in roots):
                 raise InputFileError(
                     layer_path,
-                    f"asset path {text!r} points outside the file's folder ({target}); "
+                    f"asset path {shown(text)} points outside the file's folder ({target}); "
                     "trust its folder with --asset-root to read it",
                 )
             if target.suffix.lower() in (*USD_SUFFIXES, ".usdz"):
@@ -440,8 +447,9 @@ class _Builder:
         if key in self.meshes:
             return self.meshes[key]
         name = self.names("mesh", label)
-        trimesh.Trimesh(vertices, faces, process=False).export(self.mesh_dir / f"{name}.stl")
-        self.spec.add_mesh(name=name, file=f"{name}.stl")
+        file = f"{file_stem(name, 'mesh')}.stl"  # prim names are identifiers: unique still
+        trimesh.Trimesh(vertices, faces, process=False).export(self.mesh_dir / file)
+        self.spec.add_mesh(name=name, file=file)
         self.meshes[key] = name
         return name
 
@@ -536,10 +544,10 @@ def _actuators(stage: Any, b: _Builder, rep: Reporter) -> list[str]:
             continue
         act = b.spec.add_actuator(name=b.names("actuator", where), target=joint)
         act.trntype = mujoco.mjtTrn.mjTRN_JOINT
-        for usd_name, (field, enum, prefix) in _TOKENS.items():
+        for usd_name, (field, enum, enum_prefix) in _TOKENS.items():
             token = _attr(prim, f"mjc:{usd_name}")
             if token is not None:
-                setattr(act, field, getattr(enum, prefix + str(token).upper()))
+                setattr(act, field, getattr(enum, enum_prefix + str(token).upper()))
         for usd_name, field in _LIMITED.items():
             token = _attr(prim, f"mjc:{usd_name}")
             if token is not None:
@@ -620,7 +628,7 @@ def parse_usd(
     if nb.body_count == 0:
         raise InputFileError(path, "no rigid body (UsdPhysics.RigidBodyAPI) in the file")
     stage = Usd.Stage.Open(str(path))
-    with tempfile.TemporaryDirectory(prefix="robotwright-usd-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         folder = Path(tmp)
         builder = _Builder(newton, nb, stage, rep, folder)
         spec = builder.build()
@@ -631,16 +639,14 @@ def parse_usd(
         builder.names.report(rep)
         builder.report_unread()
         spec.modelfiledir = str(folder)  # mesh files are named relative to it
+        mjcf = folder / f"{file_stem(spec.modelname, 'robot')}.xml"
         try:
-            parsed = parse_mjcf_spec(
-                spec, folder / f"{spec.modelname}.xml", MJCFOptions(work_dir=opt.work_dir)
-            )
+            parsed = parse_mjcf_spec(spec, mjcf, MJCFOptions(work_dir=opt.work_dir))
         except ConversionError as exc:  # MuJoCo's compiler names the element
             raise InputFileError(
                 path, f"MuJoCo refuses the robot read from it: {exc.problems[0].message}"
             ) from None
     hrdf = parsed.hrdf
-    mjcf = folder / f"{spec.modelname}.xml"
     hrdf = _peak_velocities(hrdf, nb, builder)
     for p in parsed.warnings:
         rep.warn(p.message.replace(str(mjcf), str(path)), p.element)

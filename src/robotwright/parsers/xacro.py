@@ -38,8 +38,10 @@ from typing import Any
 import defusedxml
 import defusedxml.ElementTree as DET
 
+from robotwright._atomic import write_text_atomic
 from robotwright._inputs import MAX_XML_BYTES, MAX_YAML_BYTES, decode, read_bytes
 from robotwright._paths import resolve_inside, trusted_roots
+from robotwright._temporaries import prefix
 from robotwright._xmlsafe import parse_xml
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.parsers.packages import (
@@ -453,13 +455,13 @@ def xacro_as_urdf(path: Path, options: dict[str, Any]) -> tuple[Path, dict[str, 
     if problems:
         raise ConversionError(problems, summary=f"meshes of {path} not resolved")
     work = opts.get("work_dir")
-    out_dir = Path(work) / "xacro" if work else Path(tempfile.mkdtemp(prefix="robotwright-xacro-"))
+    out_dir = Path(work) / "xacro" if work else Path(tempfile.mkdtemp(prefix=prefix("xacro")))
     out_dir.mkdir(parents=True, exist_ok=True)
     name = Path(path).name
     out = out_dir / (name[: -len(".xacro")] if name.lower().endswith(".xacro") else name)
     if out.suffix.lower() != ".urdf":
         out = out.with_name(out.name + ".urdf")
-    out.write_text(ET.tostring(root, encoding="unicode"), encoding="utf-8")
+    write_text_atomic(out, ET.tostring(root, encoding="unicode"))
     opts["asset_roots"] = (*asset_roots, *dict.fromkeys(roots))
     return out, opts
 

@@ -50,7 +50,9 @@ and value types is small enough to review whole, so the evaluator is written her
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from robotwright.parsers.xacro_evaluator import Evaluator
@@ -91,6 +93,24 @@ def _dotify_guard(value: Any = None, *_: Any, **__: Any) -> None:
         raise ExpressionError("xacro.dotify() takes a dict")
 
 
+def _relative_filename(xacro: Any) -> Callable[[str], str]:
+    """xacro's ``abs_filename``, made to answer relative to the top-level file's folder
+    (``/``-separated) instead of with the absolute path: the same file for the mesh
+    resolver (which resolves from that folder), and the user's folder layout never
+    reaches the output (a link named after it, say)."""
+
+    def abs_filename(spec: Any) -> str:
+        if not isinstance(spec, str):
+            raise ExpressionError("xacro.abs_filename() takes a file name")
+        stack = xacro.filestack or [None]
+        here = os.path.dirname(os.path.abspath(stack[-1])) if stack[-1] else os.getcwd()
+        top = os.path.dirname(os.path.abspath(stack[0])) if stack[0] else os.getcwd()
+        full = os.path.normpath(os.path.join(here, spec))
+        return Path(os.path.relpath(full, top)).as_posix()
+
+    return abs_filename
+
+
 def _no_eval(*_: Any, **__: Any) -> Any:
     raise ExpressionError("Python evaluation is disabled for xacro files")
 
@@ -102,14 +122,19 @@ def xacro_evaluators(xacro: Any, substitution_args: Any) -> tuple[Callable, Call
     table = xacro.Table
     root = xacro._global_symbols
     ns = dict.__getitem__(root, "xacro")
+    own = {"abs_filename": _relative_filename(xacro)}
+
+    def function(table_: dict, name: str, shown_as: str) -> SafeFunction:
+        return SafeFunction(
+            shown_as,
+            own.get(name) or dict.__getitem__(table_, name),
+            _dotify_guard if name == "dotify" else None,
+        )
+
     xacro_ns = Namespace(
         "xacro",
         {
-            name: SafeFunction(
-                f"xacro.{name}",
-                dict.__getitem__(ns, name),
-                _dotify_guard if name == "dotify" else None,
-            )
+            name: function(ns, name, f"xacro.{name}")
             for name in XACRO_NAMESPACE
             if dict.__contains__(ns, name)
         },
@@ -118,9 +143,7 @@ def xacro_evaluators(xacro: Any, substitution_args: Any) -> tuple[Callable, Call
     names["xacro"] = xacro_ns
     for name in XACRO_DIRECT:
         if dict.__contains__(root, name):
-            names[name] = SafeFunction(
-                name, dict.__getitem__(root, name), _dotify_guard if name == "dotify" else None
-            )
+            names[name] = function(root, name, name)
     dotted = (xacro.YamlDictWrapper, xacro.YamlListWrapper)
 
     def walk(symbols: Any, name: str) -> Any:
