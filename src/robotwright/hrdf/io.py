@@ -15,6 +15,7 @@ from pathlib import Path
 from robotwright._inputs import (
     MAX_XML_BYTES,
 )
+from robotwright._names import shown
 from robotwright._paths import trusted_roots
 from robotwright.errors import (
     HRDFError,
@@ -74,7 +75,7 @@ def collect_hrdf_dir(
         problems.append(
             Problem(
                 "meta.yaml",
-                f"unsupported format_version {meta.format_version!r}: expected {FORMAT_VERSION!r}",
+                f"unsupported format_version {shown(meta.format_version)}: expected {shown(FORMAT_VERSION)}",
                 column="format_version",
             )
         )

@@ -14,6 +14,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright._names import shown
+
 #: ``<option>`` attributes beside ``timestep``, ``gravity`` and ``integrator`` (which
 #: ``simulator_config`` has its own keys for): name -> ``(kind, size)``. ``kind`` is
 #: ``"float"``, ``"int"`` (>= 0) or a tuple of the MJCF keywords; ``size`` 0 for a
@@ -109,14 +111,14 @@ def option_problem(name: str, value: Any) -> str | None:
         return f"unknown <option> attribute: expected one of {sorted(OPTION_FIELDS)}"
     kind, size = OPTION_FIELDS[name]
     if isinstance(kind, tuple):
-        return None if value in kind else f"{value!r}: expected one of {list(kind)}"
+        return None if value in kind else f"{shown(value)}: expected one of {list(kind)}"
     if kind == "int":
         ok = isinstance(value, int) and not isinstance(value, bool) and value >= 0
-        return None if ok else f"{value!r}: expected an integer >= 0"
+        return None if ok else f"{shown(value)}: expected an integer >= 0"
     if size:
         ok = isinstance(value, list) and len(value) == size and all(map(_number, value))
-        return None if ok else f"{value!r}: expected a list of {size} finite numbers"
-    return None if _number(value) else f"{value!r}: expected a finite number"
+        return None if ok else f"{shown(value)}: expected a list of {size} finite numbers"
+    return None if _number(value) else f"{shown(value)}: expected a finite number"
 
 
 def flag_problem(name: str, value: Any) -> str | None:
@@ -124,7 +126,7 @@ def flag_problem(name: str, value: Any) -> str | None:
     if name not in FLAGS:
         return f"unknown <flag> of MuJoCo {mujoco.__version__}: expected one of {sorted(FLAGS)}"
     if value not in ("enable", "disable"):
-        return f"{value!r}: expected 'enable' or 'disable'"
+        return f"{shown(value)}: expected 'enable' or 'disable'"
     return None
 
 

@@ -11,6 +11,7 @@ from robotwright._inputs import (
     MAX_YAML_BYTES,
     load_yaml,
 )
+from robotwright._names import shown
 from robotwright.errors import (
     Problem,
 )
@@ -55,7 +56,7 @@ def _checked(value: Any, ok: bool, key: str, expected: str, problems: list[Probl
     """``value`` when ``ok`` (or ``None``); else ``None`` after reporting it at ``key``."""
     if value is None or ok:
         return value
-    problems.append(Problem("meta.yaml", f"{value!r}: expected {expected}", column=key))
+    problems.append(Problem("meta.yaml", f"{shown(value)}: expected {expected}", column=key))
     return None
 
 
@@ -125,7 +126,9 @@ def _base_joint(raw: Any, problems: list[Problem]) -> dict[str, Any]:
             if value in (0, 1) and not isinstance(value, float):
                 out[col.field] = bool(value)
             else:
-                problems.append(Problem("meta.yaml", f"{value!r}: expected 0 or 1", column=key))
+                problems.append(
+                    Problem("meta.yaml", f"{shown(value)}: expected 0 or 1", column=key)
+                )
         else:
             got = _number(value, key, problems)
             if got is not None:
@@ -151,7 +154,7 @@ def _mjcf_size(raw: Any, problems: list[Problem]) -> dict[str, int]:
             out[name] = value
         else:
             problems.append(
-                Problem("meta.yaml", f"{value!r}: expected an integer >= 0", column=key)
+                Problem("meta.yaml", f"{shown(value)}: expected an integer >= 0", column=key)
             )
     return out
 
@@ -178,7 +181,9 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
         if mft not in ("stl", "obj"):
             problems.append(
                 Problem(
-                    "meta.yaml", f"expected 'stl' or 'obj', got {mft!r}", column="mesh_file_type"
+                    "meta.yaml",
+                    f"expected 'stl' or 'obj', got {shown(mft)}",
+                    column="mesh_file_type",
                 )
             )
         else:
@@ -275,7 +280,7 @@ def _parse_meta(raw: Any, problems: list[Problem]) -> tuple[Meta, list[Any] | No
                     problems.append(
                         Problem(
                             "meta.yaml",
-                            f"{value!r}: expected a list of linacc, angvel, quat",
+                            f"{shown(value)}: expected a list of linacc, angvel, quat",
                             column=key + ".value",
                         )
                     )

@@ -18,7 +18,7 @@ import defusedxml
 import defusedxml.ElementTree as SafeET
 
 from robotwright._limits import keyframes_problem
-from robotwright._names import name_problem
+from robotwright._names import name_problem, shown
 from robotwright.errors import Problem
 from robotwright.hrdf.model import (
     EXTRA_MAX_DEPTH,
@@ -154,7 +154,7 @@ def _check_finite(hrdf: HRDF, reported: set[tuple[str, int | None, str]]) -> lis
                 headers = [col.csv] * len(values) if col.kind == "floats" else col.headers
                 for header, v in zip(headers, values, strict=False):
                     if not math.isfinite(v):
-                        message = f"expected a finite number, got '{v!r}'"
+                        message = f"expected a finite number, got '{shown(v)}'"
                         out.append(Problem(table, message, row=row, column=header))
     return out
 
@@ -176,7 +176,9 @@ def _check_names(hrdf: HRDF) -> list[Problem]:
                 problem = name_problem(value)
                 if problem is not None:
                     out.append(
-                        Problem(f"{stem}.csv", f"name {value!r} {problem}", row=row, column=field)
+                        Problem(
+                            f"{stem}.csv", f"name {shown(value)} {problem}", row=row, column=field
+                        )
                     )
     return out
 
@@ -207,7 +209,7 @@ def _check_physics_fields(hrdf: HRDF) -> list[Problem]:
             out.append(
                 Problem(
                     "joint.csv",
-                    f"actuatorgravcomp {j.actuatorgravcomp!r}: expected 0 or 1",
+                    f"actuatorgravcomp {shown(j.actuatorgravcomp)}: expected 0 or 1",
                     row=row,
                     column="actuatorgravcomp",
                 )

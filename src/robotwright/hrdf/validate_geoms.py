@@ -8,6 +8,7 @@ import os
 from pathlib import Path
 
 from robotwright._assets import check_asset_file, mesh_limit_bytes
+from robotwright._names import shown
 from robotwright.errors import InputFileError, Problem, UnsafePathError
 from robotwright.hrdf import validate_common
 from robotwright.hrdf.model import (
@@ -130,7 +131,7 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
             out.append(
                 Problem(
                     "mesh.csv",
-                    f"inertia {m.inertia!r}: expected one of {list(MESH_INERTIA_MODES)} or empty",
+                    f"inertia {shown(m.inertia)}: expected one of {list(MESH_INERTIA_MODES)} or empty",
                     row=i,
                     column="inertia",
                 )
@@ -247,7 +248,7 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
             out.append(
                 Problem(
                     "sensor.csv",
-                    f"sensor type {s.type!r}: expected an MJCF sensor element that reads one "
+                    f"sensor type {shown(s.type)}: expected an MJCF sensor element that reads one "
                     f"object, one of {sorted(SENSOR_OBJTYPES)}",
                     row=i,
                     column="type",
@@ -258,7 +259,7 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
             out.append(
                 Problem(
                     "sensor.csv",
-                    f"objtype {s.objtype!r}: expected one of {list(allowed)} for a {s.type} sensor",
+                    f"objtype {shown(s.objtype)}: expected one of {list(allowed)} for a {s.type} sensor",
                     row=i,
                     column="objtype",
                 )
@@ -268,7 +269,7 @@ def _check_sites_sensors(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
             out.append(
                 Problem(
                     "sensor.csv",
-                    f"reftype {s.reftype!r}: expected one of {list(FRAME_OBJTYPES)}",
+                    f"reftype {shown(s.reftype)}: expected one of {list(FRAME_OBJTYPES)}",
                     row=i,
                     column="reftype",
                 )

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from robotwright._names import file_stem
+from robotwright._names import file_stem, shown
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import HRDF, MeshGeom
 
@@ -67,17 +67,17 @@ class CollisionMeshConfig:
         if self.max_faces is not None and (
             isinstance(self.max_faces, bool) or not isinstance(self.max_faces, int)
         ):
-            raise ValueError(f"max_faces={self.max_faces!r}: expected an integer or None")
+            raise ValueError(f"max_faces={shown(self.max_faces)}: expected an integer or None")
         if self.max_faces is not None and self.max_faces < 4:
             raise ValueError(f"max_faces={self.max_faces}: expected at least 4 faces")
         if not (isinstance(self.threshold, (int, float)) and 0.01 <= self.threshold <= 1.0):
-            raise ValueError(f"threshold={self.threshold!r}: expected 0.01 <= threshold <= 1")
+            raise ValueError(f"threshold={shown(self.threshold)}: expected 0.01 <= threshold <= 1")
         if not isinstance(self.max_parts, int) or (self.max_parts != -1 and self.max_parts < 1):
-            raise ValueError(f"max_parts={self.max_parts!r}: expected -1 or at least 1")
+            raise ValueError(f"max_parts={shown(self.max_parts)}: expected -1 or at least 1")
         for name in ("resolution", "mcts_iterations", "preprocess_resolution"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name}={value!r}: expected an integer >= 1")
+                raise ValueError(f"{name}={shown(value)}: expected an integer >= 1")
 
     @property
     def active(self) -> bool:

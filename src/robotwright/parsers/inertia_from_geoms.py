@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robotwright._names import shown
+
 #: MuJoCo's default geom density (kg/m^3), which its URDF import gives collision geoms.
 DEFAULT_DENSITY = 1000.0
 #: Values of ``URDFOptions.inertia_from_geoms`` (``--inertia-from-geoms``).
@@ -69,9 +71,9 @@ def check_density(value: float) -> float:
     try:
         density = float(value)
     except (TypeError, ValueError):
-        raise ValueError(f"density={value!r}: expected a finite number > 0 (kg/m^3)") from None
+        raise ValueError(f"density={shown(value)}: expected a finite number > 0 (kg/m^3)") from None
     if not (math.isfinite(density) and density > 0):
-        raise ValueError(f"density={value!r}: expected a finite number > 0 (kg/m^3)")
+        raise ValueError(f"density={shown(value)}: expected a finite number > 0 (kg/m^3)")
     return density
 
 

@@ -150,7 +150,8 @@ def _from_compiled(
     bodies = _bodies(model, keep, root_id, frames, rep)
     joints = _joints(model, kept, root_id, path, rep)
     store = mesh_store(opt.work_dir, opt.join_obj_objects)
-    meshes, simple = _geoms(model, spec, kept, path, store, frames, rep, sub_dirs or [])
+    trusted = trusted_roots(opt.asset_roots)
+    meshes, simple = _geoms(model, spec, kept, path, store, frames, rep, sub_dirs or [], trusted)
     sites = _sites(model, kept, frames, root_id, rep)
     names = {
         "joint": {j.name for j in joints if j.name},

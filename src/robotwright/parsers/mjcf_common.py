@@ -11,6 +11,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from robotwright._names import shown
 from robotwright.parsers import inertia as inr
 
 
@@ -46,7 +47,9 @@ class MJCFOptions:
 
     def __post_init__(self) -> None:
         if self.massless_frames not in ("keep", "site"):
-            raise ValueError(f"massless_frames={self.massless_frames!r}: expected 'keep' or 'site'")
+            raise ValueError(
+                f"massless_frames={shown(self.massless_frames)}: expected 'keep' or 'site'"
+            )
 
 
 _DEFAULT_MODEL = mujoco.MjModel.from_xml_string(

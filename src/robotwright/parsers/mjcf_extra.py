@@ -18,6 +18,8 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
+from robotwright._names import shown
+
 Warn = Callable[[str, str | None], None]
 
 _DEFAULT = mujoco.MjModel.from_xml_string(
@@ -87,11 +89,11 @@ def tendons(
                     side = _name(model, obj.mjOBJ_SITE, int(prm))
                     attrs["sidesite"] = side
                     if side is None or side not in names["site"]:
-                        missing.append(f"site {side!r}")
+                        missing.append(f"site {shown(side)}")
                 wraps.append(("geom", attrs))
                 kind = "geom"
             if n is None or n not in names[kind]:
-                missing.append(f"{kind} {n!r}")
+                missing.append(f"{kind} {shown(n)}")
         if missing or not tname:
             why = f"it refers to {missing} outside the robot" if missing else "it has no name"
             warn(f"tendon dropped: {why}", where)
@@ -212,7 +214,7 @@ def equalities(
         else:
             warn(f"equality of type {mujoco.mjtEq(et).name} dropped (not supported)", where)
             continue
-        outside = [f"{k} {n!r}" for k, n in refs if n is None or n not in names[k]]
+        outside = [f"{k} {shown(n)}" for k, n in refs if n is None or n not in names[k]]
         if outside:
             warn(f"equality dropped: it refers to {outside} outside the robot", where)
             continue

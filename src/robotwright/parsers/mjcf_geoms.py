@@ -54,7 +54,11 @@ def _keep_interleaved_order(
 
 
 def _mesh_source(
-    m_spec: mujoco.MjsMesh, spec: mujoco.MjSpec, base_dir: Path, sub_dirs: list[Path]
+    m_spec: mujoco.MjsMesh,
+    spec: mujoco.MjSpec,
+    base_dir: Path,
+    sub_dirs: list[Path],
+    trusted: tuple[Path, ...] | None = None,
 ) -> Path:
     """The file of mesh ``m_spec`` as MuJoCo finds it (:func:`mjcf_asset_file`: under its
     own model's mesh folder, a sub-model's meshes keeping their ``<compiler meshdir>``;
@@ -72,7 +76,7 @@ def _mesh_source(
     found = None
     for base in (base_dir, *sub_dirs):
         try:
-            candidate = resolve_inside(file, base=base, root=base_dir)
+            candidate = resolve_inside(file, base=base, root=base_dir, trusted=trusted)
         except UnsafePathError as exc:
             raise UnsafePathError(exc.reason, element=element) from None
         if candidate.is_file():
@@ -91,9 +95,11 @@ def _geoms(
     frames: set[int],
     rep: Reporter,
     sub_dirs: list[Path],
+    trusted: tuple[Path, ...] | None = None,
 ) -> tuple[list[MeshGeom], list[SimpleGeom]]:
     """Mesh geoms (files staged, authored poses restored) and primitive geoms;
-    ``sub_dirs``: the folders of the sub-models, whose meshes are named from there."""
+    ``sub_dirs``: the folders of the sub-models, whose meshes are named from there;
+    ``trusted``: the folders outside the robot's that its files may lie in."""
     base_dir = path.resolve().parent
     mesh_files: dict[int, tuple[str, str]] = {}
     meshes: list[MeshGeom] = []
@@ -167,7 +173,7 @@ def _geoms(
                         "column); MuJoCo may centre the mesh differently",
                         where,
                     )
-                src = _mesh_source(m_spec, spec, base_dir, sub_dirs)
+                src = _mesh_source(m_spec, spec, base_dir, sub_dirs, trusted)
                 signs = tuple(-1.0 if v < 0 else 1.0 for v in m_spec.scale)
                 try:
                     if -1.0 in signs:

@@ -51,6 +51,7 @@ from typing import Any
 from urllib.parse import unquote, urlparse
 
 from robotwright._assets import check_asset_file
+from robotwright._names import shown
 from robotwright._paths import resolve_folder, resolve_inside
 from robotwright.errors import InputFileError, UnsafePathError
 
@@ -104,7 +105,7 @@ def check_package_name(name: str) -> str:
     """
     if not _PACKAGE_NAME_RE.fullmatch(name or ""):
         raise UnsafePathError(
-            f"package name {name!r}: expected letters, digits, '_', '.', '+' or '-' "
+            f"package name {shown(name)}: expected letters, digits, '_', '.', '+' or '-' "
             "(not starting with '.' or '-')"
         )
     return name

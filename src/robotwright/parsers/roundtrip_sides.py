@@ -12,6 +12,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from robotwright._names import shown
 from robotwright._paths import trusted_asset_roots
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers.reference import (
@@ -159,7 +160,7 @@ def our_urdf_view(hrdf: HRDF) -> RobotView:
 
 def _check_reference(reference: str) -> None:
     if reference not in ("auto", "mujoco", "yourdfpy"):
-        raise ValueError(f"reference={reference!r}: expected 'auto', 'mujoco' or 'yourdfpy'")
+        raise ValueError(f"reference={shown(reference)}: expected 'auto', 'mujoco' or 'yourdfpy'")
 
 
 @dataclass

@@ -34,6 +34,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
+from robotwright._names import shown
 from robotwright._notes import name_list
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import Actuator, Joint
@@ -74,11 +75,11 @@ def parse_gains(gains: Mapping[str, Any] | None) -> dict[str, tuple[float, float
             kp, kv = (float(v) for v in values)
         except (TypeError, ValueError):
             raise ValueError(
-                f"actuator_gains[{pattern!r}] = {value!r}: expected (kp, kv), two numbers"
+                f"actuator_gains[{shown(pattern)}] = {shown(value)}: expected (kp, kv), two numbers"
             ) from None
         if not (math.isfinite(kp) and math.isfinite(kv) and kp >= 0 and kv >= 0):
             raise ValueError(
-                f"actuator_gains[{pattern!r}] = {value!r}: expected finite kp >= 0, kv >= 0"
+                f"actuator_gains[{shown(pattern)}] = {shown(value)}: expected finite kp >= 0, kv >= 0"
             )
         out[str(pattern)] = (kp, kv)
     return out

@@ -15,6 +15,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from robotwright._names import shown
 from robotwright.errors import ConversionError, Problem
 from robotwright.parsers import inertia as inr
 from robotwright.parsers import inertia_from_geoms as geom_inertia
@@ -96,21 +97,23 @@ class URDFOptions:
     def __post_init__(self) -> None:
         if self.inertia_from_geoms not in geom_inertia.INERTIA_FROM_GEOMS:
             raise ValueError(
-                f"inertia_from_geoms={self.inertia_from_geoms!r}: expected one of "
+                f"inertia_from_geoms={shown(self.inertia_from_geoms)}: expected one of "
                 f"{list(geom_inertia.INERTIA_FROM_GEOMS)}"
             )
         object.__setattr__(self, "density", geom_inertia.check_density(self.density))
         if self.fixed_joints not in FIXED_POLICIES:
             raise ValueError(
-                f"fixed_joints={self.fixed_joints!r}: expected one of {list(FIXED_POLICIES)}"
+                f"fixed_joints={shown(self.fixed_joints)}: expected one of {list(FIXED_POLICIES)}"
             )
         if self.actuators not in acts.ACTUATOR_MODES:
-            raise ValueError(f"actuators={self.actuators!r}: expected one of {acts.ACTUATOR_MODES}")
+            raise ValueError(
+                f"actuators={shown(self.actuators)}: expected one of {acts.ACTUATOR_MODES}"
+            )
         object.__setattr__(self, "actuator_gains", acts.parse_gains(self.actuator_gains))
         for name in ("bound_mass", "bound_inertia"):
             value = getattr(self, name)
             if value is not None and not value >= 0:
-                raise ValueError(f"{name}={value!r}: expected None or >= 0")
+                raise ValueError(f"{name}={shown(value)}: expected None or >= 0")
 
 
 class _Unreadable(ValueError):
@@ -125,7 +128,7 @@ def _finite(text: str) -> float:
     as MJCF. Raises ValueError (:class:`_Unreadable` for the latter)."""
     value = float(text)
     if not math.isfinite(value):
-        raise ValueError(f"{text!r} is not a finite number")
+        raise ValueError(f"{shown(text)} is not a finite number")
     if value != 0 and abs(value) < sys.float_info.min:
         from robotwright.parsers.reference import mujoco_xml_reads_subnormals
 
@@ -134,7 +137,7 @@ def _finite(text: str) -> float:
 
             raise _Unreadable(
                 f"MuJoCo {mujoco.__version__} reads no nonzero number smaller than "
-                f"{sys.float_info.min!r} in magnitude"
+                f"{shown(sys.float_info.min)} in magnitude"
             )
     return value
 
@@ -160,7 +163,9 @@ def _floats(
         raise ConversionError(
             [
                 Problem(
-                    rep.file, f"{what} = {text!r}: expected {n} finite numbers{why}", element=where
+                    rep.file,
+                    f"{what} = {shown(text)}: expected {n} finite numbers{why}",
+                    element=where,
                 )
             ],
         )
@@ -203,7 +208,8 @@ def _num(elem: ET.Element | None, attr: str, default: float, where: str, rep: Re
             [
                 Problem(
                     rep.file,
-                    f"<{elem.tag} {attr}={elem.get(attr)!r}>: expected a finite number" + _why(exc),
+                    f"<{elem.tag} {attr}={shown(elem.get(attr))}>: expected a finite number"
+                    + _why(exc),
                     element=where,
                 )
             ]

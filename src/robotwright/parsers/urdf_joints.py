@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from robotwright._names import shown
 from robotwright._xmlsafe import describe
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import (
@@ -69,7 +70,7 @@ def _read_tree(root: ET.Element, path: Path) -> _Tree:
             errors.append(
                 Problem(
                     str(path),
-                    f"type {jtype!r}: expected one of {sorted(_JOINT_TYPES)}",
+                    f"type {shown(jtype)}: expected one of {sorted(_JOINT_TYPES)}",
                     element=where,
                 )
             )
@@ -83,7 +84,7 @@ def _read_tree(root: ET.Element, path: Path) -> _Tree:
         for role, ln in (("parent", p), ("child", c)):
             if ln not in links:
                 errors.append(
-                    Problem(str(path), f"{role} link {ln!r} is not defined", element=where)
+                    Problem(str(path), f"{role} link {shown(ln)} is not defined", element=where)
                 )
         if c in parent_of:
             errors.append(Problem(str(path), f"link '{c}' has two parent joints", element=where))
@@ -201,7 +202,7 @@ def _mimic_extra(
             )
             continue
         lines.append(
-            f'    <joint joint1="{follower}" joint2="{leader}" polycoef="{off!r} {mult!r} 0 0 0"/>'
+            f'    <joint joint1="{follower}" joint2="{leader}" polycoef="{shown(off)} {shown(mult)} 0 0 0"/>'
         )
     if not lines:
         return None

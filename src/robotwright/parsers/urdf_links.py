@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from robotwright._names import shown
 from robotwright._xmlsafe import describe
 from robotwright.errors import ConversionError, Problem
 from robotwright.hrdf.model import (
@@ -68,7 +69,7 @@ def _link_inertial(link: ET.Element, rep: Reporter) -> tuple[float, np.ndarray, 
         try:
             mass = _finite(mass_el.get("value", "0"))
         except ValueError as exc:
-            problem = f"mass {mass_el.get('value')!r}: expected a finite number{_why(exc)}"
+            problem = f"mass {shown(mass_el.get('value'))}: expected a finite number{_why(exc)}"
             raise ConversionError([Problem(rep.file, problem, element=where)]) from exc
     i_el = inertial.find("inertia")
     tensor = np.zeros((3, 3))
@@ -263,9 +264,9 @@ class _URDFReader:
             )
             raise ConversionError([Problem(self.rep.file, problem, element=where)]) from None
         self.rep.warn(
-            f"no <inertial>: mass {got.mass!r} kg, centre of mass {_t(got.com)} m, principal "
+            f"no <inertial>: mass {shown(got.mass)} kg, centre of mass {_t(got.com)} m, principal "
             f"moments {got.moments} kg m^2 computed by MuJoCo from its {len(shapes)} "
-            f"collision geom(s) at density {density!r} kg/m^3, as MuJoCo's URDF import "
+            f"collision geom(s) at density {shown(density)} kg/m^3, as MuJoCo's URDF import "
             "does (inertia_from_geoms='never', --inertia-from-geoms never, leaves it massless)",
             where,
         )

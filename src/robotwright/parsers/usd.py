@@ -192,14 +192,14 @@ class _Names:
             if kind in ("body", "joint", "actuator"):
                 for label, name in pairs:
                     rep.warn(
-                        f"{kind} name {prim_name(label)!r} is used by several prims; {label} "
-                        f"becomes {name!r}"
+                        f"{kind} name {shown(prim_name(label))} is used by several prims; {label} "
+                        f"becomes {shown(name)}"
                     )
             elif kind != "mesh":
-                shown = ", ".join(f"{label} -> {name!r}" for label, name in pairs[:3])
+                listed = ", ".join(f"{label} -> {shown(name)}" for label, name in pairs[:3])
                 rep.warn(
                     f"{len(pairs)} {kind}(s) share a prim name with another and get a "
-                    f"suffix: {shown}{', ...' if len(pairs) > 3 else ''}"
+                    f"suffix: {listed}{', ...' if len(pairs) > 3 else ''}"
                 )
 
 
@@ -306,7 +306,7 @@ class _Builder:
             else:  # a floating articulation: USD has no joint prim, so no name
                 body.add_freejoint()
                 self.rep.warn(
-                    f"body {body.name!r} floats: USD holds no free joint prim, so the free "
+                    f"body {shown(body.name)} floats: USD holds no free joint prim, so the free "
                     "joint's name is not in the file; left unnamed"
                 )
             return

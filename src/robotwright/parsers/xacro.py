@@ -40,6 +40,7 @@ import defusedxml.ElementTree as DET
 
 from robotwright._atomic import write_text_atomic
 from robotwright._inputs import MAX_XML_BYTES, MAX_YAML_BYTES, decode, read_bytes
+from robotwright._names import shown
 from robotwright._paths import resolve_inside, trusted_roots
 from robotwright._temporaries import prefix
 from robotwright._xmlsafe import parse_xml
@@ -172,7 +173,7 @@ def isolated_python_command(module: str, function: str) -> list[str]:
 
     home = Path(__file__).resolve().parents[2]  # the folder holding robotwright/
     bootstrap = (
-        f"import sys; sys.path.insert(0, {str(home)!r}); "
+        f"import sys; sys.path.insert(0, {shown(str(home))}); "
         f"from {module} import {function}; {function}()"
     )
     return [sys.executable, "-I", "-c", bootstrap]
@@ -330,7 +331,7 @@ class _Guard:
     def open(self, file: Any, mode: str = "r", *args: Any, **kwargs: Any) -> io.StringIO:
         """xacro's ``open``: checked path, size cap, safe XML; read-only."""
         if "r" not in mode or any(c in mode for c in "wax+"):
-            raise _Refused(f"xacro tried to open {file!r} with mode {mode!r}; refused")
+            raise _Refused(f"xacro tried to open {shown(file)} with mode {shown(mode)}; refused")
         path = self.check(file)
         is_yaml = path.suffix.lower() in (".yaml", ".yml")
         try:

@@ -12,6 +12,7 @@ import re
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
+from robotwright._names import shown
 from robotwright.parsers.xacro_names import (
     _CONTAINERS,
     _SCALARS,
@@ -155,7 +156,7 @@ class Evaluator:
 
     def _Constant(self, node: ast.Constant, local: dict[str, Any]) -> Any:
         if type(node.value) not in _SCALARS:
-            raise ExpressionError(f"the literal {node.value!r} is not allowed")
+            raise ExpressionError(f"the literal {shown(node.value)} is not allowed")
         return _checked(node.value, "a literal")
 
     def _Name(self, node: ast.Name, local: dict[str, Any]) -> Any:
@@ -265,7 +266,7 @@ class Evaluator:
         index = self._eval(node.slice, local)
         if isinstance(value, self.scopes) and self.scope_lookup is not None:
             if not isinstance(index, str) or index.startswith("_"):
-                raise ExpressionError(f"a namespace key must be a name, not {index!r}")
+                raise ExpressionError(f"a namespace key must be a name, not {shown(index)}")
             return self._value(self.scope_lookup(value, index), index)
         if not (type(value) in (str, list, tuple, dict) or isinstance(value, self.dotted)):
             raise ExpressionError(f"a {type(value).__name__} cannot be subscripted")
