@@ -144,6 +144,12 @@ class InputFileError(RobotwrightError, ValueError):
         super().__init__(f"{path}: {reason}")
 
 
+class RobotSetupWarning(UserWarning):
+    """A robot written for simulation will not behave as a user training it expects (no
+    drives, a fixed base on a legged robot, a drive without damping): shown always,
+    naming the robot and what to give."""
+
+
 class ConversionWarning(UserWarning):
     """An element was dropped or approximated during a conversion (named in the message).
 

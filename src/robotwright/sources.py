@@ -64,6 +64,8 @@ URDF_OPTIONS = (
     "inertia_from_geoms",
     "density",
     "floating_base",
+    "actuators",
+    "actuator_gains",
 )
 MJCF_OPTIONS = ("root_body",)
 XACRO_OPTIONS = ("xacro_args",)

@@ -13,6 +13,7 @@ from pathlib import Path
 from robotwright._outputs import check_overwrite
 from robotwright.cli.options import (
     ROBOT_SOURCE_HELP,
+    actuator_gain,
     add_overwrite_flag,
     add_strict_flags,
     parse_xacro_arg,
@@ -51,18 +52,6 @@ def _options(args: argparse.Namespace) -> dict:
     return opts
 
 
-def _actuator_gain(text: str) -> tuple[str, tuple[float, float]]:
-    """``PATTERN=KP,KV`` (or ``PATTERN=KP``) of ``--actuator-gain``."""
-    pattern, sep, values = text.rpartition("=")
-    try:
-        gains = tuple(float(v) for v in values.split(","))
-    except ValueError:
-        gains = ()
-    if not sep or not pattern or len(gains) not in (1, 2) or min(gains) < 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected PATTERN=KP,KV (numbers >= 0)")
-    return pattern, (gains[0], gains[1] if len(gains) == 2 else 0.0)
-
-
 def _density(text: str) -> float:
     """``--density``: a finite number > 0 (kg/m^3)."""
     from robotwright.parsers.inertia_from_geoms import check_density
@@ -92,7 +81,7 @@ def _source_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--actuator-gain",
         action="append",
-        type=_actuator_gain,
+        type=actuator_gain,
         metavar="PATTERN=KP,KV",
         help="URDF --actuators position/velocity/auto: servo gains for the joints whose "
         "name matches PATTERN (fnmatch; first match wins; repeat for several)",

@@ -7,6 +7,8 @@ import re
 import warnings
 from pathlib import Path
 
+from robotwright._bounds import Bound
+from robotwright._names import shown
 from robotwright._outputs import check_overwrite
 from robotwright._usd_format import USD_SUFFIXES
 from robotwright.cli.options import ROBOT_SOURCE_HELP, add_overwrite_flag, add_strict_flags
@@ -25,15 +27,34 @@ _EXPORT_FORMAT_HELP = (
 )
 
 
-def _add_usd_layout(p: argparse.ArgumentParser) -> None:
+def _add_usd_layout(p: argparse.ArgumentParser, default: str = "nested") -> None:
     p.add_argument(
         "--usd-layout",
         choices=("nested", "flat"),
-        default="nested",
-        help="USD: bodies nested as the kinematic tree (default, the converter's) or flat, "
-        "each a child of the robot's prim as Isaac Lab's importers write them (its body "
-        "expressions and PhysX contact sensors expect that)",
+        default=default,
+        help=f"USD: bodies nested as the kinematic tree (the converter's) or flat, each a "
+        "child of the robot's prim as Isaac Lab's importers write them (its body "
+        f"expressions, sensor prim paths and PhysX contact sensors expect that); default "
+        f"{default}",
     )
+
+
+#: An initial joint position [rad or m] given on the command line.
+JOINT_POS_BOUND = Bound(-1e3, 1e3)
+
+
+def _joint_pos(text: str) -> tuple[str, float]:
+    """``PATTERN=VALUE`` of ``--joint-pos``."""
+    pattern, sep, value = text.rpartition("=")
+    try:
+        number = JOINT_POS_BOUND.check(float(value))
+    except ValueError:
+        number = None
+    if not sep or not pattern or number is None:
+        raise argparse.ArgumentTypeError(
+            f"{shown(text)}: expected PATTERN=VALUE, VALUE {JOINT_POS_BOUND.describe()} (rad or m)"
+        )
+    return pattern, float(number)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -87,14 +108,27 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Write a Python module with an Isaac Lab ArticulationCfg (ROBOT_CFG: "
         "USD spawn, initial state, ImplicitActuatorCfg groups from the robot's actuators) "
         "and the robot's USD beside it, named after the module (robot_cfg.py: robot_cfg.usd; "
-        "as `export -o robot_cfg.usd` writes it). Isaac Lab's environment (Python 3.12).",
-        epilog="Example: robotwright isaaclab-cfg mini_humanoid -o robots/mini_humanoid_cfg.py",
+        "as `export -o robot_cfg.usd` writes it). A free base starts standing on z = 0 in "
+        "its initial pose. Isaac Lab's environment (Python 3.12).",
+        epilog="Example (a trainable Go2): robotwright isaaclab-cfg go2 --floating-base "
+        "--actuators position --actuator-gain '*=25,0.5' --joint-pos '*thigh_joint=0.8' "
+        "--joint-pos '*calf_joint=-1.5' -o robots/go2_cfg.py",
     )
     p.add_argument("robot", help=ROBOT_SOURCE_HELP)
     p.add_argument(
         "--strict", action="store_true", help="fail instead of writing when the USD's proof differs"
     )
-    _add_usd_layout(p)
+    p.add_argument(
+        "--joint-pos",
+        action="append",
+        type=_joint_pos,
+        default=[],
+        metavar="PATTERN=VALUE",
+        help="initial position [rad or m] of the joints whose name matches PATTERN (fnmatch; "
+        "first match wins; repeatable): a legged robot's standing pose; other joints keep "
+        "their reference position",
+    )
+    _add_usd_layout(p, default="flat")
     p.add_argument("-o", "--output", required=True, help="the module to write (.py)")
     add_overwrite_flag(p)
     p.set_defaults(func=_isaaclab_cfg)
@@ -226,9 +260,19 @@ def _isaaclab_cfg(args: argparse.Namespace) -> int:
     check_overwrite([args.output, str(Path(args.output).with_suffix(".usd"))], args.overwrite)
     hrdf = load_robot(args.robot)
     module, usd = write_articulation_cfg(
-        hrdf, args.output, overwrite=args.overwrite, strict=args.strict, layout=args.usd_layout
+        hrdf,
+        args.output,
+        overwrite=args.overwrite,
+        strict=args.strict,
+        layout=args.usd_layout,
+        joint_pos=args.joint_pos,
     )
     print(f"wrote {module} (ROBOT_CFG) and {usd}")
+    if args.usd_layout == "flat":
+        # Where a sensor goes: a body of the robot prim spawned at {ENV_REGEX_NS}/Robot.
+        print(
+            f"bodies are {{ENV_REGEX_NS}}/Robot/<body>; the base: {{ENV_REGEX_NS}}/Robot/{hrdf.root_body.name}"
+        )
     return 0
 
 

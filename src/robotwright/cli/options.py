@@ -8,6 +8,8 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from robotwright._bounds import Bound
+from robotwright._names import shown
 from robotwright.sources import MJCF_OPTIONS, URDF_OPTIONS
 
 __all__ = [
@@ -55,6 +57,29 @@ def parse_xacro_arg(text: str) -> tuple[str, str]:
     if not sep or not name.strip():
         raise argparse.ArgumentTypeError(f"{text!r}: expected NAME:=VALUE")
     return name.strip(), value
+
+
+#: A servo gain from the command line: kp [N m/rad or N/m], kv [N m s/rad or N s/m].
+GAIN_BOUND = Bound(0.0, 1e9)
+
+
+def actuator_gain(text: str) -> tuple[str, tuple[float, float]]:
+    """``PATTERN=KP,KV`` (or ``PATTERN=KP``) of ``--actuator-gain``."""
+    pattern, sep, values = text.rpartition("=")
+    try:
+        gains = tuple(float(v) for v in values.split(","))
+    except ValueError:
+        gains = ()
+    if (
+        not sep
+        or not pattern
+        or len(gains) not in (1, 2)
+        or any(GAIN_BOUND.check(g) is None for g in gains)
+    ):
+        raise argparse.ArgumentTypeError(
+            f"{shown(text)}: expected PATTERN=KP,KV, each {GAIN_BOUND.describe()}"
+        )
+    return pattern, (gains[0], gains[1] if len(gains) == 2 else 0.0)
 
 
 def add_source_options(p: argparse.ArgumentParser) -> None:
@@ -112,6 +137,21 @@ def add_source_options(p: argparse.ArgumentParser) -> None:
         "render, view and lidar then stand it on the floor",
     )
     add(
+        "--actuators",
+        choices=("none", "motor", "position", "velocity", "auto"),
+        help="URDF: none (default; URDF has no actuators), one torque motor per moving joint "
+        "(motor), PD or velocity servos with --actuator-gain (position, velocity), or what "
+        "each <transmission> declares (auto)",
+    )
+    add(
+        "--actuator-gain",
+        action="append",
+        type=actuator_gain,
+        metavar="PATTERN=KP,KV",
+        help="URDF --actuators position/velocity/auto: servo gains of the joints whose name "
+        "matches PATTERN (fnmatch; first match wins; repeatable)",
+    )
+    add(
         "--xacro-arg",
         action="append",
         type=parse_xacro_arg,
@@ -129,6 +169,8 @@ def source_options(args: argparse.Namespace) -> dict[str, Any]:
             opts[name] = value
     if getattr(args, "xacro_arg", None):
         opts["xacro_args"] = dict(args.xacro_arg)
+    if getattr(args, "actuator_gain", None):
+        opts["actuator_gains"] = dict(args.actuator_gain)
     return opts
 
 

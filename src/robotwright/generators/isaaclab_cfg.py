@@ -24,11 +24,15 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
+from fnmatch import fnmatchcase
 from pathlib import Path
 
 import mujoco
 
 from robotwright._atomic import write_text_atomic
+from robotwright._names import shown
+from robotwright._notes import name_list
 from robotwright._outputs import check_overwrite
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
@@ -64,13 +68,26 @@ def _groups(hrdf: HRDF) -> list[tuple[dict[str, float], list[str]]]:
 
 
 def _initial_state(
-    model: mujoco.MjModel,
+    model: mujoco.MjModel, joint_pos: Sequence[tuple[str, float]] = ()
 ) -> tuple[tuple[float, float, float], dict[str, float], list[str]]:
-    """Root position [m] and joint positions (the MJCF's reference pose, clamped into
-    the joint ranges Isaac Lab checks), with a line per clamped joint."""
+    """Root position [m] and joint positions, with a line per clamped joint.
+
+    A joint's position is the value of the first ``(pattern, value)`` of ``joint_pos``
+    whose fnmatch pattern matches its name (a user's standing pose, rad or m), else the
+    MJCF's reference pose clamped into the joint's range (Isaac Lab checks ranges). A
+    free base is raised so that its collision geometry, in that pose, stands on z = 0;
+    the USD's root body sits at its prim's origin (:func:`~robotwright.generators.usd.to_usd`),
+    so this position is where the base spawns and where a reset puts it.
+
+    Raises:
+        GeneratorError: a pattern matches no joint, or a value lies outside the range of
+            a joint it sets.
+    """
     pos = (0.0, 0.0, 0.0)
-    joint_pos: dict[str, float] = {}
+    positions: dict[str, float] = {}
     clamped = []
+    used = [False] * len(joint_pos)
+    problems = []
     for j in range(model.njnt):
         adr = int(model.jnt_qposadr[j])
         kind = int(model.jnt_type[j])
@@ -80,21 +97,39 @@ def _initial_state(
         if kind not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
             continue
         name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
-        q = float(model.qpos0[adr])
-        if model.jnt_limited[j]:
-            lo, hi = (float(v) for v in model.jnt_range[j])
-            if not lo <= q <= hi:
-                new = min(max(q, lo), hi)
-                clamped.append(
-                    f"{name}: reference position {q:g} outside [{lo:g}, {hi:g}], written as {new:g}"
+        lo, hi = (float(v) for v in model.jnt_range[j])
+        limited = bool(model.jnt_limited[j])
+        given = next((k for k, (pat, _) in enumerate(joint_pos) if fnmatchcase(name, pat)), None)
+        if given is not None:
+            used[given] = True
+            q = float(joint_pos[given][1])
+            if limited and not lo <= q <= hi:
+                problems.append(
+                    f"--joint-pos {shown(joint_pos[given][0])}={q:g}: joint {shown(name)} "
+                    f"moves in [{lo:g}, {hi:g}]"
                 )
-                q = new
-        joint_pos[name] = q
+            positions[name] = q
+            continue
+        q = float(model.qpos0[adr])
+        if limited and not lo <= q <= hi:
+            new = min(max(q, lo), hi)
+            clamped.append(
+                f"{name}: reference position {q:g} outside [{lo:g}, {hi:g}], written as {new:g}"
+            )
+            q = new
+        positions[name] = q
+    problems += [
+        f"--joint-pos {shown(pat)}: matches no hinge or slide joint"
+        for (pat, _), hit in zip(joint_pos, used, strict=True)
+        if not hit
+    ]
+    if problems:
+        raise GeneratorError("; ".join(problems))
     if not model.njnt or int(model.jnt_type[0]) != int(mujoco.mjtJoint.mjJNT_FREE):
         pos = tuple(float(v) for v in model.body_pos[1])  # type: ignore[assignment]
     else:
-        pos = (pos[0], pos[1], pos[2] + _floor_clearance(model, joint_pos))
-    return pos, joint_pos, clamped
+        pos = (pos[0], pos[1], pos[2] + _floor_clearance(model, positions))
+    return pos, positions, clamped
 
 
 def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> float:
@@ -110,6 +145,42 @@ def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> floa
     return 0.0 if not math.isfinite(lowest) else -lowest
 
 
+#: Body names that say a robot walks (its feet and the links above them).
+_LEGGED = re.compile(r"(foot|feet|toe|ankle|calf|shin|sole)", re.IGNORECASE)
+
+
+def setup_warnings(hrdf: HRDF, model: mujoco.MjModel) -> list[str]:
+    """What would surprise a user training this robot: no drives at all, a fixed base on
+    a robot whose bodies say it walks, a position drive without damping. One line each,
+    naming the robot, the joints and the option that changes it."""
+    out = []
+    name = shown(hrdf.name)
+    if not hrdf.actuators:
+        out.append(
+            f"robot {name} has no actuators: its USD has no joint drives and the config "
+            "actuators={}; give --actuators position --actuator-gain 'PATTERN=KP,KV' (URDF "
+            "sources) or a robot file with actuators"
+        )
+    floating = model.njnt > 0 and int(model.jnt_type[0]) == int(mujoco.mjtJoint.mjJNT_FREE)
+    feet = [b.name for b in hrdf.bodies if _LEGGED.search(b.name)]
+    if not floating and len(feet) >= 2:
+        out.append(
+            f"robot {name} has a fixed base but its bodies say it walks "
+            f"({name_list(feet, 4)}): give --floating-base for a free base"
+        )
+    undamped = [
+        a.joint
+        for a in hrdf.actuators
+        if (a.type or "motor") == "position" and (a.p_gain or 0.0) > 0 and not (a.d_gain or 0.0)
+    ]
+    if undamped:
+        out.append(
+            f"robot {name}: position drives without damping (kv = 0) on "
+            f"{name_list(undamped, 4)}: they oscillate; give --actuator-gain 'PATTERN=KP,KV'"
+        )
+    return out
+
+
 def _docstring(text: str) -> str:
     """``text`` as a module docstring. It holds names from the robot file, so it is a
     plain triple-quoted block only when no character could end or escape it (printable
@@ -119,10 +190,15 @@ def _docstring(text: str) -> str:
 
 
 def articulation_cfg_source(
-    hrdf: HRDF, model: mujoco.MjModel, usd_name: str
+    hrdf: HRDF,
+    model: mujoco.MjModel,
+    usd_name: str,
+    joint_pos: Sequence[tuple[str, float]] = (),
 ) -> tuple[str, list[str]]:
-    """The module's text and the notes (joints whose reference pose was clamped)."""
-    pos, joint_pos, clamped = _initial_state(model)
+    """The module's text and the notes (joints whose reference pose was clamped);
+    ``joint_pos``: ``(fnmatch pattern, position)`` pairs, first match wins (see
+    :func:`_initial_state`)."""
+    pos, joint_pos_by_name, clamped = _initial_state(model, joint_pos)
     doc = [
         f"Isaac Lab ArticulationCfg of the robot {hrdf.name!r}, written by robotwright.",
         "",
@@ -150,7 +226,9 @@ def articulation_cfg_source(
         f"        pos=({', '.join(_num(v) for v in pos)}),",
         "        joint_pos={",
     ]
-    lines += [f"            {re.escape(name)!r}: {_num(q)}," for name, q in joint_pos.items()]
+    lines += [
+        f"            {re.escape(name)!r}: {_num(q)}," for name, q in joint_pos_by_name.items()
+    ]
     lines += ["        },", "    ),", "    actuators={"]
     for k, (values, joints) in enumerate(_groups(hrdf)):
         exprs = ", ".join(repr(re.escape(j)) for j in joints)
@@ -172,16 +250,30 @@ def write_articulation_cfg(
     *,
     overwrite: bool = False,
     strict: bool = False,
-    layout: str = "nested",
+    layout: str = "flat",
+    joint_pos: Sequence[tuple[str, float]] = (),
 ) -> tuple[Path, Path]:
     """Write ``<output>`` (the module) and the robot's USD beside it, named after the
     module (``robots/go2_cfg.py`` and ``robots/go2_cfg.usd``: the robot file's own name
-    never chooses a file name; ``layout``: see :func:`~robotwright.generators.usd.to_usd`).
-    Both go through the output gate (a temporary of their own, then a rename).
+    never chooses a file name). Both go through the output gate (a temporary of their
+    own, then a rename).
+
+    Args:
+        layout: ``"flat"`` (the default: every body a child of the robot's prim, so that
+            ``{ENV_REGEX_NS}/Robot/<body>`` names a body, as the LiDAR's ``prim_path``
+            and Isaac Lab's contact sensors need) or ``"nested"``; see
+            :func:`~robotwright.generators.usd.to_usd`.
+        joint_pos: the initial joint positions, ``(fnmatch pattern, value)`` pairs
+            (rad or m; first match wins): a legged robot's standing pose.
+
+    Each :func:`setup_warnings` line is a :class:`~robotwright.errors.RobotSetupWarning`.
 
     Returns:
         (module path, USD path).
     """
+    import warnings
+
+    from robotwright.errors import RobotSetupWarning
     from robotwright.generators.usd import to_usd
 
     out = Path(output)
@@ -191,9 +283,11 @@ def write_articulation_cfg(
     check_overwrite([out, usd], overwrite)
     done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout)
     try:  # the initial state comes from the MJCF the USD was made from
-        text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name)
+        text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name, joint_pos)
         write_text_atomic(out, text)
     except BaseException:
         usd.unlink(missing_ok=True)  # no half of the pair without the other
         raise
+    for line in setup_warnings(hrdf, done.mjcf_model):
+        warnings.warn(line, RobotSetupWarning, stacklevel=2)
     return out, usd

@@ -107,11 +107,19 @@ def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
 
     model = converter_model_name(hrdf.name)
     path = folder / "mjcf" / f"{model}.xml"
+    robot = dataclasses.replace(hrdf, name=model)
+    if hrdf.floating_base and any(hrdf.root_body.pos):
+        # A free base at its prim's origin: Isaac Lab places the prim at the config's
+        # initial position when it spawns and the root body there when it resets; an
+        # offset of the body inside the prim would count twice at spawn.
+        bodies = [
+            dataclasses.replace(b, pos=(0.0, 0.0, 0.0)) if b is hrdf.root_body else b
+            for b in hrdf.bodies
+        ]
+        robot = dataclasses.replace(robot, bodies=bodies)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        MJCFHumanoidGenerator.from_hrdf(dataclasses.replace(hrdf, name=model)).export(
-            path, copy_meshes=True, add_scene=False
-        )
+        MJCFHumanoidGenerator.from_hrdf(robot).export(path, copy_meshes=True, add_scene=False)
     lost = []
     for w in caught:
         lines = str(w.message).splitlines()
