@@ -88,6 +88,14 @@ def is_ours(w: warnings.WarningMessage) -> bool:
     )
 
 
+def _always_shown(w: warnings.WarningMessage) -> bool:
+    """A warning the command line prints as it is, never folded into the notes' count
+    (:class:`~robotwright.errors.RobotSetupWarning`: what the user must act on)."""
+    from robotwright.errors import RobotSetupWarning
+
+    return issubclass(w.category, RobotSetupWarning)
+
+
 def _unique(items: Iterable[Note]) -> list[Note]:
     return list(dict.fromkeys(items))
 
@@ -115,7 +123,7 @@ def collect_notes() -> Iterator[CaughtNotes]:
         finally:
             notes: list[Note] = []
             for w in caught:
-                if is_ours(w):
+                if is_ours(w) and not _always_shown(w):
                     notes += notes_of(str(w.message))
                 else:
                     caught_notes.others.append(w)

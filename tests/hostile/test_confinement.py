@@ -141,7 +141,12 @@ def checks_off(monkeypatch):
     def accept(file, *, base, root, trusted=None, what="", hint=""):
         return (Path(base) / file).resolve()
 
+    from robotwright.parsers import mjcf_geoms
+
+    # The checks and the mesh stager resolve through the same function (the stager
+    # imports it by name).
     monkeypatch.setattr(paths, "resolve_inside", accept)
+    monkeypatch.setattr(mjcf_geoms, "resolve_inside", accept)
     for module in (mjcf_parser, paths, view_scene):
         if hasattr(module, "check_mjcf_includes"):
             monkeypatch.setattr(module, "check_mjcf_includes", lambda *a, **k: None)

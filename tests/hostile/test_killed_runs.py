@@ -117,15 +117,21 @@ def test_the_sweep_leaves_running_processes_and_other_names_alone(tmp_path) -> N
 
 
 def test_sigterm_unwinds_like_ctrl_c() -> None:
-    cleaned = []
-    with pytest.raises(KeyboardInterrupt), terminate_like_interrupt():
-        try:
-            os.kill(os.getpid(), signal.SIGTERM)
-            time.sleep(5)
-        finally:
-            cleaned.append(True)
-    assert cleaned == [True]
-    assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+    # A test runner's worker may have a SIGTERM handler of its own: the command line
+    # starts with the default one, so the test does too (and restores the runner's).
+    runner = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        cleaned = []
+        with pytest.raises(KeyboardInterrupt), terminate_like_interrupt():
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(5)
+            finally:
+                cleaned.append(True)
+        assert cleaned == [True]
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+    finally:
+        signal.signal(signal.SIGTERM, runner)
 
 
 def _catches_sigterm(pid: int) -> bool:

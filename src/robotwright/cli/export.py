@@ -43,6 +43,19 @@ def _add_usd_layout(p: argparse.ArgumentParser, default: str = "nested") -> None
 JOINT_POS_BOUND = Bound(-1e3, 1e3)
 
 
+def _add_joint_pos(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--joint-pos",
+        action="append",
+        type=_joint_pos,
+        default=[],
+        metavar="PATTERN=VALUE",
+        help="initial position [rad or m] of the joints whose name matches PATTERN (fnmatch; "
+        "first match wins; repeatable): a legged robot's standing pose; other joints keep "
+        "their reference position",
+    )
+
+
 def _joint_pos(text: str) -> tuple[str, float]:
     """``PATTERN=VALUE`` of ``--joint-pos``."""
     pattern, sep, value = text.rpartition("=")
@@ -118,20 +131,28 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--strict", action="store_true", help="fail instead of writing when the USD's proof differs"
     )
-    p.add_argument(
-        "--joint-pos",
-        action="append",
-        type=_joint_pos,
-        default=[],
-        metavar="PATTERN=VALUE",
-        help="initial position [rad or m] of the joints whose name matches PATTERN (fnmatch; "
-        "first match wins; repeatable): a legged robot's standing pose; other joints keep "
-        "their reference position",
-    )
+    _add_joint_pos(p)
     _add_usd_layout(p, default="flat")
     p.add_argument("-o", "--output", required=True, help="the module to write (.py)")
     add_overwrite_flag(p)
     p.set_defaults(func=_isaaclab_cfg)
+    p = sub.add_parser(
+        "mjlab-cfg",
+        help="write an mjlab EntityCfg module and the robot's MJCF",
+        description="Write a Python module with an mjlab EntityCfg (ROBOT_CFG: the MJCF "
+        "beside it, the initial state, the MJCF's actuators wrapped by XmlActuatorCfg) and "
+        "the robot's MJCF (robot only, meshes copied), named after the module "
+        "(robot_entity.py: robot_entity.xml). A free base starts standing on z = 0 in its "
+        "initial pose. mjlab's environment (MuJoCo 3.11).",
+        epilog="Example (a trainable Go2): robotwright mjlab-cfg go2 --floating-base "
+        "--actuators position --actuator-gain '*=50,1' --joint-pos '*thigh_joint=0.9' "
+        "--joint-pos '*calf_joint=-1.5' -o robots/go2_entity.py",
+    )
+    p.add_argument("robot", help=ROBOT_SOURCE_HELP)
+    _add_joint_pos(p)
+    p.add_argument("-o", "--output", required=True, help="the module to write (.py)")
+    add_overwrite_flag(p)
+    p.set_defaults(func=_mjlab_cfg)
     p = sub.add_parser(
         "compose",
         help="put several robots in one scene file",
@@ -273,6 +294,21 @@ def _isaaclab_cfg(args: argparse.Namespace) -> int:
         print(
             f"bodies are {{ENV_REGEX_NS}}/Robot/<body>; the base: {{ENV_REGEX_NS}}/Robot/{hrdf.root_body.name}"
         )
+    return 0
+
+
+def _mjlab_cfg(args: argparse.Namespace) -> int:
+    from robotwright.generators.mjlab_cfg import write_entity_cfg
+    from robotwright.tasks import load_robot
+
+    if Path(args.output).suffix != ".py":
+        raise GeneratorError(f"{args.output}: expected a Python module file name ending in .py")
+    check_overwrite([args.output, str(Path(args.output).with_suffix(".xml"))], args.overwrite)
+    hrdf = load_robot(args.robot)
+    module, xml = write_entity_cfg(
+        hrdf, args.output, overwrite=args.overwrite, joint_pos=args.joint_pos
+    )
+    print(f"wrote {module} (ROBOT_CFG) and {xml}")
     return 0
 
 

@@ -61,6 +61,7 @@ _ASSET_COMMANDS: tuple[str, ...] = (
     "render",
     "lidar",
     "isaaclab-cfg",
+    "mjlab-cfg",
 )
 
 #: Commands that read URDF/xacro files (every command that reads a robot: any takes a

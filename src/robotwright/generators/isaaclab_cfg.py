@@ -37,13 +37,21 @@ from robotwright._outputs import check_overwrite
 from robotwright.errors import GeneratorError
 from robotwright.hrdf.model import HRDF
 
-__all__ = ["articulation_cfg_source", "write_articulation_cfg"]
+__all__ = [
+    "articulation_cfg_source",
+    "cfg_number",
+    "docstring_literal",
+    "initial_state",
+    "setup_warnings",
+    "write_articulation_cfg",
+]
 
 
-def _num(value: float) -> str:
+def cfg_number(value: float) -> str:
+    """``value`` as a Python float literal for a generated config module."""
     value = float(value)
     if not math.isfinite(value):
-        raise GeneratorError(f"cannot write a non-finite value {value!r} into the Isaac Lab config")
+        raise GeneratorError(f"cannot write a non-finite value {value!r} into a config module")
     return repr(value)
 
 
@@ -67,7 +75,7 @@ def _groups(hrdf: HRDF) -> list[tuple[dict[str, float], list[str]]]:
     return list(groups.values())
 
 
-def _initial_state(
+def initial_state(
     model: mujoco.MjModel, joint_pos: Sequence[tuple[str, float]] = ()
 ) -> tuple[tuple[float, float, float], dict[str, float], list[str]]:
     """Root position [m] and joint positions, with a line per clamped joint.
@@ -181,7 +189,7 @@ def setup_warnings(hrdf: HRDF, model: mujoco.MjModel) -> list[str]:
     return out
 
 
-def _docstring(text: str) -> str:
+def docstring_literal(text: str) -> str:
     """``text`` as a module docstring. It holds names from the robot file, so it is a
     plain triple-quoted block only when no character could end or escape it (printable
     characters and newlines, no quote or backslash); otherwise one escaped literal."""
@@ -197,8 +205,8 @@ def articulation_cfg_source(
 ) -> tuple[str, list[str]]:
     """The module's text and the notes (joints whose reference pose was clamped);
     ``joint_pos``: ``(fnmatch pattern, position)`` pairs, first match wins (see
-    :func:`_initial_state`)."""
-    pos, joint_pos_by_name, clamped = _initial_state(model, joint_pos)
+    :func:`initial_state`)."""
+    pos, joint_pos_by_name, clamped = initial_state(model, joint_pos)
     doc = [
         f"Isaac Lab ArticulationCfg of the robot {hrdf.name!r}, written by robotwright.",
         "",
@@ -210,7 +218,7 @@ def articulation_cfg_source(
         doc += ["", "Joint positions clamped into their ranges (Isaac Lab checks them):"]
         doc += [f"  {c}" for c in clamped]
     lines = [
-        _docstring("\n".join(doc) + "\n"),
+        docstring_literal("\n".join(doc) + "\n"),
         "",
         "from pathlib import Path",
         "",
@@ -223,11 +231,12 @@ def articulation_cfg_source(
         "ROBOT_CFG = ArticulationCfg(",
         "    spawn=sim_utils.UsdFileCfg(usd_path=USD_PATH),",
         "    init_state=ArticulationCfg.InitialStateCfg(",
-        f"        pos=({', '.join(_num(v) for v in pos)}),",
+        f"        pos=({', '.join(cfg_number(v) for v in pos)}),",
         "        joint_pos={",
     ]
     lines += [
-        f"            {re.escape(name)!r}: {_num(q)}," for name, q in joint_pos_by_name.items()
+        f"            {re.escape(name)!r}: {cfg_number(q)},"
+        for name, q in joint_pos_by_name.items()
     ]
     lines += ["        },", "    ),", "    actuators={"]
     for k, (values, joints) in enumerate(_groups(hrdf)):
@@ -235,10 +244,10 @@ def articulation_cfg_source(
         lines.append(f"        {f'group_{k}'!r}: ImplicitActuatorCfg(")
         lines.append(f"            joint_names_expr=[{exprs}],")
         for key in ("stiffness", "damping"):  # None: Isaac Lab takes the USD drive's
-            lines.append(f"            {key}={_num(values[key]) if key in values else None},")
+            lines.append(f"            {key}={cfg_number(values[key]) if key in values else None},")
         for key in ("joint_effort_limit", "joint_velocity_limit"):
             if key in values:
-                lines.append(f"            {key}={_num(values[key])},")
+                lines.append(f"            {key}={cfg_number(values[key])},")
         lines.append("        ),")
     lines += ["    },", ")", ""]
     return "\n".join(lines), clamped
