@@ -448,3 +448,56 @@ def test_observation_terms_in_isaac_lab_style(world):
         )
         assert torch.equal(_window_cells(sensor, 64, 16), want)
         _step(sim, scene, 1)
+
+
+def test_every_mesh_prim_paths_entry_that_matches_nothing_is_named(world):
+    """An entry naming no collision shape (a typo, a prim the scene lacks) is listed
+    by name, the others are not; the sensor warns each one when it starts."""
+    from robotwright.sensors.isaaclab.config import resolve
+    from robotwright.sensors.isaaclab.scene_shapes import scene_shapes
+
+    _, scene = world
+    sensor = scene["seed"]
+    model = sensor.backend.model
+    carriers = model.shape_body.numpy()[sensor._sensor_site_indices.numpy()]
+    cfg = _seed_cfg()
+    cfg.mesh_prim_paths = [*cfg.mesh_prim_paths, "/World/no_such_prim", "{ENV_REGEX_NS}/Sofa"]
+    shapes = scene_shapes(model, carriers, resolve(cfg), True, lambda path: 0)
+    assert shapes.unmatched_patterns == ("/World/no_such_prim", "{ENV_REGEX_NS}/Sofa")
+    seed = scene_shapes(model, carriers, resolve(_seed_cfg()), True, lambda path: 0)
+    assert seed.unmatched_patterns == ()
+    with pytest.warns(UserWarning, match="'/World/no_such_prim' matches no"):
+        sensor.shapes, saved = shapes, sensor.shapes
+        try:
+            sensor._warn_scene()
+        finally:
+            sensor.shapes = saved
+
+
+def test_hits_lost_to_max_pass_through_are_counted_and_warned(world):
+    """With the robot see-through and no pass allowed, every ray that first meets the
+    robot reads as a miss: counted on the device, at least the rays a multi-pass
+    reference sees a hit for, and warned once."""
+    sim, scene = world
+    sensor = scene["no_self"]
+    _step(sim, scene, 1)
+    before = sensor.lost_pass_through_hits
+    saved = sensor.cfg.max_pass_through
+    sensor.cfg.max_pass_through = 0
+    sensor._casts, sensor._lost_warned = 0, False  # the next cast looks at the count
+    try:
+        with pytest.warns(UserWarning, match="max_pass_through=0"):
+            _step(sim, scene, 1)
+            _ = sensor.data
+        lost = sensor.lost_pass_through_hits - before
+        hit = sensor.get_hit_mask().reshape(-1).cpu().numpy()
+        seen = sensor.shapes.visible.copy()
+        _, _, ref_hit = _reference(sensor, seen, sensor.shapes.classes, sensor.cfg.max_distance)
+        missed = int((ref_hit & ~hit).sum())
+        assert 0 < missed <= lost <= hit.size
+    finally:
+        sensor.cfg.max_pass_through = saved
+    _step(sim, scene, 1)
+    _ = sensor.data
+    after = sensor.lost_pass_through_hits
+    assert after == before + lost  # four passes: the robot is passed, nothing lost

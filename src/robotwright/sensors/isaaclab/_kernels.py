@@ -112,9 +112,11 @@ def scatter_pass(
     normal: wp.array(dtype=wp.vec3f),
     next_pending: wp.array(dtype=wp.int32),
     next_count: wp.array(dtype=wp.int32),
+    lost: wp.array(dtype=wp.int32),
 ):
     """Merge a re-cast into the rays' results; rays still behind see-through shapes are
-    queued again, or become misses on the last pass. dim=(pending,)."""
+    queued again, or on the last pass become misses, counted in ``lost[0]``.
+    dim=(pending,)."""
     j = wp.tid()
     i = pending[j]
     s = sub_shape[j]
@@ -131,9 +133,16 @@ def scatter_pass(
     if last_pass != 0:
         total[i] = -1.0
         shape[i] = -1
+        wp.atomic_add(lost, 0, 1)
         return
     slot = wp.atomic_add(next_count, 0, 1)
     next_pending[slot] = i
+
+
+@wp.kernel(enable_backward=False)
+def add_count(src: wp.array(dtype=wp.int32), dst: wp.array(dtype=wp.int32)):
+    """``dst[0] += src[0]`` on the device (no host read). dim=1."""
+    dst[0] = dst[0] + src[0]
 
 
 @wp.kernel(enable_backward=False)

@@ -130,6 +130,7 @@ class ResolvedLidarCfg:
         self_class_id: class of the carrier robot's shapes (0: they are see-through).
         miss_distance: the miss value of ``get_distances()`` [m].
         mesh_patterns: compiled ``mesh_prim_paths`` (empty: every shape is seen).
+        mesh_prim_paths: the entries as written, one per pattern (for messages).
     """
 
     mapping: dict[str, list[str]]
@@ -138,6 +139,7 @@ class ResolvedLidarCfg:
     self_class_id: int
     miss_distance: float
     mesh_patterns: tuple[re.Pattern[str], ...]
+    mesh_prim_paths: tuple[str, ...] = ()
 
 
 def _number(value: object) -> bool:
@@ -221,7 +223,9 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
         raise SensorError(f"{name}.exclude_parent_body: expected True or False")
     patterns = _mesh_patterns(cfg.mesh_prim_paths, name)
     if not isinstance(cfg, SemanticLidarCfg):
-        return ResolvedLidarCfg({}, (UNKNOWN_CLASS,), 0, 0, float(miss), patterns)
+        return ResolvedLidarCfg(
+            {}, (UNKNOWN_CLASS,), 0, 0, float(miss), patterns, tuple(cfg.mesh_prim_paths)
+        )
     for flag in ("return_semantic_labels", "return_mesh_ids"):
         if not isinstance(getattr(cfg, flag), bool):
             raise SensorError(f"{name}.{flag}: expected True or False")
@@ -235,4 +239,6 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
     names: tuple[str, ...] = (UNKNOWN_CLASS, *mapping)
     names, terrain_id = _class_slot(names, cfg.terrain_class, f"{name}.terrain_class")
     names, self_id = _class_slot(names, cfg.self_class, f"{name}.self_class")
-    return ResolvedLidarCfg(mapping, names, terrain_id, self_id, float(miss), patterns)
+    return ResolvedLidarCfg(
+        mapping, names, terrain_id, self_id, float(miss), patterns, tuple(cfg.mesh_prim_paths)
+    )

@@ -35,6 +35,8 @@ class SceneShapes:
         carrier: the shape belongs to a body carrying the sensor.
         own_robot: the shape belongs to the articulation carrying the sensor.
         unlabelled_terrain: a global shape with no prim path (class ``terrain_class``).
+        unmatched_patterns: the ``mesh_prim_paths`` entries that match no collision
+            shape (as the user wrote them).
     """
 
     labels: list[str]
@@ -44,6 +46,7 @@ class SceneShapes:
     carrier: np.ndarray
     own_robot: np.ndarray
     unlabelled_terrain: np.ndarray
+    unmatched_patterns: tuple[str, ...] = ()
 
 
 def articulation_bodies(child: np.ndarray, art: np.ndarray, body: int) -> set[int]:
@@ -134,12 +137,18 @@ def scene_shapes(
     carrier = np.isin(shape_body, list(carrier_bodies)) & (shape_body >= 0)
     own = np.isin(shape_body, list(robot_bodies)) & (shape_body >= 0)
     visible = collides.copy()
+    matched = [False] * len(resolved.mesh_patterns)
     if resolved.mesh_patterns:
         for s in range(n):
-            if not any(
-                p.fullmatch(a) for a in _ancestors(labels[s]) for p in resolved.mesh_patterns
-            ):
+            hits = [
+                any(p.fullmatch(a) for a in _ancestors(labels[s])) for p in resolved.mesh_patterns
+            ]
+            if not any(hits):
                 visible[s] = False
+            elif collides[s]:
+                matched = [m or h for m, h in zip(matched, hits, strict=True)]
+    entries = list(resolved.mesh_prim_paths)
+    unmatched = tuple(entries[i] for i, m in enumerate(matched) if not m)
     if exclude_parent_body:
         visible &= ~carrier
     if not resolved.self_class_id:
@@ -152,4 +161,4 @@ def scene_shapes(
             classes[s] = resolved.terrain_class_id
         else:
             classes[s] = classify(labels[s])
-    return SceneShapes(labels, collides, visible, classes, carrier, own, unlabelled)
+    return SceneShapes(labels, collides, visible, classes, carrier, own, unlabelled, unmatched)

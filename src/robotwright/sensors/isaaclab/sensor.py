@@ -53,6 +53,10 @@ from robotwright.sensors.semantic import classify_path
 
 __all__ = ["LidarSensor", "LidarSensorData", "SemanticLidarData", "SemanticLidarSensor"]
 
+#: Casts between two looks at the count of hits lost to ``max_pass_through`` (each look
+#: waits for the device once).
+LOST_CHECK_EVERY = 100
+
 EnvIds = torch.Tensor | Sequence[int] | slice | None
 
 
@@ -256,6 +260,11 @@ class LidarSensor(NewtonRaycastSensor):
         self._final_normal = wp.empty(count, dtype=wp.vec3f, device=dev)
         self._pending = [wp.empty(count, dtype=wp.int32, device=dev) for _ in range(2)]
         self._pending_count = [wp.zeros(1, dtype=wp.int32, device=dev) for _ in range(2)]
+        # Hits lost when max_pass_through runs out, summed on the device since the
+        # start; read on the host only every LOST_CHECK_EVERY casts (one warning).
+        self._lost = wp.zeros(1, dtype=wp.int32, device=dev)
+        self._casts = 0
+        self._lost_warned = False
         self._sub = {
             "starts": wp.empty(count, dtype=wp.vec3f, device=dev),
             "dirs": wp.empty(count, dtype=wp.vec3f, device=dev),
@@ -270,8 +279,41 @@ class LidarSensor(NewtonRaycastSensor):
         """Class of a shape path; the plain LiDAR has no classes."""
         return 0
 
+    @property
+    def lost_pass_through_hits(self) -> int:
+        """Rays, summed over every cast since the sensor started, that were still behind
+        see-through shapes (the carrier, the robot, shapes outside ``mesh_prim_paths``)
+        when ``max_pass_through`` ran out, and so read as misses. Reading it waits for the
+        device."""
+        return int(self._lost.numpy()[0])
+
+    def _check_lost(self) -> None:
+        """Warn once, naming the count, when hits were lost to ``max_pass_through``;
+        looks every :data:`LOST_CHECK_EVERY` casts (a host read)."""
+        self._casts += 1
+        if self._lost_warned or (self._casts - 1) % LOST_CHECK_EVERY:
+            return
+        lost = self.lost_pass_through_hits
+        if lost:
+            self._lost_warned = True
+            rays = self._casts * self._view_count * self.num_rays
+            warnings.warn(
+                f"{type(self.cfg).__name__}: {lost} of {rays} rays ({100 * lost / rays:.2g}%) "
+                f"were still behind see-through shapes after max_pass_through="
+                f"{self.cfg.max_pass_through} passes and read as misses; raise "
+                "max_pass_through, or mount the sensor outside the robot "
+                "(sensor.lost_pass_through_hits counts them)",
+                stacklevel=3,
+            )
+
     def _warn_scene(self) -> None:
         """Say what would otherwise go unnoticed: a pattern matching no shape."""
+        for entry in self.shapes.unmatched_patterns:
+            warnings.warn(
+                f"{type(self.cfg).__name__}.mesh_prim_paths entry {entry!r} matches no "
+                "collision shape of the scene (rays pass through what it was meant to name)",
+                stacklevel=3,
+            )
         if self.resolved.mesh_patterns and not self.shapes.visible.any():
             warnings.warn(
                 f"{type(self.cfg).__name__}.mesh_prim_paths={self.cfg.mesh_prim_paths!r} match "
@@ -389,10 +431,13 @@ class LidarSensor(NewtonRaycastSensor):
                     self._final_normal,
                     self._pending[nxt],
                     self._pending_count[nxt],
+                    self._lost,
                 ],
                 device=dev,
             )
             queue, nxt = nxt, queue
+        if passes == 0:  # every ray queued by the first pass is a lost hit
+            wp.launch(k.add_count, dim=1, inputs=[self._pending_count[0], self._lost], device=dev)
         wp.launch(
             k.finish_rays,
             dim=(e, n),
@@ -418,6 +463,7 @@ class LidarSensor(NewtonRaycastSensor):
             ],
             device=dev,
         )
+        self._check_lost()
 
     def direction_bounds(self) -> tuple[float, float, float, float, bool]:
         """Azimuth and elevation bounds [rad] of every ray of the pattern (all windows),
