@@ -1,6 +1,7 @@
 """Train the semantic seeker with and without the LiDAR's labels; compare time at target.
 
     python benchmarks/semantic_seeker.py --iterations 150 --seeds 1 [--jobs 2] [--out DIR]
+        [--policy mlp|pointnet]
 
 Runs mjlab's PPO (rsl_rl, the task's own runner config: 64 envs x 32 steps per
 iteration, MLP 128-64) on ``Mjlab-Semantic-Seeker-PointMass`` and on its ``-NoLabels``
@@ -12,6 +13,10 @@ first and last values and the seconds per iteration, writes ``DIR/seeker_runs.js
 and ``DIR/seeker_curves.png`` (needs matplotlib), and prints last:
 
     at target: labels X, no labels Y
+
+With ``--policy pointnet`` the one variant is ``Mjlab-Semantic-Seeker-PointMass-PointNet``
+(the labelled hits as a point cloud, :class:`robotwright.sensors.pointnet.PointNetModel`)
+and the last line is ``at target: pointnet X``.
 
 X and Y: ``at_target`` over the last 10 iterations (all of them when there are fewer),
 mean over seeds. The cylinders are solid; ``--pass-through`` turns contacts off. Needs the mjlab
@@ -32,11 +37,16 @@ from dataclasses import asdict
 from pathlib import Path
 
 VARIANTS = (("labels", True), ("no labels", False))
+#: ``--policy pointnet``: the labels read as a point cloud by PointNet (no twin without
+#: labels: the classes are what its points carry).
+POINTNET_VARIANTS = (("pointnet", True),)
 #: Iterations at the end whose ``at_target`` the summary averages.
 LAST = 10
 
 
-def train(labels: bool, seed: int, iterations: int, device: str, solid: bool = True) -> dict:
+def train(
+    labels: bool, seed: int, iterations: int, device: str, solid: bool = True, policy: str = "mlp"
+) -> dict:
     """One training run in this process: per-iteration metrics and timing."""
     import torch
     from mjlab.envs import ManagerBasedRlEnv
@@ -45,9 +55,9 @@ def train(labels: bool, seed: int, iterations: int, device: str, solid: bool = T
     from robotwright.sensors.mjlab import seeker
 
     torch.manual_seed(seed)
-    env_cfg = seeker.seeker_env_cfg(labels, solid=solid)
+    env_cfg = seeker.seeker_env_cfg(labels, solid=solid, policy=policy)
     env_cfg.seed = seed
-    rl_cfg = seeker.seeker_runner_cfg(labels)
+    rl_cfg = seeker.seeker_runner_cfg(labels, policy=policy)
     rl_cfg.seed = seed
     steps = rl_cfg.num_steps_per_env
     sums: dict[str, list[float]] = {"at_target": [], "near_obstacle": []}
@@ -85,7 +95,7 @@ def train(labels: bool, seed: int, iterations: int, device: str, solid: bool = T
         for key, v in sums.items()
     }
     return {
-        "variant": "labels" if labels else "no labels",
+        "variant": "pointnet" if policy == "pointnet" else "labels" if labels else "no labels",
         "seed": seed,
         "iterations": iterations,
         "seconds": seconds,
@@ -108,7 +118,7 @@ def plot(runs: list[dict], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7.5, 4.2), dpi=120)
-    colours = {"labels": "tab:blue", "no labels": "tab:orange"}
+    colours = {"labels": "tab:blue", "no labels": "tab:orange", "pointnet": "tab:green"}
     seen: set[str] = set()
     for run in runs:
         v = run["variant"]
@@ -126,14 +136,15 @@ def plot(runs: list[dict], path: Path) -> None:
     ax.set_ylim(0.0, 1.0)
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left")
-    ax.set_title("Semantic seeker: the same task with and without LiDAR labels")
+    ax.set_title("Semantic seeker: LiDAR labels as rays (MLP), points (PointNet), or none")
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
 
 
 def _run_worker(labels: bool, seed: int, args: argparse.Namespace, out: Path) -> dict:
-    result = out / f"run_{'labels' if labels else 'nolabels'}_{seed}.json"
+    name = "pointnet" if args.policy == "pointnet" else "labels" if labels else "nolabels"
+    result = out / f"run_{name}_{seed}.json"
     cmd = [
         sys.executable,
         __file__,
@@ -144,6 +155,7 @@ def _run_worker(labels: bool, seed: int, args: argparse.Namespace, out: Path) ->
         args.device,
         str(result),
         "0" if args.pass_through else "1",
+        args.policy,
     ]
     env = dict(os.environ)
     if args.jobs > 1:  # share the cores between the runs
@@ -157,12 +169,12 @@ def _run_worker(labels: bool, seed: int, args: argparse.Namespace, out: Path) ->
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv and argv[0] == "--worker":
-        labels, seed, iterations, device, path, solid = argv[1:7]
+        labels, seed, iterations, device, path, solid, policy = argv[1:8]
         if device == "cpu" and os.environ.get("OMP_NUM_THREADS") == "1":
             import torch
 
             torch.set_num_threads(1)
-        result = train(labels == "1", int(seed), int(iterations), device, solid == "1")
+        result = train(labels == "1", int(seed), int(iterations), device, solid == "1", policy)
         Path(path).write_text(json.dumps(result), encoding="utf-8")
         return 0
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -176,11 +188,19 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="contacts off: the agent passes through the cylinders (both variants alike)",
     )
+    parser.add_argument(
+        "--policy",
+        choices=("mlp", "pointnet"),
+        default="mlp",
+        help="mlp: the labelled and unlabelled rays into an MLP (both variants); pointnet: "
+        "the labelled hits as a point cloud into PointNet (robotwright.sensors.pointnet)",
+    )
     args = parser.parse_args(argv)
     if args.iterations < 1 or args.seeds < 1 or args.jobs < 1:
         parser.error("expected --iterations, --seeds and --jobs >= 1")
     args.out.mkdir(parents=True, exist_ok=True)
-    plan = [(labels, seed) for _, labels in VARIANTS for seed in range(args.seeds)]
+    variants = POINTNET_VARIANTS if args.policy == "pointnet" else VARIANTS
+    plan = [(labels, seed) for _, labels in variants for seed in range(args.seeds)]
     print(
         f"training {len(plan)} runs of {args.iterations} iterations on {args.device} "
         f"({args.jobs} at a time, "
@@ -204,9 +224,9 @@ def main(argv: list[str] | None = None) -> int:
         print("note: matplotlib is not installed: no curve picture")
     means = {
         name: sum(tail_mean(r["at_target"]) for r in runs if r["variant"] == name) / args.seeds
-        for name, _ in VARIANTS
+        for name, _ in variants
     }
-    print(f"at target: labels {means['labels']:.3f}, no labels {means['no labels']:.3f}")
+    print("at target: " + ", ".join(f"{name} {value:.3f}" for name, value in means.items()))
     return 0
 
 

@@ -50,11 +50,13 @@ from robotwright.sensors.mjlab.config import SemanticLidarSensorCfg
 from robotwright.sensors.mjlab.observations import (
     lidar_distances_normalized,
     lidar_one_hot_classes,
+    lidar_point_cloud,
 )
 from robotwright.sensors.patterns import SpinningLidarPatternCfg
 
 __all__ = [
     "NO_LABELS_TASK_ID",
+    "POINTNET_TASK_ID",
     "TASK_ID",
     "seeker_env_cfg",
     "seeker_runner_cfg",
@@ -62,6 +64,7 @@ __all__ = [
 
 TASK_ID = "Mjlab-Semantic-Seeker-PointMass"
 NO_LABELS_TASK_ID = "Mjlab-Semantic-Seeker-PointMass-NoLabels"
+POINTNET_TASK_ID = "Mjlab-Semantic-Seeker-PointMass-PointNet"
 
 #: Half side of the square arena the cylinders and the agent are placed in [m].
 ARENA_HALF = 2.5
@@ -183,12 +186,17 @@ def near_obstacle(env: Any) -> torch.Tensor:
 
 
 def seeker_env_cfg(
-    labels: bool = True, play: bool = False, solid: bool = True
+    labels: bool = True, play: bool = False, solid: bool = True, policy: str = "mlp"
 ) -> ManagerBasedRlEnvCfg:
     """The seeker task; ``labels=False`` drops the class channels from the observations
     (the ``-NoLabels`` variant), ``play`` makes episodes endless. The cylinders are
     solid (the agent stops at their surface); ``solid=False`` turns contacts off and
-    lets it pass through them."""
+    lets it pass through them. ``policy="pointnet"`` observes the scan as a point cloud
+    (a ``"points"`` group: :func:`lidar_point_cloud`, the hits in the agent's sensor
+    frame with their one-hot classes) beside the velocity, for
+    :class:`~robotwright.sensors.pointnet.PointNetModel`."""
+    if policy not in POLICIES:
+        raise ValueError(f"policy {policy!r}: expected one of {', '.join(POLICIES)}")
     lidar = SemanticLidarSensorCfg(
         name="lidar",
         frame=ObjRef(type="body", name="agent", entity="agent"),
@@ -207,6 +215,19 @@ def seeker_env_cfg(
             func=lidar_one_hot_classes, params={"sensor_name": "lidar"}
         )
     terms["velocity"] = ObservationTermCfg(func=joint_vel_rel, params={"asset_cfg": _AGENT})
+    groups = {"actor": ObservationGroupCfg(terms), "critic": ObservationGroupCfg(dict(terms))}
+    if policy == "pointnet":
+        if not labels:
+            raise ValueError("policy 'pointnet' reads the labels: expected labels=True")
+        velocity = {"velocity": terms["velocity"]}
+        points = ObservationTermCfg(
+            func=lidar_point_cloud, params={"sensor_name": "lidar", "max_points": RING_RAYS}
+        )
+        groups = {
+            "actor": ObservationGroupCfg(velocity),
+            "critic": ObservationGroupCfg(dict(velocity)),
+            "points": ObservationGroupCfg({"points": points}),
+        }
     entities = {
         "agent": EntityCfg(
             spec_fn=_agent_spec,
@@ -228,10 +249,7 @@ def seeker_env_cfg(
             num_envs=NUM_ENVS,
             env_spacing=2.0 * ARENA_HALF + 1.0,
         ),
-        observations={
-            "actor": ObservationGroupCfg(terms),
-            "critic": ObservationGroupCfg(dict(terms)),
-        },
+        observations=groups,
         actions={"force": JointEffortActionCfg(entity_name="agent", actuator_names=("x", "y"))},
         events={"reset_layout": EventTermCfg(func=reset_layout, mode="reset")},
         rewards={
@@ -253,9 +271,19 @@ def seeker_env_cfg(
     )
 
 
-def seeker_runner_cfg(labels: bool = True) -> RslRlOnPolicyRunnerCfg:
-    """PPO for the seeker (both variants alike): MLP 128-64, 32 steps per env."""
-    model = {"hidden_dims": (128, 64), "activation": "elu", "obs_normalization": False}
+def seeker_runner_cfg(labels: bool = True, policy: str = "mlp") -> RslRlOnPolicyRunnerCfg:
+    """PPO for the seeker (every variant alike): MLP head 128-64, 32 steps per env;
+    ``policy="pointnet"``: a PointNet encoder (shared point MLP 64-128, max-pooled) on
+    the ``"points"`` group before the head, actor and critic alike."""
+    model: dict[str, Any] = {
+        "hidden_dims": (128, 64),
+        "activation": "elu",
+        "obs_normalization": False,
+    }
+    obs_groups = {"actor": ("actor",), "critic": ("critic",)}
+    if policy == "pointnet":
+        model["class_name"] = POINTNET_MODEL
+        obs_groups = {"actor": ("actor", "points"), "critic": ("critic", "points")}
     return RslRlOnPolicyRunnerCfg(
         actor=RslRlModelCfg(
             **model,
@@ -280,23 +308,39 @@ def seeker_runner_cfg(labels: bool = True) -> RslRlOnPolicyRunnerCfg:
             desired_kl=0.01,
             max_grad_norm=1.0,
         ),
-        experiment_name="semantic_seeker" if labels else "semantic_seeker_no_labels",
+        experiment_name=(
+            f"semantic_seeker_{policy}"
+            if policy != "mlp"
+            else "semantic_seeker"
+            if labels
+            else "semantic_seeker_no_labels"
+        ),
         logger="tensorboard",
         save_interval=50,
         num_steps_per_env=STEPS_PER_ENV,
         max_iterations=150,
+        obs_groups=obs_groups,
     )
 
 
+#: Policies of the seeker: an MLP on the flattened rays, or PointNet on the points.
+POLICIES = ("mlp", "pointnet")
+#: rsl_rl's name of the point-cloud model (resolved by rsl_rl when the runner starts).
+POINTNET_MODEL = "robotwright.sensors.pointnet:PointNetModel"
+
+
 def register() -> None:
-    """Register both variants with mjlab (once per process)."""
+    """Register the variants with mjlab (once per process): labels, no labels, and
+    labels read as a point cloud by PointNet."""
     from mjlab.tasks.registry import list_tasks, register_mjlab_task
 
-    for task_id, labels in ((TASK_ID, True), (NO_LABELS_TASK_ID, False)):
+    variants = ((TASK_ID, True, "mlp"), (NO_LABELS_TASK_ID, False, "mlp"))
+    variants += ((POINTNET_TASK_ID, True, "pointnet"),)
+    for task_id, labels, policy in variants:
         if task_id not in list_tasks():
             register_mjlab_task(
                 task_id=task_id,
-                env_cfg=seeker_env_cfg(labels),
-                play_env_cfg=seeker_env_cfg(labels, play=True),
-                rl_cfg=seeker_runner_cfg(labels),
+                env_cfg=seeker_env_cfg(labels, policy=policy),
+                play_env_cfg=seeker_env_cfg(labels, play=True, policy=policy),
+                rl_cfg=seeker_runner_cfg(labels, policy=policy),
             )
