@@ -41,6 +41,7 @@ __all__ = [
     "articulation_cfg_source",
     "cfg_number",
     "docstring_literal",
+    "module_docstring",
     "initial_state",
     "setup_warnings",
     "write_articulation_cfg",
@@ -189,6 +190,19 @@ def setup_warnings(hrdf: HRDF, model: mujoco.MjModel) -> list[str]:
     return out
 
 
+def module_docstring(lines: list[str], clamped: list[str]) -> str:
+    """A generated module's docstring: ``lines``, then the joints whose reference
+    position was clamped into its range (the frameworks check ranges), one each."""
+    if clamped:
+        lines = [
+            *lines,
+            "",
+            "Joint positions clamped into their ranges:",
+            *(f"  {c}" for c in clamped),
+        ]
+    return docstring_literal("\n".join(lines) + "\n")
+
+
 def docstring_literal(text: str) -> str:
     """``text`` as a module docstring. It holds names from the robot file, so it is a
     plain triple-quoted block only when no character could end or escape it (printable
@@ -214,11 +228,8 @@ def articulation_cfg_source(
         "groups below repeat the drive values (stiffness N m/rad, damping N m s/rad,",
         "effort N m, velocity rad/s) so that Isaac Lab applies them.",
     ]
-    if clamped:
-        doc += ["", "Joint positions clamped into their ranges (Isaac Lab checks them):"]
-        doc += [f"  {c}" for c in clamped]
     lines = [
-        docstring_literal("\n".join(doc) + "\n"),
+        module_docstring(doc, clamped),
         "",
         "from pathlib import Path",
         "",

@@ -33,8 +33,8 @@ from robotwright._outputs import check_overwrite
 from robotwright.errors import GeneratorError, RobotSetupWarning
 from robotwright.generators.isaaclab_cfg import (
     cfg_number,
-    docstring_literal,
     initial_state,
+    module_docstring,
     setup_warnings,
 )
 from robotwright.hrdf.model import HRDF
@@ -57,11 +57,8 @@ def entity_cfg_source(
         f"The MJCF beside this file holds the robot and its {model.nu} actuator(s); mjlab's",
         "XmlActuatorCfg drives them with the gains written there.",
     ]
-    if clamped:
-        doc += ["", "Joint positions clamped into their ranges:"]
-        doc += [f"  {c}" for c in clamped]
     lines = [
-        docstring_literal("\n".join(doc) + "\n"),
+        module_docstring(doc, clamped),
         "",
         "from pathlib import Path",
         "",
