@@ -325,6 +325,18 @@ def _error_text(exc: RobotwrightError) -> str:
     return _one_line(str(exc))
 
 
+def _interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C or SIGTERM among the causes of ``exc`` (an import it interrupted
+    fails as an ``ImportError`` caused by an ``ImportError`` caused by it), if any."""
+    seen = 0
+    cause = exc.__cause__ or exc.__context__
+    while cause is not None and seen < 16:
+        if isinstance(cause, KeyboardInterrupt):
+            return cause
+        cause, seen = cause.__cause__ or cause.__context__, seen + 1
+    return None
+
+
 def _interrupted(exc: KeyboardInterrupt) -> int:
     """Exit status and line of a command stopped by Ctrl-C (130) or SIGTERM (143)."""
     if isinstance(exc, Terminated):
@@ -381,9 +393,10 @@ def _run(args: argparse.Namespace) -> int:
         return _interrupted(exc)
     except ImportError as exc:
         # The signal came while an extension module initialised (MuJoCo's, loaded
-        # lazily): Python reports the interrupted import as its cause.
-        if isinstance(exc.__cause__, KeyboardInterrupt):
-            return _interrupted(exc.__cause__)
+        # lazily): Python reports the interrupted import as a cause of the failure.
+        cause = _interrupt_behind(exc)
+        if cause is not None:
+            return _interrupted(cause)
         raise
     except BrokenPipeError:
         raise  # main ends quietly: the reader of stdout closed the pipe
