@@ -144,3 +144,29 @@ def test_a_grammar_start_that_is_not_a_name(tmp_path, capsys, start) -> None:
     code = main(_COUNT + ["--grammar", str(path), "--library", str(default_library_path())])
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err and "start" in err and len(err) < 4000
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("max_distance", 1e300),
+        ("min_distance", 1e300),
+        ("range_noise_std", 1e300),
+        ("offset_pos", (1e300, 0.0, 0.0)),
+        ("seed", 2**70),
+        ("num_threads", 10**9),
+    ],
+)
+def test_sensor_config_numbers_are_bounded(field, value) -> None:
+    from robotwright.errors import SensorError
+    from robotwright.sensors import LidarCfg
+
+    with pytest.raises(SensorError, match=field):
+        LidarCfg(prim_path="lidar", **{field: value})
+
+
+def test_a_huge_mount_quaternion_is_normalised_not_zeroed() -> None:
+    from robotwright.sensors import LidarCfg
+
+    cfg = LidarCfg(prim_path="lidar", offset_rot=(1e200, 1e200, 0.0, 0.0))
+    assert cfg.offset_rot == pytest.approx((2**-0.5, 2**-0.5, 0.0, 0.0))

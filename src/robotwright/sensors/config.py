@@ -10,6 +10,7 @@ from typing import Literal
 
 import numpy as np
 
+from robotwright._names import shown
 from robotwright.errors import InputFileError, SensorError
 from robotwright.sensors.patterns import LivoxPatternCfg, PatternCfg
 
@@ -23,6 +24,13 @@ __all__ = [
 
 #: Most CPU threads a sensor may start.
 MAX_THREADS = 256
+#: Longest range a sensor config gives (max and min distance, noise) [m]: far
+#: beyond any LiDAR's, a bound for what a user or a file can set.
+MAX_RANGE_M = 1e5
+#: Largest mount offset from the carrier [m].
+MAX_OFFSET_M = 1e4
+#: Largest seed (numpy's generators take 64-bit seeds).
+MAX_SEED = 2**63 - 1
 
 
 def _is_number(value: object) -> bool:
@@ -137,13 +145,14 @@ class LidarCfg:
             )
         self.pattern_cfg.validate()  # its fields as they are now (edited after construction)
         offset_pos = _floats(self.offset_pos, 3)
-        if offset_pos is None or not all(math.isfinite(v) for v in offset_pos):
+        if offset_pos is None or not all(abs(v) <= MAX_OFFSET_M for v in offset_pos):
             raise SensorError(
-                f"{name}.offset_pos: expected 3 finite numbers [m], got {self.offset_pos!r}"
+                f"{name}.offset_pos: expected 3 finite numbers [m], each within "
+                f"+-{MAX_OFFSET_M:g}, got {self.offset_pos!r}"
             )
         self.offset_pos = offset_pos  # type: ignore[assignment]
         rot = _floats(self.offset_rot, 4)
-        norm = math.sqrt(sum(v * v for v in rot)) if rot is not None else 0.0
+        norm = math.hypot(*rot) if rot is not None else 0.0  # no overflow on squares
         if not norm > 1e-9 or not math.isfinite(norm):
             raise SensorError(
                 f"{name}.offset_rot: expected a non-zero quaternion (w, x, y, z), got {self.offset_rot!r}"
@@ -164,7 +173,11 @@ class LidarCfg:
                 raise SensorError(
                     f"{name}.{key}: expected a non-negative number [m], got {value!r}"
                 )
-        if not math.isfinite(self.max_distance) or self.max_distance <= self.min_distance:
+            if key != "max_distance" and value > MAX_RANGE_M:  # max_distance: finite, below
+                raise SensorError(
+                    f"{name}.{key}: expected at most {MAX_RANGE_M:g} m, got {value!r}"
+                )
+        if not self.max_distance <= MAX_RANGE_M or self.max_distance <= self.min_distance:
             raise SensorError(
                 f"{name}: expected min_distance < max_distance < inf, got {self.min_distance}, {self.max_distance}"
             )
@@ -199,10 +212,13 @@ class LidarCfg:
                 f"got {self.num_threads!r}"
             )
         if self.seed is not None and (
-            not isinstance(self.seed, int) or isinstance(self.seed, bool) or self.seed < 0
+            not isinstance(self.seed, int)
+            or isinstance(self.seed, bool)
+            or not 0 <= self.seed <= MAX_SEED
         ):
             raise SensorError(
-                f"{name}.seed: expected an integer >= 0 or None (fresh entropy), got {self.seed!r}"
+                f"{name}.seed: expected an integer >= 0 and below 2**63, or None (fresh entropy), "
+                f"got {shown(self.seed)}"
             )
         if not isinstance(self.exclude_robot, bool):
             raise SensorError(
