@@ -116,3 +116,27 @@ def test_isaaclab_cfg_source_takes_the_same_pose() -> None:
     pos, joints = _init_state(mj)
     assert any("knee" in k and v == 0.3 for k, v in joints.items())
     assert pos[2] > 0.1  # a free base raised to stand
+
+
+def test_a_free_base_sits_at_its_prims_origin_only_for_a_config(tmp_path) -> None:
+    """isaaclab-cfg's USD puts the free base at its prim's origin (its config's
+    init_state then gives the height: spawn and reset agree); a plain export keeps the
+    robot's reference position (the USD reads back as the robot)."""
+    from robotwright.generators.isaaclab_cfg import initial_state
+    from robotwright.generators.usd import _robot_mjcf
+    from robotwright.sources import load_robot
+
+    hrdf = load_robot("mini_humanoid")
+    assert hrdf.floating_base and hrdf.root_body.pos[2] > 0.5
+    kept, _ = _robot_mjcf(hrdf, tmp_path / "kept")
+    moved, _ = _robot_mjcf(hrdf, tmp_path / "moved", root_at_origin=True)
+    kept_model = mujoco.MjModel.from_xml_path(str(kept))
+    moved_model = mujoco.MjModel.from_xml_path(str(moved))
+    assert kept_model.body_pos[1][2] == pytest.approx(hrdf.root_body.pos[2])
+    assert np.allclose(moved_model.body_pos[1], 0.0)
+    pos, _, _ = initial_state(moved_model)
+    data = mujoco.MjData(moved_model)
+    data.qpos[:3] = pos
+    mujoco.mj_kinematics(moved_model, data)
+    assert lowest_collision_point(moved_model, data) == pytest.approx(0.0, abs=1e-9)
+    assert initial_state(kept_model)[0] == pytest.approx(pos)  # the same standing pose

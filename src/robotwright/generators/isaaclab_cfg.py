@@ -301,7 +301,7 @@ def write_articulation_cfg(
         raise GeneratorError(f"{out}: expected a Python module file name ending in .py")
     usd = out.with_suffix(".usd")
     check_overwrite([out, usd], overwrite)
-    done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout)
+    done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout, root_at_origin=True)
     try:  # the initial state comes from the MJCF the USD was made from
         text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name, joint_pos)
         write_text_atomic(out, text)

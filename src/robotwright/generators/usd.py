@@ -96,10 +96,11 @@ def converter_model_name(name: str) -> str:
     return f"_{stem}" if stem[0].isdigit() else stem
 
 
-def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
+def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple[Path, list[str]]:
     """Our MJCF of the robot alone (its model named by :func:`converter_model_name`),
     meshes copied beside it, and the values the MJCF could not hold that the USD does
-    not get either (``peak_velocity`` it does get)."""
+    not get either (``peak_velocity`` it does get). ``root_at_origin``: a free base's
+    body is put at the model's origin (see :func:`to_usd`)."""
     import dataclasses
     import warnings
 
@@ -108,10 +109,7 @@ def _robot_mjcf(hrdf: HRDF, folder: Path) -> tuple[Path, list[str]]:
     model = converter_model_name(hrdf.name)
     path = folder / "mjcf" / f"{model}.xml"
     robot = dataclasses.replace(hrdf, name=model)
-    if hrdf.floating_base and any(hrdf.root_body.pos):
-        # A free base at its prim's origin: Isaac Lab places the prim at the config's
-        # initial position when it spawns and the root body there when it resets; an
-        # offset of the body inside the prim would count twice at spawn.
+    if root_at_origin and hrdf.floating_base and any(hrdf.root_body.pos):
         bodies = [
             dataclasses.replace(b, pos=(0.0, 0.0, 0.0)) if b is hrdf.root_body else b
             for b in hrdf.bodies
@@ -267,6 +265,7 @@ def to_usd(
     prove: bool = True,
     strict: bool = False,
     layout: str = "nested",
+    root_at_origin: bool = False,
 ) -> UsdExport:
     """Write ``hrdf`` as one USD file (see the module docstring for what is authored).
 
@@ -279,6 +278,13 @@ def to_usd(
     ``layout``: ``"nested"`` (the converter's: bodies nested as the kinematic tree under
     ``/<robot>/Geometry``) or ``"flat"`` (every body a child of ``/<robot>``, as Isaac
     Lab's importers write and its PhysX contact sensors expect).
+
+    ``root_at_origin``: a free base's body sits at its prim's origin instead of at its
+    reference position (which the USD then does not hold: for a config that gives the
+    initial position itself, as :func:`~robotwright.generators.isaaclab_cfg.write_articulation_cfg`
+    does). Isaac Lab places the prim at the config's initial position when it spawns and
+    the root body there when it resets, so an offset of the body inside its prim would
+    count twice at spawn.
 
     Raises:
         GeneratorError: the converter is missing, the suffix is not a USD one, the
@@ -298,7 +304,7 @@ def to_usd(
     from pxr import Usd
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
-        mjcf, lost = _robot_mjcf(hrdf, Path(tmp))
+        mjcf, lost = _robot_mjcf(hrdf, Path(tmp), root_at_origin)
         asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
         stage = Usd.Stage.Open(asset.path)
         root = stage.GetDefaultPrim()
