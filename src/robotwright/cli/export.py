@@ -272,19 +272,11 @@ def _export(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_module_output(output: str, beside: str, overwrite: bool) -> None:
-    """Before the robot is read: a module name ending in .py, and neither it nor the file
-    written beside it (``beside``: its suffix) in the way without ``--overwrite``."""
-    if Path(output).suffix != ".py":
-        raise GeneratorError(f"{output}: expected a Python module file name ending in .py")
-    check_overwrite([output, str(Path(output).with_suffix(beside))], overwrite)
-
-
 def _isaaclab_cfg(args: argparse.Namespace) -> int:
-    from robotwright.generators.isaaclab_cfg import write_articulation_cfg
+    from robotwright.generators.isaaclab_cfg import module_outputs, write_articulation_cfg
     from robotwright.tasks import load_robot
 
-    _check_module_output(args.output, ".usd", args.overwrite)
+    module_outputs(args.output, ".usd", args.overwrite)  # before the robot is read
     hrdf = load_robot(args.robot)
     module, usd = write_articulation_cfg(
         hrdf,
@@ -304,10 +296,11 @@ def _isaaclab_cfg(args: argparse.Namespace) -> int:
 
 
 def _mjlab_cfg(args: argparse.Namespace) -> int:
+    from robotwright.generators.isaaclab_cfg import module_outputs
     from robotwright.generators.mjlab_cfg import write_entity_cfg
     from robotwright.tasks import load_robot
 
-    _check_module_output(args.output, ".xml", args.overwrite)
+    module_outputs(args.output, ".xml", args.overwrite)  # before the robot is read
     hrdf = load_robot(args.robot)
     module, xml = write_entity_cfg(
         hrdf, args.output, overwrite=args.overwrite, joint_pos=args.joint_pos

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from fnmatch import fnmatchcase
 from pathlib import Path
 
@@ -43,8 +43,10 @@ __all__ = [
     "docstring_literal",
     "module_docstring",
     "initial_state",
+    "module_outputs",
     "setup_warnings",
     "write_articulation_cfg",
+    "write_module_beside",
 ]
 
 
@@ -296,18 +298,35 @@ def write_articulation_cfg(
     from robotwright.errors import RobotSetupWarning
     from robotwright.generators.usd import to_usd
 
-    out = Path(output)
-    if out.suffix != ".py":
-        raise GeneratorError(f"{out}: expected a Python module file name ending in .py")
-    usd = out.with_suffix(".usd")
-    check_overwrite([out, usd], overwrite)
+    out, usd = module_outputs(output, ".usd", overwrite)
     done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout, root_at_origin=True)
-    try:  # the initial state comes from the MJCF the USD was made from
-        text, _ = articulation_cfg_source(hrdf, done.mjcf_model, usd.name, joint_pos)
-        write_text_atomic(out, text)
-    except BaseException:
-        usd.unlink(missing_ok=True)  # no half of the pair without the other
-        raise
+    # The initial state comes from the MJCF the USD was made from.
+    write_module_beside(
+        out, usd, lambda: articulation_cfg_source(hrdf, done.mjcf_model, usd.name, joint_pos)[0]
+    )
     for line in setup_warnings(hrdf, done.mjcf_model):
         warnings.warn(line, RobotSetupWarning, stacklevel=2)
     return out, usd
+
+
+def module_outputs(output: str | Path, side_suffix: str, overwrite: bool) -> tuple[Path, Path]:
+    """A generated module's path and the path of the file written beside it (named after
+    the module, ``side_suffix``), once checked: a ``.py`` name, and neither in the way
+    without ``overwrite``."""
+    out = Path(output)
+    if out.suffix != ".py":
+        raise GeneratorError(f"{out}: expected a Python module file name ending in .py")
+    side = out.with_suffix(side_suffix)
+    check_overwrite([out, side], overwrite)
+    return out, side
+
+
+def write_module_beside(out: Path, side: Path, text: Callable[[], str]) -> None:
+    """Write the module ``out`` (its ``text()``) through the output gate once the file
+    ``side`` it loads is written; on any failure ``side`` is removed again (no half of
+    the pair without the other)."""
+    try:
+        write_text_atomic(out, text())
+    except BaseException:
+        side.unlink(missing_ok=True)
+        raise

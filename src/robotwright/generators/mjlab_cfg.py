@@ -28,14 +28,14 @@ from pathlib import Path
 
 import mujoco
 
-from robotwright._atomic import write_text_atomic
-from robotwright._outputs import check_overwrite
-from robotwright.errors import GeneratorError, RobotSetupWarning
+from robotwright.errors import RobotSetupWarning
 from robotwright.generators.isaaclab_cfg import (
     cfg_number,
     initial_state,
     module_docstring,
+    module_outputs,
     setup_warnings,
+    write_module_beside,
 )
 from robotwright.hrdf.model import HRDF
 
@@ -109,19 +109,15 @@ def write_entity_cfg(
     """
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
 
-    out = Path(output)
-    if out.suffix != ".py":
-        raise GeneratorError(f"{out}: expected a Python module file name ending in .py")
-    xml = out.with_suffix(".xml")
-    check_overwrite([out, xml], overwrite)
-    generator = MJCFHumanoidGenerator.from_hrdf(hrdf)
-    generator.export(xml, copy_meshes=True, add_scene=False)
-    try:
-        model = mujoco.MjModel.from_xml_path(str(xml))
-        write_text_atomic(out, entity_cfg_source(hrdf, model, xml.name, joint_pos))
-    except BaseException:
-        xml.unlink(missing_ok=True)  # no half of the pair without the other
-        raise
-    for line in setup_warnings(hrdf, model):
+    out, xml = module_outputs(output, ".xml", overwrite)
+    MJCFHumanoidGenerator.from_hrdf(hrdf).export(xml, copy_meshes=True, add_scene=False)
+    compiled: list[mujoco.MjModel] = []
+
+    def text() -> str:  # MuJoCo's compile of the file written: its initial state
+        compiled.append(mujoco.MjModel.from_xml_path(str(xml)))
+        return entity_cfg_source(hrdf, compiled[0], xml.name, joint_pos)
+
+    write_module_beside(out, xml, text)
+    for line in setup_warnings(hrdf, compiled[0]):
         warnings.warn(line, RobotSetupWarning, stacklevel=2)
     return out, xml
