@@ -57,8 +57,10 @@ def main(argv: list[str] | None = None) -> int:
         ax.fill_between(
             [LANDED_S, t[-1]], settled - BAND_M, settled + BAND_M, color=line.get_color(), alpha=0.1
         )
-        print(f"{curve['framework']}: settled {settled:.4f} m, largest excursion after "
-              f"{LANDED_S:g} s {worst * 100:.2f} cm (bound {BAND_M * 100:g} cm)")
+        print(
+            f"{curve['framework']}: settled {settled:.4f} m, largest excursion after "
+            f"{LANDED_S:g} s {worst * 100:.2f} cm (bound {BAND_M * 100:g} cm)"
+        )
     ax.set_xlabel("simulated time [s]")
     ax.set_ylabel("base height [m]")
     ax.set_title("Go2 from one command, standing under its PD drives (band: the test's 2 cm)")
