@@ -5,8 +5,9 @@
 * A command stopped by SIGTERM (what ``timeout`` and ``kill`` send) or Ctrl-C unwinds
   like an error (:func:`terminate_like_interrupt`): every ``with`` block removes its
   temporaries and a confined reader is killed.
-* A process stopped by SIGKILL cannot clean up: the next command removes the
-  temporaries of processes of this user that no longer run (:func:`sweep_stale`).
+* A process stopped by SIGKILL cannot clean up: a later command removes the
+  temporaries of processes of this user that no longer run, once they are an hour old
+  (:func:`sweep_stale`; the hour spares a live process of another PID namespace).
 * A child (a confined reader, a search's pool worker) gets Linux's parent-death signal
   (:func:`die_with_parent`): it is killed when its parent dies, even by SIGKILL,
   instead of running on under PID 1.
@@ -22,6 +23,7 @@ import signal
 import sys
 import tempfile
 import threading
+import time
 from collections.abc import Iterator
 
 __all__ = [
@@ -54,11 +56,19 @@ def running(pid: int) -> bool:
     return True
 
 
-def sweep_stale(folder: str | None = None) -> list[str]:
+#: Age [s] below which a temporary is never swept: a process of another PID namespace
+#: sharing the temporary folder (a container) may hold a live one under a process id
+#: that looks dead from here.
+MIN_STALE_AGE_S = 3600.0
+
+
+def sweep_stale(folder: str | None = None, min_age_s: float = MIN_STALE_AGE_S) -> list[str]:
     """Remove the temporaries (:func:`prefix`) in ``folder`` (default: the system's
-    temporary folder) that belong to this user and to processes that no longer run;
-    returns their names. Links are never followed, other users' files never touched."""
+    temporary folder) that belong to this user and to processes that no longer run, and
+    were last changed at least ``min_age_s`` seconds ago; returns their names. Links
+    are never followed, other users' files never touched."""
     folder = folder or tempfile.gettempdir()
+    now = time.time()
     removed = []
     try:
         entries = list(os.scandir(folder))
@@ -73,7 +83,7 @@ def sweep_stale(folder: str | None = None) -> list[str]:
             st = entry.stat(follow_symlinks=False)
         except OSError:
             continue
-        if uid is not None and st.st_uid != uid:
+        if (uid is not None and st.st_uid != uid) or now - st.st_mtime < min_age_s:
             continue
         if entry.is_dir(follow_symlinks=False):
             shutil.rmtree(entry.path, ignore_errors=True)
