@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from robotwright._limits import limit_for_block, megabytes
-from robotwright._temporaries import running
+from robotwright._temporaries import remove_entry, running
 from robotwright.errors import InputFileError, OutputPathError
 
 __all__ = [
@@ -185,11 +185,7 @@ def remove_stale_temporaries(folder: str | os.PathLike[str], target: str) -> Non
         match = _TEMP_NAME.match(entry.name)
         if match is None or match["target"] != target or running(int(match["pid"])):
             continue
-        if entry.is_dir(follow_symlinks=False):
-            shutil.rmtree(entry.path, ignore_errors=True)
-        else:
-            with suppress(OSError):
-                os.unlink(entry.path)
+        remove_entry(entry)
 
 
 def _restore_moved_aside(target: Path) -> None:

@@ -29,6 +29,7 @@ from collections.abc import Iterator
 __all__ = [
     "die_with_parent",
     "prefix",
+    "remove_entry",
     "running",
     "sweep_stale",
     "terminate_like_interrupt",
@@ -85,13 +86,19 @@ def sweep_stale(folder: str | None = None, min_age_s: float = MIN_STALE_AGE_S) -
             continue
         if (uid is not None and st.st_uid != uid) or now - st.st_mtime < min_age_s:
             continue
-        if entry.is_dir(follow_symlinks=False):
-            shutil.rmtree(entry.path, ignore_errors=True)
-        else:
-            with contextlib.suppress(OSError):
-                os.unlink(entry.path)
+        remove_entry(entry)
         removed.append(entry.name)
     return removed
+
+
+def remove_entry(entry: os.DirEntry) -> None:
+    """Remove a folder (with what it holds) or a file or link of a listing, never
+    following a link; what cannot be removed is left."""
+    if entry.is_dir(follow_symlinks=False):
+        shutil.rmtree(entry.path, ignore_errors=True)
+    else:
+        with contextlib.suppress(OSError):
+            os.unlink(entry.path)
 
 
 def die_with_parent(parent: int) -> None:

@@ -86,9 +86,9 @@ def initial_state(
     A joint's position is the value of the first ``(pattern, value)`` of ``joint_pos``
     whose fnmatch pattern matches its name (a user's standing pose, rad or m), else the
     MJCF's reference pose clamped into the joint's range (Isaac Lab checks ranges). A
-    free base is raised so that its collision geometry, in that pose, stands on z = 0;
-    the USD's root body sits at its prim's origin (:func:`~robotwright.generators.usd.to_usd`),
-    so this position is where the base spawns and where a reset puts it.
+    free base is raised so that its collision geometry, in that pose, stands on z = 0
+    (in the USD of :func:`write_articulation_cfg` the root body sits at its prim's
+    origin, so this position is where the base spawns and where a reset puts it).
 
     Raises:
         GeneratorError: a pattern matches no joint, or a value lies outside the range of
@@ -160,7 +160,7 @@ def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> floa
 _LEGGED = re.compile(r"(foot|feet|toe|ankle|calf|shin|sole)", re.IGNORECASE)
 
 
-def setup_warnings(hrdf: HRDF, model: mujoco.MjModel) -> list[str]:
+def setup_warnings(hrdf: HRDF) -> list[str]:
     """What would surprise a user training this robot: no drives at all, a fixed base on
     a robot whose bodies say it walks, a position drive without damping. One line each,
     naming the robot, the joints and the option that changes it."""
@@ -172,9 +172,8 @@ def setup_warnings(hrdf: HRDF, model: mujoco.MjModel) -> list[str]:
             "actuators={}; give --actuators position --actuator-gain 'PATTERN=KP,KV' (URDF "
             "sources) or a robot file with actuators"
         )
-    floating = model.njnt > 0 and int(model.jnt_type[0]) == int(mujoco.mjtJoint.mjJNT_FREE)
     feet = [b.name for b in hrdf.bodies if _LEGGED.search(b.name)]
-    if not floating and len(feet) >= 2:
+    if not hrdf.floating_base and len(feet) >= 2:
         out.append(
             f"robot {name} has a fixed base but its bodies say it walks "
             f"({name_list(feet, 4)}): give --floating-base for a free base"
@@ -304,7 +303,7 @@ def write_articulation_cfg(
     write_module_beside(
         out, usd, lambda: articulation_cfg_source(hrdf, done.mjcf_model, usd.name, joint_pos)[0]
     )
-    for line in setup_warnings(hrdf, done.mjcf_model):
+    for line in setup_warnings(hrdf):
         warnings.warn(line, RobotSetupWarning, stacklevel=2)
     return out, usd
 

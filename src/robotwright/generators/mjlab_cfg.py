@@ -111,13 +111,12 @@ def write_entity_cfg(
 
     out, xml = module_outputs(output, ".xml", overwrite)
     MJCFHumanoidGenerator.from_hrdf(hrdf).export(xml, copy_meshes=True, add_scene=False)
-    compiled: list[mujoco.MjModel] = []
 
-    def text() -> str:  # MuJoCo's compile of the file written: its initial state
-        compiled.append(mujoco.MjModel.from_xml_path(str(xml)))
-        return entity_cfg_source(hrdf, compiled[0], xml.name, joint_pos)
+    def text() -> str:  # the initial state from MuJoCo's compile of the file written
+        model = mujoco.MjModel.from_xml_path(str(xml))
+        return entity_cfg_source(hrdf, model, xml.name, joint_pos)
 
     write_module_beside(out, xml, text)
-    for line in setup_warnings(hrdf, compiled[0]):
+    for line in setup_warnings(hrdf):
         warnings.warn(line, RobotSetupWarning, stacklevel=2)
     return out, xml

@@ -6,6 +6,7 @@ whose entries name the file, the rule or component, and the field.
 
 from __future__ import annotations
 
+import math
 import re
 import warnings
 from importlib import resources
@@ -117,9 +118,6 @@ def _read_yaml(path: Path, problems: list[Problem]) -> dict[str, Any] | None:
     return data
 
 
-_num = finite_number
-
-
 def _description(value: Any) -> str:
     """A symbol's, rule's or component's description: a text, shown as given; anything
     else (a list, an alias bomb) is summarised, never formatted whole."""
@@ -134,7 +132,7 @@ PARAM_BOUND = Bound(-1000.0, 1000.0)
 #: Most values one parameter may list (the search enumerates them).
 MAX_PARAM_VALUES = 1000
 #: A DoF's twist about the link axis [rad].
-TWIST_BOUND = Bound(-2 * 3.141592653589793, 2 * 3.141592653589793, unit="rad")
+TWIST_BOUND = Bound(-2 * math.pi, 2 * math.pi, unit="rad")
 #: Housing sizes [m] and actuator ratings (N m or N, rad/s or m/s).
 RATING_BOUND = Bound(0.0, 1e6, open_low=True)
 #: A colour channel.
@@ -246,7 +244,7 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 continue
             good = True
             for v in values:
-                x = _num(v)
+                x = finite_number(v)
                 if x is None:
                     err(f"value {shown(v)} is not a number", col)
                     good = False
@@ -327,7 +325,7 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                         f"unknown actuator rating {shown(key)}; expected {', '.join(_ACTUATOR_KEYS)}",
                         "actuator",
                     )
-        density = _num(spec.get("density", 1000.0))
+        density = finite_number(spec.get("density", 1000.0))
         if density is None or not 0 < density <= MAX_DENSITY:
             err(
                 f"density must be a number in (0, {MAX_DENSITY:g}] kg/m^3, got "
@@ -354,8 +352,12 @@ def _parse_library(path: Path, data: dict[str, Any], problems: list[Problem]) ->
                 density=density,
                 rgba=tuple(float(v) for v in rgba),  # type: ignore[arg-type]
                 dofs=tuple(dofs),
-                housing={k: float(v) for k, v in (spec.get("housing") or {}).items() if _num(v)},
-                actuator={k: float(v) for k, v in (spec.get("actuator") or {}).items() if _num(v)},
+                housing={
+                    k: float(v) for k, v in (spec.get("housing") or {}).items() if finite_number(v)
+                },
+                actuator={
+                    k: float(v) for k, v in (spec.get("actuator") or {}).items() if finite_number(v)
+                },
             )
         except ValueError as exc:
             err(str(exc))

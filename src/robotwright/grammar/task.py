@@ -35,9 +35,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from robotwright._bounds import finite_number
 from robotwright._names import MAX_NAME_LENGTH, name_problem, shown, shown_key
 from robotwright.errors import GrammarError, Problem, RobotwrightError
-from robotwright.grammar.loader import _num, _read_yaml
+from robotwright.grammar.loader import _read_yaml
 from robotwright.grammar.physics import BACKWARDS, SETTING_BOUNDS, Carrier, _carrier_xml
 from robotwright.hrdf.assets import bundled_robot_names
 
@@ -147,7 +148,7 @@ def load_task(path: str | os.PathLike[str]) -> Task:
 def _vector(value: Any, n: int) -> tuple[float, ...] | None:
     if not isinstance(value, list) or len(value) != n:
         return None
-    out = tuple(_num(v) for v in value)
+    out = tuple(finite_number(v) for v in value)
     return None if any(v is None for v in out) else out  # type: ignore[return-value]
 
 
