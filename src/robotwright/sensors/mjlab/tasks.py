@@ -1,6 +1,7 @@
 """mjlab tasks (loaded by mjlab's ``mjlab.tasks`` entry point, so ``train`` / ``play``
-list them): ``Mjlab-Velocity-Rough-Unitree-Go1-SemanticLidar``, below, and the semantic
-seeker ``Mjlab-Semantic-Seeker-PointMass`` (and ``-NoLabels``), :mod:`.seeker`.
+list them): ``Mjlab-Velocity-Rough-Unitree-Go1-SemanticLidar``, below, the semantic
+seeker ``Mjlab-Semantic-Seeker-PointMass`` (and ``-NoLabels``), :mod:`.seeker`, and the
+seed's task ``Robotwright-Mjlab-SemanticNav-Go2`` (and ``-PointNet``), :mod:`.semantic_nav`.
 
 mjlab's rough-terrain Go1 velocity task, plus obstacles of the three default classes on
 the terrain around every robot, and a semantic Mid-360 on the trunk whose range image
@@ -36,6 +37,7 @@ from mjlab.tasks.velocity.rl import VelocityOnPolicyRunner
 from robotwright.sensors.mjlab.config import SemanticLidarSensorCfg
 from robotwright.sensors.mjlab.observations import lidar_range_image
 from robotwright.sensors.mjlab.seeker import register as register_seeker
+from robotwright.sensors.mjlab.semantic_nav import register as register_semantic_nav
 from robotwright.sensors.patterns import LivoxPatternCfg
 
 __all__ = ["TASK_ID", "semantic_lidar_go1_rough_env_cfg"]
@@ -143,3 +145,4 @@ if TASK_ID not in list_tasks():  # importing twice (entry point, then by name) i
     )
 
 register_seeker()
+register_semantic_nav()

@@ -1,0 +1,178 @@
+"""The class-labelled scene (:class:`~robotwright.sensors.semantic_scene.SemanticSceneCfg`)
+in mjlab: one mocap entity per object slot, placed and moved by one event term.
+
+``add_semantic_scene(env_cfg, SemanticSceneCfg())`` adds to an mjlab environment config
+
+* an entity per slot, named ``obstacle_0_cracker_box``, ``valuable_0_sofa``, ... holding
+  one primitive geom named after its asset (``cracker_box``): mjlab makes the fixed body
+  a mocap body, so the object is kinematic (it pushes a robot; nothing pushes it), and
+  the LiDAR's class comes from the geom's path;
+* the event term ``semantic_scene`` (:class:`SemanticSceneEvent`, mode ``"step"``):
+  at each environment's reset it draws the layout
+  (:func:`~robotwright.sensors.semantic_scene.sample_layout`) around the environment's
+  origin, and every environment step it moves the dynamic obstacles along their paths
+  (:func:`~robotwright.sensors.semantic_scene.advance`).
+
+With ``clutter_curriculum=True`` and a terrain generator with a curriculum, an
+environment on terrain level ``l`` of ``L`` gets ``ceil(N (l + 1) / L)`` of its ``N``
+obstacles in the arena; the others are parked :data:`PARK_DEPTH` m under its origin,
+where no ray from above reaches them. Objects stand on the environment origin's height.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import mujoco
+import torch
+from mjlab.entity import EntityCfg
+from mjlab.managers.event_manager import EventTermCfg
+
+from robotwright.sensors.semantic_scene import (
+    SceneAssetCfg,
+    SceneSlot,
+    SemanticSceneCfg,
+    advance,
+    sample_layout,
+)
+
+__all__ = [
+    "PARK_DEPTH",
+    "SemanticSceneEvent",
+    "add_semantic_scene",
+    "object_distances",
+    "scene_entities",
+]
+
+#: How far under its environment's origin an inactive obstacle is parked [m].
+PARK_DEPTH = 10.0
+#: The event term's name in ``env_cfg.events``.
+EVENT_NAME = "semantic_scene"
+
+_SHAPES = {"box": mujoco.mjtGeom.mjGEOM_BOX, "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER}
+
+
+def _object_spec(asset: SceneAssetCfg) -> Any:
+    """A spec function: one fixed body holding the asset's geom (named after the asset,
+    its centre at the body's origin)."""
+
+    def spec_fn() -> mujoco.MjSpec:
+        spec = mujoco.MjSpec()
+        body = spec.worldbody.add_body(name="object")
+        size = tuple(asset.size) + (0.0,) * (3 - len(asset.size))
+        body.add_geom(name=asset.name, type=_SHAPES[asset.shape], size=size, rgba=asset.rgba)
+        return spec
+
+    return spec_fn
+
+
+def scene_entities(scene: SemanticSceneCfg) -> dict[str, EntityCfg]:
+    """An entity per slot of ``scene`` (validated first), keyed by the slot's name."""
+    scene.check()
+    return {slot.name: EntityCfg(spec_fn=_object_spec(slot.asset)) for slot in scene.slots()}
+
+
+def add_semantic_scene(
+    env_cfg: Any, scene: SemanticSceneCfg, clutter_curriculum: bool = False
+) -> None:
+    """Add the objects and the event term of ``scene`` to ``env_cfg`` (an mjlab
+    ``ManagerBasedRlEnvCfg``), and room for their contacts with a robot."""
+    env_cfg.scene.entities = {**env_cfg.scene.entities, **scene_entities(scene)}
+    env_cfg.events[EVENT_NAME] = EventTermCfg(
+        func=SemanticSceneEvent,
+        mode="step",
+        params={"scene": scene, "clutter_curriculum": clutter_curriculum},
+    )
+    if env_cfg.sim.nconmax is not None:
+        env_cfg.sim.nconmax += 8 * len(scene.slots())
+
+
+class SemanticSceneEvent:
+    """mjlab event term (class form, mode ``"step"``): draws each environment's layout at
+    its reset (:meth:`reset`) and moves the dynamic obstacles every step (``__call__``).
+
+    Attributes:
+        slots: the scene's slots, in order.
+        xy: ``(E, S, 2)`` object positions relative to their environment's origin [m].
+        yaw: ``(E, S)`` [rad]. velocity: ``(E, S, 2)`` [m/s]. active: ``(E, S)`` bool.
+    """
+
+    def __init__(self, cfg: EventTermCfg, env: Any) -> None:
+        self.scene: SemanticSceneCfg = cfg.params["scene"]
+        self.scene.check()
+        self.curriculum = bool(cfg.params.get("clutter_curriculum", False))
+        self.env = env
+        self.slots: list[SceneSlot] = self.scene.slots()
+        n, s, dev = env.num_envs, len(self.slots), env.device
+        self.xy = torch.zeros(n, s, 2, device=dev)
+        self.yaw = torch.zeros(n, s, device=dev)
+        self.velocity = torch.zeros(n, s, 2, device=dev)
+        self.active = torch.ones(n, s, dtype=torch.bool, device=dev)
+        self.height = torch.tensor([sl.asset.half_height for sl in self.slots], device=dev)
+        self.dynamic = [k for k, sl in enumerate(self.slots) if sl.dynamic]
+
+    def reset(self, env_ids: torch.Tensor | None = None) -> None:
+        """Draw the layout of ``env_ids`` (all when ``None``) and put the objects there."""
+        if env_ids is None:
+            env_ids = torch.arange(self.env.num_envs, device=self.env.device)
+        if len(env_ids) == 0 or not self.slots:
+            return
+        layout = sample_layout(self.scene, len(env_ids), self.env.device)
+        self.xy[env_ids], self.yaw[env_ids] = layout.xy, layout.yaw
+        self.velocity[env_ids] = layout.velocity
+        self.active[env_ids] = self._active(env_ids)
+        self._write(env_ids, range(len(self.slots)))
+
+    def __call__(self, env: Any, env_ids: Any, **_params: Any) -> None:
+        """One environment step: the dynamic obstacles move by ``velocity * step_dt``."""
+        if not self.dynamic:
+            return
+        k = self.dynamic
+        self.xy[:, k], self.velocity[:, k] = advance(
+            self.xy[:, k], self.velocity[:, k], env.step_dt, self.scene.arena_half
+        )
+        self._write(torch.arange(env.num_envs, device=env.device), k)
+
+    def _active(self, env_ids: torch.Tensor) -> torch.Tensor:
+        """``(n, S)`` which slots of ``env_ids`` stand in the arena (see the module)."""
+        on = torch.ones(len(env_ids), len(self.slots), dtype=torch.bool, device=self.env.device)
+        terrain = getattr(self.env.scene, "terrain", None)
+        levels = getattr(terrain, "terrain_levels", None)
+        if not self.curriculum or levels is None or not self.dynamic:
+            return on
+        top = max(int(getattr(terrain, "max_terrain_level", 1)), 1)
+        share = (levels[env_ids].float() + 1.0) / top
+        count = torch.ceil(share.clamp(max=1.0) * len(self.dynamic))
+        rank = torch.arange(len(self.dynamic), device=self.env.device)
+        on[:, self.dynamic] = rank[None, :] < count[:, None]
+        return on
+
+    def _write(self, env_ids: torch.Tensor, slots: Any) -> None:
+        origins = self.env.scene.env_origins[env_ids]
+        half = self.yaw[env_ids] * 0.5
+        for k in slots:
+            z = torch.where(
+                self.active[env_ids, k], self.height[k], torch.full_like(half[:, k], -PARK_DEPTH)
+            )
+            pos = origins + torch.cat([self.xy[env_ids, k], z[:, None]], dim=1)
+            quat = torch.stack(
+                [half[:, k].cos(), torch.zeros_like(z), torch.zeros_like(z), half[:, k].sin()], 1
+            )
+            entity = self.env.scene[self.slots[k].name]
+            entity.write_mocap_pose_to_sim(torch.cat([pos, quat], dim=1), env_ids=env_ids)
+
+
+def object_distances(env: Any, xy: torch.Tensor, dynamic: bool) -> torch.Tensor:
+    """``(E,)`` distance [m] from the world x/y points ``xy`` ``(E, 2)`` to the nearest
+    footprint disc of the scene's active obstacles (``dynamic``) or valuables; ``inf``
+    where there is none."""
+    term: SemanticSceneEvent = env.event_manager.get_term_cfg(EVENT_NAME).func
+    picked = [k for k, sl in enumerate(term.slots) if sl.dynamic == dynamic]
+    if not picked:
+        return torch.full((env.num_envs,), math.inf, device=env.device)
+    centres = env.scene.env_origins[:, None, :2] + term.xy[:, picked]
+    radius = torch.tensor([term.slots[k].asset.footprint_radius for k in picked], device=env.device)
+    gap = (xy[:, None] - centres).norm(dim=-1) - radius
+    gap = torch.where(term.active[:, picked], gap, torch.full_like(gap, math.inf))
+    return gap.amin(dim=1)
