@@ -147,6 +147,8 @@ def semantic_nav_env_cfg(
     pushes; ``policy``: ``"mlp"`` (range image with class channels) or ``"pointnet"``
     (a ``"points"`` group of :data:`MAX_POINTS` hits with one-hot classes)."""
     check_policy(policy)
+    scene = scene or SemanticSceneCfg()
+    scene.check()  # before the robot is read
     cfg = make_velocity_env_cfg()
     cfg.sim.mujoco.ccd_iterations = 50
     cfg.sim.nconmax = 300  # the robot starts inside the terrain before its first reset
@@ -176,7 +178,7 @@ def semantic_nav_env_cfg(
     )
     cfg.scene.sensors = (*(cfg.scene.sensors or ()), feet, lidar)
     cfg.scene.terrain.terrain_generator.curriculum = True
-    add_semantic_scene(cfg, scene or SemanticSceneCfg(), clutter_curriculum=True)
+    add_semantic_scene(cfg, scene, clutter_curriculum=True)
 
     action = cfg.actions["joint_pos"]
     assert isinstance(action, JointPositionActionCfg)
