@@ -60,8 +60,9 @@ GO2_JOINT_POS = (
 #: The Go2's LiDAR body and the feet.
 LIDAR_BODY, FEET = "radar", ("FL_foot", "FR_foot", "RL_foot", "RR_foot")
 #: The scan: channels between the elevations [rad], columns over the full circle, range
-#: [m]. Tilted down so that a 20 cm box a metre ahead is seen from 0.3 m up.
-LIDAR_CHANNELS, LIDAR_COLUMNS = 8, 64
+#: [m]. Tilted down so that the YCB objects a few metres away are hit from 0.3 m up
+#: (2 deg between columns: a 16 cm box subtends 4.6 deg at 2 m).
+LIDAR_CHANNELS, LIDAR_COLUMNS = 16, 180
 LIDAR_ELEVATION = (math.radians(-35.0), math.radians(15.0))
 LIDAR_RANGE = 6.0
 #: Range image the MLP reads: columns x rows.

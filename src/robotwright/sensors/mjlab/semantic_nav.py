@@ -141,11 +141,15 @@ def near_obstacle(env: Any) -> torch.Tensor:
 
 
 def semantic_nav_env_cfg(
-    play: bool = False, policy: str = "mlp", scene: SemanticSceneCfg | None = None
+    play: bool = False,
+    policy: str = "mlp",
+    scene: SemanticSceneCfg | None = None,
+    flat: bool = False,
 ) -> ManagerBasedRlEnvCfg:
     """The task's environment config (see the module); ``play``: endless episodes, no
     pushes; ``policy``: ``"mlp"`` (range image with class channels) or ``"pointnet"``
-    (a ``"points"`` group of :data:`MAX_POINTS` hits with one-hot classes)."""
+    (a ``"points"`` group of :data:`MAX_POINTS` hits with one-hot classes); ``flat``: a
+    plane instead of the generated terrain (no terrain curriculum: every obstacle out)."""
     check_policy(policy)
     scene = scene or SemanticSceneCfg()
     scene.check()  # before the robot is read
@@ -212,6 +216,11 @@ def semantic_nav_env_cfg(
         func=mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}
     )
     _add_scan_observations(cfg, policy)
+    if flat:
+        cfg.scene.terrain.terrain_type = "plane"
+        cfg.scene.terrain.terrain_generator = None
+        cfg.curriculum.pop("terrain_levels", None)
+        cfg.terminations.pop("out_of_terrain_bounds", None)
     if play:
         cfg.episode_length_s = int(1e9)
         cfg.observations["actor"].enable_corruption = False
