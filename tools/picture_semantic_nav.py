@@ -35,7 +35,7 @@ def _mjlab_state(steps: int, seed: int) -> dict:
     for _ in range(steps):
         env.step(action)
     robot, lidar = env.scene["robot"], env.scene["lidar"]
-    term = env.event_manager.get_term_cfg("semantic_scene").func
+    term = env.event_manager.get_term_cfg("semantic_scene").func.state
     names = robot.joint_names
     state = {
         "xml": _go2_mjcf()[0],

@@ -121,3 +121,31 @@ def test_bad_configs_are_refused_naming_the_field(change: dict, field: str) -> N
         setattr(cfg, key, value)  # configs change after construction
     with pytest.raises(SensorError, match="SemanticSceneCfg." + re.escape(field)):
         cfg.check()
+
+
+def test_scene_state_parks_obstacles_beyond_the_clutter_share_and_poses_them() -> None:
+    from robotwright.sensors.semantic_scene import PARK_DEPTH, SceneState
+
+    torch.manual_seed(1)
+    state = SceneState(SemanticSceneCfg(num_obstacles=4, num_valuables=2), 3, "cpu")
+    ids = torch.arange(3)
+    state.redraw(ids, torch.tensor([0.0, 0.5, 1.0]))
+    assert state.active[:, :4].sum(dim=1).tolist() == [0, 2, 4]
+    assert bool(state.active[:, 4:].all())
+    origins = torch.tensor([[10.0, 0.0, 1.0], [0.0, 10.0, 2.0], [0.0, 0.0, 0.0]])
+    pos, quat = state.poses(ids, 0, origins)
+    assert pos[:, 2].tolist() == pytest.approx([1.0 - PARK_DEPTH, 2.105, 0.105])
+    assert torch.allclose(pos[:, :2], origins[:, :2] + state.xy[:, 0])
+    yaw = 2.0 * torch.atan2(quat[:, 3], quat[:, 0])
+    assert torch.allclose(
+        torch.remainder(yaw - state.yaw[:, 0] + math.pi, 2 * math.pi), torch.full((3,), math.pi)
+    )
+    # Distances: to the nearest active footprint; parked obstacles are not there.
+    d = state.distance(origins[:, :2] + state.xy[:, 5], origins, dynamic=False)
+    assert torch.allclose(d, -state.radius[5].expand(3))
+    far = state.distance(origins[:, :2], origins, dynamic=True)
+    assert far[0] == math.inf and math.isfinite(float(far[2]))
+    before = state.xy.clone()
+    state.step(0.1)
+    assert torch.equal(state.xy[:, 4:], before[:, 4:])
+    assert float((state.xy[2, :4] - before[2, :4]).abs().max()) > 0

@@ -28,8 +28,7 @@ from mjlab_train import run_train  # noqa: E402
 
 from robotwright.catalog import find_entry  # noqa: E402
 from robotwright.sensors.mjlab import semantic_nav  # noqa: E402
-from robotwright.sensors.mjlab.semantic_scene import PARK_DEPTH  # noqa: E402
-from robotwright.sensors.semantic_scene import SemanticSceneCfg  # noqa: E402
+from robotwright.sensors.semantic_scene import PARK_DEPTH, SemanticSceneCfg  # noqa: E402
 
 needs_go2 = pytest.mark.skipif(
     find_entry("go2") is None, reason="the Go2 comes from example-robot-data (not installed)"
@@ -55,7 +54,7 @@ def nav_env():
 
 
 def _scene_term(env):
-    return env.event_manager.get_term_cfg("semantic_scene").func
+    return env.event_manager.get_term_cfg("semantic_scene").func.state
 
 
 def _step(env, n: int) -> None:
@@ -92,7 +91,7 @@ def test_the_go2_is_the_one_command_robot_with_its_standing_pose() -> None:
 def test_every_object_and_every_ray_on_it_carries_its_expected_class(nav_env) -> None:
     env, term = nav_env, _scene_term(nav_env)
     lidar = env.scene["lidar"]
-    expected = term.scene.expected_classes()
+    expected = term.cfg.expected_classes()
     names = lidar.class_names
     model = env.sim.mj_model
     object_geoms = {}
@@ -137,7 +136,7 @@ def test_dynamic_obstacles_move_along_their_paths_and_valuables_stay(nav_env) ->
     moved = term.xy - xy
     for k, slot in enumerate(term.slots):
         if slot.dynamic:
-            bounced = (xy[:, k] + vel[:, k] * 3 * env.step_dt).abs() > term.scene.arena_half
+            bounced = (xy[:, k] + vel[:, k] * 3 * env.step_dt).abs() > term.cfg.arena_half
             keep = ~bounced.any(dim=1)
             want = vel[keep, k] * 3 * env.step_dt
             torch.testing.assert_close(moved[keep, k], want, atol=1e-5, rtol=0)
@@ -153,13 +152,13 @@ def test_the_clutter_curriculum_parks_obstacles_of_low_levels(nav_env) -> None:
     saved = terrain.terrain_levels.clone()
     try:
         terrain.terrain_levels[:] = 0
-        term.reset(torch.arange(env.num_envs))
+        env.event_manager.get_term_cfg("semantic_scene").func.reset(torch.arange(env.num_envs))
         dynamic = [k for k, s in enumerate(term.slots) if s.dynamic]
         want = math.ceil(len(dynamic) / top)
         assert term.active[:, dynamic].sum(dim=1).tolist() == [want] * env.num_envs
         assert bool(term.active[:, [k for k in range(len(term.slots)) if k not in dynamic]].all())
         terrain.terrain_levels[:] = top - 1
-        term.reset(torch.arange(env.num_envs))
+        env.event_manager.get_term_cfg("semantic_scene").func.reset(torch.arange(env.num_envs))
         assert bool(term.active.all())
     finally:
         terrain.terrain_levels[:] = saved

@@ -39,9 +39,11 @@ from robotwright.sensors.semantic import classify_path
 __all__ = [
     "DEFAULT_OBSTACLES",
     "DEFAULT_VALUABLES",
+    "PARK_DEPTH",
     "SceneAssetCfg",
     "SceneLayout",
     "SceneSlot",
+    "SceneState",
     "SemanticSceneCfg",
     "advance",
     "sample_layout",
@@ -269,3 +271,86 @@ def advance(
     over = moved.abs() > arena_half
     moved = torch.where(over, torch.sign(moved) * (2.0 * arena_half - moved.abs()), moved)
     return moved.clamp(-arena_half, arena_half), torch.where(over, -velocity, velocity)
+
+
+#: How far under its environment's origin an inactive obstacle is parked [m]: where no
+#: ray from above the terrain reaches it.
+PARK_DEPTH = 10.0
+
+
+class SceneState:
+    """The objects of ``n`` environments between resets, the same in every framework:
+    the adapters call :meth:`redraw` at an environment's reset, :meth:`step` every
+    environment step, and write :meth:`poses` to their simulator.
+
+    Attributes:
+        slots: the scene's slots, in order.
+        xy: ``(n, S, 2)`` positions relative to each environment's origin [m].
+        yaw: ``(n, S)`` [rad]. velocity: ``(n, S, 2)`` [m/s].
+        active: ``(n, S)`` bool: in the arena (False: parked, see :meth:`redraw`).
+    """
+
+    def __init__(self, cfg: SemanticSceneCfg, n: int, device: torch.device | str) -> None:
+        cfg.check()
+        self.cfg, self.device = cfg, device
+        self.slots = cfg.slots()
+        s = len(self.slots)
+        self.xy = torch.zeros(n, s, 2, device=device)
+        self.yaw = torch.zeros(n, s, device=device)
+        self.velocity = torch.zeros(n, s, 2, device=device)
+        self.active = torch.ones(n, s, dtype=torch.bool, device=device)
+        self.half_height = torch.tensor([sl.asset.half_height for sl in self.slots], device=device)
+        self.radius = torch.tensor([sl.asset.footprint_radius for sl in self.slots], device=device)
+        self.dynamic = [k for k, sl in enumerate(self.slots) if sl.dynamic]
+
+    def redraw(self, env_ids: torch.Tensor, clutter: torch.Tensor | None = None) -> None:
+        """New layouts for ``env_ids``. ``clutter`` ``(len(env_ids),)`` in [0, 1] (a
+        curriculum's share: terrain level + 1 over the levels) keeps the first
+        ``ceil(share * N)`` of the ``N`` obstacles in the arena and parks the others
+        :data:`PARK_DEPTH` m under the origin; ``None`` keeps all."""
+        if len(env_ids) == 0 or not self.slots:
+            return
+        layout = sample_layout(self.cfg, len(env_ids), self.device)
+        self.xy[env_ids], self.yaw[env_ids] = layout.xy, layout.yaw
+        self.velocity[env_ids] = layout.velocity
+        on = torch.ones(len(env_ids), len(self.slots), dtype=torch.bool, device=self.device)
+        if clutter is not None and self.dynamic:
+            count = torch.ceil(clutter.float().clamp(0.0, 1.0) * len(self.dynamic))
+            rank = torch.arange(len(self.dynamic), device=self.device)
+            on[:, self.dynamic] = rank[None, :] < count[:, None]
+        self.active[env_ids] = on
+
+    def step(self, dt: float) -> None:
+        """Move the dynamic obstacles of every environment along their paths for ``dt`` [s]."""
+        if self.dynamic:
+            k = self.dynamic
+            self.xy[:, k], self.velocity[:, k] = advance(
+                self.xy[:, k], self.velocity[:, k], dt, self.cfg.arena_half
+            )
+
+    def poses(
+        self, env_ids: torch.Tensor, k: int, origins: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """World position ``(n, 3)`` [m] and orientation ``(n, 4)`` (w, x, y, z) of slot
+        ``k`` in ``env_ids``, whose environment origins are ``origins`` ``(n, 3)``: the
+        object stands on the origin's height, or is parked under it."""
+        z = torch.where(
+            self.active[env_ids, k],
+            self.half_height[k],
+            torch.full_like(self.yaw[env_ids, k], -PARK_DEPTH),
+        )
+        pos = origins + torch.cat([self.xy[env_ids, k], z[:, None]], dim=1)
+        half = self.yaw[env_ids, k] * 0.5
+        zero = torch.zeros_like(half)
+        return pos, torch.stack([half.cos(), zero, zero, half.sin()], dim=1)
+
+    def distance(self, xy: torch.Tensor, origins: torch.Tensor, dynamic: bool) -> torch.Tensor:
+        """``(n,)`` distance [m] from world points ``xy`` ``(n, 2)`` to the nearest footprint
+        disc of the active obstacles (``dynamic``) or valuables; ``inf`` where none."""
+        picked = [k for k, sl in enumerate(self.slots) if sl.dynamic == dynamic]
+        if not picked:
+            return torch.full((xy.shape[0],), math.inf, device=xy.device)
+        centres = origins[:, None, :2] + self.xy[:, picked]
+        gap = (xy[:, None] - centres).norm(dim=-1) - self.radius[picked]
+        gap = torch.where(self.active[:, picked], gap, torch.full_like(gap, math.inf))
+        return gap.amin(dim=1)

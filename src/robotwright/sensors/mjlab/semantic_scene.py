@@ -21,7 +21,6 @@ where no ray from above reaches them. Objects stand on the environment origin's 
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import mujoco
@@ -30,11 +29,10 @@ from mjlab.entity import EntityCfg
 from mjlab.managers.event_manager import EventTermCfg
 
 from robotwright.sensors.semantic_scene import (
+    PARK_DEPTH,
     SceneAssetCfg,
-    SceneSlot,
+    SceneState,
     SemanticSceneCfg,
-    advance,
-    sample_layout,
 )
 
 __all__ = [
@@ -45,8 +43,6 @@ __all__ = [
     "scene_entities",
 ]
 
-#: How far under its environment's origin an inactive obstacle is parked [m].
-PARK_DEPTH = 10.0
 #: The event term's name in ``env_cfg.events``.
 EVENT_NAME = "semantic_scene"
 
@@ -90,77 +86,43 @@ def add_semantic_scene(
 
 class SemanticSceneEvent:
     """mjlab event term (class form, mode ``"step"``): draws each environment's layout at
-    its reset (:meth:`reset`) and moves the dynamic obstacles every step (``__call__``).
-
-    Attributes:
-        slots: the scene's slots, in order.
-        xy: ``(E, S, 2)`` object positions relative to their environment's origin [m].
-        yaw: ``(E, S)`` [rad]. velocity: ``(E, S, 2)`` [m/s]. active: ``(E, S)`` bool.
-    """
+    its reset (:meth:`reset`) and moves the dynamic obstacles every step (``__call__``);
+    the layout lives in :attr:`state`
+    (:class:`~robotwright.sensors.semantic_scene.SceneState`)."""
 
     def __init__(self, cfg: EventTermCfg, env: Any) -> None:
-        self.scene: SemanticSceneCfg = cfg.params["scene"]
-        self.scene.check()
+        self.state = SceneState(cfg.params["scene"], env.num_envs, env.device)
         self.curriculum = bool(cfg.params.get("clutter_curriculum", False))
         self.env = env
-        self.slots: list[SceneSlot] = self.scene.slots()
-        n, s, dev = env.num_envs, len(self.slots), env.device
-        self.xy = torch.zeros(n, s, 2, device=dev)
-        self.yaw = torch.zeros(n, s, device=dev)
-        self.velocity = torch.zeros(n, s, 2, device=dev)
-        self.active = torch.ones(n, s, dtype=torch.bool, device=dev)
-        self.height = torch.tensor([sl.asset.half_height for sl in self.slots], device=dev)
-        self.dynamic = [k for k, sl in enumerate(self.slots) if sl.dynamic]
+        self.entities = [env.scene[slot.name] for slot in self.state.slots]
 
     def reset(self, env_ids: torch.Tensor | None = None) -> None:
         """Draw the layout of ``env_ids`` (all when ``None``) and put the objects there."""
         if env_ids is None:
             env_ids = torch.arange(self.env.num_envs, device=self.env.device)
-        if len(env_ids) == 0 or not self.slots:
-            return
-        layout = sample_layout(self.scene, len(env_ids), self.env.device)
-        self.xy[env_ids], self.yaw[env_ids] = layout.xy, layout.yaw
-        self.velocity[env_ids] = layout.velocity
-        self.active[env_ids] = self._active(env_ids)
-        self._write(env_ids, range(len(self.slots)))
+        self.state.redraw(env_ids, self._clutter(env_ids))
+        self._write(env_ids, range(len(self.state.slots)))
 
     def __call__(self, env: Any, env_ids: Any, **_params: Any) -> None:
         """One environment step: the dynamic obstacles move by ``velocity * step_dt``."""
-        if not self.dynamic:
-            return
-        k = self.dynamic
-        self.xy[:, k], self.velocity[:, k] = advance(
-            self.xy[:, k], self.velocity[:, k], env.step_dt, self.scene.arena_half
-        )
-        self._write(torch.arange(env.num_envs, device=env.device), k)
+        if self.state.dynamic:
+            self.state.step(env.step_dt)
+            self._write(torch.arange(env.num_envs, device=env.device), self.state.dynamic)
 
-    def _active(self, env_ids: torch.Tensor) -> torch.Tensor:
-        """``(n, S)`` which slots of ``env_ids`` stand in the arena (see the module)."""
-        on = torch.ones(len(env_ids), len(self.slots), dtype=torch.bool, device=self.env.device)
+    def _clutter(self, env_ids: torch.Tensor) -> torch.Tensor | None:
+        """The curriculum's share of obstacles for ``env_ids`` (see the module)."""
         terrain = getattr(self.env.scene, "terrain", None)
         levels = getattr(terrain, "terrain_levels", None)
-        if not self.curriculum or levels is None or not self.dynamic:
-            return on
+        if not self.curriculum or levels is None:
+            return None
         top = max(int(getattr(terrain, "max_terrain_level", 1)), 1)
-        share = (levels[env_ids].float() + 1.0) / top
-        count = torch.ceil(share.clamp(max=1.0) * len(self.dynamic))
-        rank = torch.arange(len(self.dynamic), device=self.env.device)
-        on[:, self.dynamic] = rank[None, :] < count[:, None]
-        return on
+        return (levels[env_ids].float() + 1.0) / top
 
     def _write(self, env_ids: torch.Tensor, slots: Any) -> None:
         origins = self.env.scene.env_origins[env_ids]
-        half = self.yaw[env_ids] * 0.5
         for k in slots:
-            z = torch.where(
-                self.active[env_ids, k], self.height[k], torch.full_like(half[:, k], -PARK_DEPTH)
-            )
-            pos = origins + torch.cat([self.xy[env_ids, k], z[:, None]], dim=1)
-            quat = torch.stack(
-                [half[:, k].cos(), torch.zeros_like(z), torch.zeros_like(z), half[:, k].sin()], 1
-            )
-            entity = self.env.scene[self.slots[k].name]
-            entity.write_mocap_pose_to_sim(torch.cat([pos, quat], dim=1), env_ids=env_ids)
+            pos, quat = self.state.poses(env_ids, k, origins)
+            self.entities[k].write_mocap_pose_to_sim(torch.cat([pos, quat], dim=1), env_ids=env_ids)
 
 
 def object_distances(env: Any, xy: torch.Tensor, dynamic: bool) -> torch.Tensor:
@@ -168,11 +130,4 @@ def object_distances(env: Any, xy: torch.Tensor, dynamic: bool) -> torch.Tensor:
     footprint disc of the scene's active obstacles (``dynamic``) or valuables; ``inf``
     where there is none."""
     term: SemanticSceneEvent = env.event_manager.get_term_cfg(EVENT_NAME).func
-    picked = [k for k, sl in enumerate(term.slots) if sl.dynamic == dynamic]
-    if not picked:
-        return torch.full((env.num_envs,), math.inf, device=env.device)
-    centres = env.scene.env_origins[:, None, :2] + term.xy[:, picked]
-    radius = torch.tensor([term.slots[k].asset.footprint_radius for k in picked], device=env.device)
-    gap = (xy[:, None] - centres).norm(dim=-1) - radius
-    gap = torch.where(term.active[:, picked], gap, torch.full_like(gap, math.inf))
-    return gap.amin(dim=1)
+    return term.state.distance(xy, env.scene.env_origins, dynamic)
