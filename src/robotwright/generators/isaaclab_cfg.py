@@ -58,7 +58,7 @@ def cfg_number(value: float) -> str:
     return repr(value)
 
 
-def _groups(hrdf: HRDF) -> list[tuple[dict[str, float], list[str]]]:
+def actuator_groups(hrdf: HRDF) -> list[tuple[dict[str, float], list[str]]]:
     """Actuated joints grouped by equal drive values (in first-seen order)."""
     groups: dict[tuple, tuple[dict[str, float], list[str]]] = {}
     for act in hrdf.actuators:
@@ -251,7 +251,7 @@ def articulation_cfg_source(
         for name, q in joint_pos_by_name.items()
     ]
     lines += ["        },", "    ),", "    actuators={"]
-    for k, (values, joints) in enumerate(_groups(hrdf)):
+    for k, (values, joints) in enumerate(actuator_groups(hrdf)):
         exprs = ", ".join(repr(re.escape(j)) for j in joints)
         lines.append(f"        {f'group_{k}'!r}: ImplicitActuatorCfg(")
         lines.append(f"            joint_names_expr=[{exprs}],")
