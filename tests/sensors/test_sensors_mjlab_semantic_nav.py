@@ -86,6 +86,16 @@ def test_the_go2_is_the_one_command_robot_with_its_standing_pose() -> None:
     model = spec.compile()
     assert model.nu == 12 and model.actuator_gainprm[:, 0].tolist() == [50.0] * 12
     assert model.actuator_biasprm[:, 2].tolist() == [-1.0] * 12  # kv 1
+    # No two of the robot's collision geoms can collide (no self-collision); every one
+    # collides with a default geom (terrain, objects).
+    colliding = [
+        g for g in range(model.ngeom) if model.geom_contype[g] or model.geom_conaffinity[g]
+    ]
+    assert colliding
+    for a in colliding:
+        assert model.geom_contype[a] & 1 or model.geom_conaffinity[a] & 1
+        for b in colliding:
+            assert not (model.geom_contype[a] & model.geom_conaffinity[b])
 
 
 def test_every_object_and_every_ray_on_it_carries_its_expected_class(nav_env) -> None:

@@ -39,6 +39,7 @@ from isaaclab.assets import ArticulationCfg
 from isaaclab.managers import ObservationGroupCfg, ObservationTermCfg, SceneEntityCfg
 from isaaclab.managers import RewardTermCfg as RewTerm
 from isaaclab.utils import configclass
+from isaaclab_newton.sim.schemas import NewtonArticulationCfg
 from isaaclab_tasks.core.velocity.config.go2.agents.rsl_rl_ppo_cfg import (
     UnitreeGo2RoughPPORunnerCfg,
 )
@@ -113,7 +114,8 @@ def _conjugate(q: np.ndarray) -> np.ndarray:
 
 def go2_articulation_cfg() -> ArticulationCfg:
     """The Go2 as ``robotwright isaaclab-cfg go2`` with the task's options writes it: its
-    USD, standing pose, and one implicit actuator group per set of equal drive values."""
+    USD, standing pose, and one implicit actuator group per set of equal drive values;
+    contact reports on and self-collisions off, as Isaac Lab's own Go2 has them."""
     from robotwright.generators.isaaclab_cfg import actuator_groups
 
     usd, pos, joint_pos, _, _ = _go2_usd()
@@ -131,7 +133,14 @@ def go2_articulation_cfg() -> ArticulationCfg:
         )
     return ArticulationCfg(
         prim_path="{ENV_REGEX_NS}/Robot",
-        spawn=sim_utils.UsdFileCfg(usd_path=usd),
+        # As Isaac Lab's own Go2: contact reports on (its contact sensor needs them) and
+        # no collisions between the robot's own bodies (the rotor shapes sit inside the
+        # base and the hips).
+        spawn=sim_utils.UsdFileCfg(
+            usd_path=usd,
+            activate_contact_sensors=True,
+            articulation_props=NewtonArticulationCfg(self_collision_enabled=False),
+        ),
         init_state=ArticulationCfg.InitialStateCfg(pos=pos, joint_pos=joint_pos),
         actuators=actuators,
     )

@@ -40,9 +40,9 @@ OBJECT_PRIM_PATHS = ("{ENV_REGEX_NS}/obstacle_.*", "{ENV_REGEX_NS}/valuable_.*")
 def _spawn(asset: SceneAssetCfg) -> Any:
     """Isaac Lab spawner of the asset: kinematic, colliding, coloured."""
     common = {
-        "rigid_props": sim_utils.RigidBodyPropertiesCfg(kinematic_enabled=True),
-        "mass_props": sim_utils.MassPropertiesCfg(mass=1.0),
-        "collision_props": sim_utils.CollisionPropertiesCfg(),
+        "rigid_props": sim_utils.UsdPhysicsRigidBodyCfg(kinematic_enabled=True),
+        "mass_props": sim_utils.MassCfg(mass=1.0),
+        "collision_props": sim_utils.UsdPhysicsCollisionCfg(),
         "visual_material": sim_utils.PreviewSurfaceCfg(diffuse_color=tuple(asset.rgba[:3])),
     }
     if asset.shape == "box":

@@ -19,6 +19,8 @@ from pathlib import Path
 
 #: Most environments and iterations a run may ask for.
 MAX_ENVS, MAX_ITERATIONS = 1 << 20, 10**7
+#: Most rows or columns of sub-terrains.
+MAX_TERRAIN_CELLS = 100
 
 
 def _bounded(low: int, high: int) -> object:
@@ -41,6 +43,9 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--device", default="cpu", help="cpu or cuda:N")
     p.add_argument("--seed", type=_bounded(0, 2**31 - 1), default=None)
     p.add_argument("--log_root", type=Path, default=Path("logs/rsl_rl"))
+    rows = _bounded(1, MAX_TERRAIN_CELLS)
+    p.add_argument("--terrain_rows", type=rows, default=None, help="terrain generator rows")
+    p.add_argument("--terrain_cols", type=rows, default=None, help="terrain generator columns")
     return p
 
 
@@ -66,6 +71,11 @@ def main(argv: list[str] | None = None) -> int:
     agent_cfg = handle_deprecated_rsl_rl_cfg(agent_cfg, check_rsl_rl_version())
     if args.num_envs is not None:
         env_cfg.scene.num_envs = args.num_envs
+    generator = getattr(env_cfg.scene.terrain, "terrain_generator", None)
+    for field in ("num_rows", "num_cols"):
+        value = getattr(args, f"terrain_{field[4:]}")
+        if value is not None and generator is not None:
+            setattr(generator, field, value)
     if args.max_iterations is not None:
         agent_cfg.max_iterations = args.max_iterations
     if args.seed is not None:

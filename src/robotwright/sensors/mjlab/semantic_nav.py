@@ -89,7 +89,7 @@ def _go2_mjcf() -> tuple[str, tuple[float, float, float], dict[str, float]]:
 
 def _go2_spec() -> mujoco.MjSpec:
     """The Go2 instrumented like mjlab's Go1: IMU site and sensors on the base, a site
-    and a named collision geom (``FL_foot_collision``, ...) per foot."""
+    and a named collision geom (``FL_foot_collision``, ...) per foot; self-collisions off."""
     spec = mujoco.MjSpec.from_string(_go2_mjcf()[0])
     base = spec.body("base")
     base.add_site(name="imu", pos=(0.0, 0.0, 0.0), group=5)
@@ -104,6 +104,12 @@ def _go2_spec() -> mujoco.MjSpec:
         objtype=mujoco.mjtObj.mjOBJ_BODY,
         objname="base",
     )
+    # No collisions between the robot's own bodies (as Isaac Lab's Go2; the base and the
+    # front thighs touch in the standing pose): its shapes collide with what has
+    # contype 1 (terrain, objects), not with each other.
+    for geom in spec.geoms:
+        if geom.contype or geom.conaffinity:
+            geom.contype, geom.conaffinity = 2, 1
     for leg, foot in zip(_LEGS, FEET, strict=True):
         body = spec.body(foot)
         body.add_site(name=leg, pos=(0.0, 0.0, 0.0), group=5)
