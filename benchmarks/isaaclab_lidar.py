@@ -98,7 +98,8 @@ LABELS = {
 }
 
 
-def bench(num_envs: int, device: str, rounds: int) -> None:
+def bench(num_envs: int, device: str, rounds: int) -> dict[str, dict[str, float]]:
+    """Print and return, per contender: rays, median seconds per update, ratio to stock."""
     import isaaclab.sim as sim_utils
     from isaaclab.scene import InteractiveScene
     from isaaclab_newton.physics import MJWarpSolverCfg, NewtonCfg
@@ -125,6 +126,7 @@ def bench(num_envs: int, device: str, rounds: int) -> None:
                     times[name].append(time.perf_counter() - tick)
         stock = statistics.median(times["stock"])
         print(f"\n{num_envs} environments, {device}:")
+        out: dict[str, dict[str, float]] = {}
         for name, label in LABELS.items():
             sensor = scene[name]
             med = statistics.median(times[name])
@@ -133,6 +135,13 @@ def bench(num_envs: int, device: str, rounds: int) -> None:
                 f"  {label:36s} {rays:9d} rays {med * 1e3:8.2f} ms  "
                 f"{rays / med / 1e6:7.2f} Mrays/s  x{med / stock:5.2f} of stock"
             )
+            out[name] = {
+                "rays": rays,
+                "seconds": med,
+                "rays_per_s": rays / med,
+                "x_stock": med / stock,
+            }
+    return out
 
 
 def main() -> None:
