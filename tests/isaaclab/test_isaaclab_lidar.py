@@ -73,6 +73,9 @@ SENSORS = {
     "seed": _seed_cfg(return_mesh_ids=True),
     "everything": SemanticLidarCfg(prim_path=BASE, pattern_cfg=IL_PATTERN, return_mesh_ids=True),
     "no_self": SemanticLidarCfg(prim_path=BASE, pattern_cfg=IL_PATTERN, self_class=None),
+    "no_self_recast": SemanticLidarCfg(
+        prim_path=BASE, pattern_cfg=IL_PATTERN, self_class=None, pass_through="recast"
+    ),
     "il_pattern": _seed_cfg(pattern_cfg=IL_PATTERN),
     "multi_mesh": MultiMeshRayCasterCfg(
         prim_path=BASE,
@@ -474,12 +477,43 @@ def test_every_mesh_prim_paths_entry_that_matches_nothing_is_named(world):
             sensor.shapes = saved
 
 
+def test_one_skipping_cast_equals_the_re_casts_past_see_through_shapes(world):
+    """pass_through="skip" (one BVH walk leaving the see-through robot out) gives what
+    the re-casts past it give, ray for ray, over moving scenes; it loses no hit."""
+    sim, scene = world
+    skip, recast = scene["no_self"], scene["no_self_recast"]
+    assert skip._skip_cast is not None and recast._skip_cast is None
+    compared = 0
+    for step in range(3):
+        _step(sim, scene, 1, box_phase=0.4 * step)
+        a, b = skip.data, recast.data
+        hit = a.hit_mask.torch
+        assert torch.equal(hit, b.hit_mask.torch)
+        torch.testing.assert_close(
+            a.ray_distances.torch[hit], b.ray_distances.torch[hit], atol=2e-4, rtol=0
+        )
+        same = a.shape_ids.torch == b.shape_ids.torch
+        assert float(same[hit].float().mean()) > 0.999  # ties at shape seams aside
+        assert torch.equal(a.semantic_labels.torch[hit & same], b.semantic_labels.torch[hit & same])
+        compared += int(hit.sum())
+    assert compared > 1000
+    assert skip.lost_pass_through_hits == 0
+
+
+def test_pass_through_defaults_to_the_skipping_cast_and_is_checked() -> None:
+    from robotwright.sensors.isaaclab.config import resolve
+
+    assert SemanticLidarCfg(prim_path=BASE).pass_through == "skip"
+    with pytest.raises(SensorError, match="pass_through"):
+        resolve(SemanticLidarCfg(prim_path=BASE, pass_through="twice"))
+
+
 def test_hits_lost_to_max_pass_through_are_counted_and_warned(world):
     """With the robot see-through and no pass allowed, every ray that first meets the
     robot reads as a miss: counted on the device, at least the rays a multi-pass
     reference sees a hit for, and warned once."""
     sim, scene = world
-    sensor = scene["no_self"]
+    sensor = scene["no_self_recast"]
     _step(sim, scene, 1)
     before = sensor.lost_pass_through_hits
     saved = sensor.cfg.max_pass_through

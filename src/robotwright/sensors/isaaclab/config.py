@@ -70,7 +70,14 @@ class LidarCfg(NewtonRaycastSensorCfg):
         miss_distance: the distance :meth:`LidarSensor.get_distances` and the distance
             observation terms give a miss [m] (``None``: ``max_distance``).
             ``data.ray_distances`` keeps Isaac Lab's ``inf``.
-        max_pass_through: most see-through shapes one ray passes; a ray still behind
+        pass_through: how rays pass see-through shapes. ``"skip"`` (default): one cast
+            whose walk of Newton's shape BVH leaves them out, at the stock cast's cost,
+            with no host read (CUDA graphs capture it; falls back to ``"recast"`` with a
+            warning where Newton lacks the intersection functions it uses).
+            ``"recast"``: the rays that hit one are cast again from just past it, up to
+            ``max_pass_through`` times, each pass reading its queue length on the host.
+        max_pass_through: with ``pass_through="recast"``, most see-through shapes one ray
+            passes; a ray still behind
             one after that many reads as a miss.
     """
 
@@ -81,9 +88,10 @@ class LidarCfg(NewtonRaycastSensorCfg):
     min_distance: float = 0.0
     max_distance: float = 40.0
     miss_distance: float | None = None
+    pass_through: str = "skip"
     max_pass_through: int = 4
-    # The pass-through loop reads its queue length on the host, which a CUDA graph
-    # cannot capture.
+    # The "recast" pass-through reads its queue length on the host, which a CUDA graph
+    # cannot capture; "skip" can be captured: set True to use one.
     use_cuda_graph: bool = False
 
     def validate_config(self) -> None:
@@ -140,6 +148,10 @@ class ResolvedLidarCfg:
     miss_distance: float
     mesh_patterns: tuple[re.Pattern[str], ...]
     mesh_prim_paths: tuple[str, ...] = ()
+
+
+#: How rays pass see-through shapes (:attr:`LidarCfg.pass_through`).
+PASS_THROUGH_MODES = ("skip", "recast")
 
 
 def _number(value: object) -> bool:
@@ -210,6 +222,11 @@ def resolve(cfg: Any) -> ResolvedLidarCfg:
     miss = cfg.max_distance if cfg.miss_distance is None else cfg.miss_distance
     if not _number(miss) or not math.isfinite(miss):
         raise SensorError(f"{name}.miss_distance: expected None or a finite number [m]")
+    if cfg.pass_through not in PASS_THROUGH_MODES:
+        raise SensorError(
+            f"{name}.pass_through: expected one of {', '.join(PASS_THROUGH_MODES)}, "
+            f"got {cfg.pass_through!r}"
+        )
     passes = cfg.max_pass_through
     if (
         not isinstance(passes, int)

@@ -192,7 +192,6 @@ class SemanticNavGo2EnvCfg(UnitreeGo2RoughEnvCfg):
             max_distance=LIDAR_RANGE,
             mesh_prim_paths=["/World/ground", *OBJECT_PRIM_PATHS],
             self_class=None,
-            max_pass_through=8,  # the rays from inside the head pass the robot's own shapes
             update_period=self.decimation * self.sim.dt,
         )
         add_semantic_scene(self, self.semantic_scene, clutter_curriculum=True)

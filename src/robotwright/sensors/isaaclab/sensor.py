@@ -9,11 +9,13 @@ tracking, drift, update timing and outputs (``ray_hits_w``, ``ray_distances``,
 1. ``pattern_window`` (windowed patterns only): each environment's window of the
    pattern table, chosen by its simulated time since reset;
 2. Isaac Lab's ray transform (``_update_ray_infos``);
-3. ``newton.intersect_ray`` with ``out_shape_id``: the nearest collision shape per ray;
-4. rays whose nearest shape is see-through (outside ``mesh_prim_paths``, the carrier
-   body, or the robot itself when ``self_class=None``) are re-cast just past it, only
-   those rays, up to ``max_pass_through`` times;
-5. ``finish_rays``: Isaac Lab's outputs plus the hit mask, shape ids and class ids.
+3. the nearest *seen* collision shape per ray: with ``pass_through="skip"`` (default)
+   one cast whose walk of Newton's shape BVH leaves the see-through shapes out (outside
+   ``mesh_prim_paths``, the carrier body, or the robot itself when ``self_class=None``;
+   :mod:`._skip_cast`); with ``"recast"``, ``newton.intersect_ray`` with
+   ``out_shape_id``, then the rays whose nearest shape is see-through re-cast just past
+   it, only those rays, up to ``max_pass_through`` times;
+4. ``finish_rays``: Isaac Lab's outputs plus the hit mask, shape ids and class ids.
 
 Parts of the parent relied on (private in Isaac Lab, pinned by a test):
 ``_launch_raycast``, ``_update_ray_infos``, ``_initialize_rays_impl``,
@@ -41,6 +43,7 @@ from robotwright._rotations import quat_to_mat
 from robotwright.errors import SensorError
 from robotwright.sensors import learning_obs
 from robotwright.sensors.isaaclab import _kernels as k
+from robotwright.sensors.isaaclab._skip_cast import skip_cast_kernel
 from robotwright.sensors.isaaclab.config import (
     LidarCfg,
     ResolvedLidarCfg,
@@ -201,10 +204,23 @@ class LidarSensor(NewtonRaycastSensor):
     def _initialize_impl(self) -> None:
         # Fields may have changed since construction (Isaac Lab and tyro allow it).
         self.resolved = resolve(self.cfg)
-        if self.cfg.use_cuda_graph and self.cfg.max_pass_through > 0:
+        global_world = not bool(self.cfg.global_world_only)
+        self._skip_cast = None
+        if self.cfg.pass_through == "skip":
+            self._skip_cast = skip_cast_kernel(global_world)
+            if self._skip_cast is None:
+                warnings.warn(
+                    f"{type(self.cfg).__name__}: this Newton lacks the ray-intersection "
+                    "functions pass_through='skip' uses; re-casting past see-through "
+                    "shapes instead (pass_through='recast')",
+                    stacklevel=2,
+                )
+        recast = self._skip_cast is None
+        if self.cfg.use_cuda_graph and recast and self.cfg.max_pass_through > 0:
             warnings.warn(
-                f"{type(self.cfg).__name__}: use_cuda_graph=True needs max_pass_through=0 "
-                "(the pass-through loop reads its queue on the host); casting without a graph",
+                f"{type(self.cfg).__name__}: use_cuda_graph=True needs pass_through='skip' "
+                "or max_pass_through=0 (the re-cast loop reads its queue on the host); "
+                "casting without a graph",
                 stacklevel=2,
             )
             self.cfg.use_cuda_graph = False
@@ -324,7 +340,7 @@ class LidarSensor(NewtonRaycastSensor):
     # -- the cast ---------------------------------------------------------------------
     def _launch_raycast(self) -> None:
         e, n = self._view_count, self.num_rays
-        dev, model = self._device, self.backend.model
+        dev = self._device
         data = self._data
         if self.frame_period is not None:
             wp.launch(
@@ -348,6 +364,42 @@ class LidarSensor(NewtonRaycastSensor):
                 device=dev,
             )
         self._update_ray_infos(self._is_outdated)
+        if self._skip_cast is not None:
+            self._cast_skipping()
+        else:
+            self._cast_recasting()
+        self._finish()
+
+    def _cast_skipping(self) -> None:
+        """One cast that leaves the see-through shapes out of its BVH walk."""
+        model = self.backend.model
+        wp.launch(
+            self._skip_cast,
+            dim=self._view_count * self.num_rays,
+            inputs=[
+                model.bvh_shapes.id,
+                model.bvh_shapes_group_roots,
+                model.bvh_shape_enabled,
+                model.bvh_shape_world_transforms,
+                model.shape_type,
+                model.shape_scale,
+                model.shape_source_ptr,
+                self._shape_visible,
+                self._is_outdated,
+                self.num_rays,
+                self._ray_starts_w_flat,
+                self._ray_directions_w_flat,
+                self._ray_worlds,
+                float(self.cfg.max_distance),
+            ],
+            outputs=[self._total, self._final_shape, self._final_normal],
+            device=self._device,
+        )
+
+    def _cast_recasting(self) -> None:
+        """The stock cast, then re-casts past see-through shapes (host reads per pass)."""
+        e, n = self._view_count, self.num_rays
+        dev, model = self._device, self.backend.model
         global_world = not bool(self.cfg.global_world_only)
         newton.intersect_ray(
             model,
@@ -438,6 +490,10 @@ class LidarSensor(NewtonRaycastSensor):
             queue, nxt = nxt, queue
         if passes == 0:  # every ray queued by the first pass is a lost hit
             wp.launch(k.add_count, dim=1, inputs=[self._pending_count[0], self._lost], device=dev)
+
+    def _finish(self) -> None:
+        """Isaac Lab's outputs and ours from the final hits; the lost-hit check."""
+        e, n, data = self._view_count, self.num_rays, self._data
         wp.launch(
             k.finish_rays,
             dim=(e, n),
@@ -450,7 +506,7 @@ class LidarSensor(NewtonRaycastSensor):
                 self._final_normal,
                 self._shape_class,
                 float(self.cfg.min_distance),
-                max_d,
+                float(self.cfg.max_distance),
                 self.ray_cast_drift.warp,
             ],
             outputs=[
@@ -461,7 +517,7 @@ class LidarSensor(NewtonRaycastSensor):
                 data._shape_ids,
                 data._labels,
             ],
-            device=dev,
+            device=self._device,
         )
         self._check_lost()
 
