@@ -16,7 +16,7 @@ skipped with the reason):
   nav_isaaclab     steps/s of Robotwright-Isaac-SemanticNav-Go2-v0
   train_mjlab      N iterations of mjlab's train on the task: losses and mean reward per
                    iteration
-  train_isaaclab   N iterations of the kit-less rsl_rl train on the Isaac Lab task
+  train_isaaclab   N iterations of `robotwright isaaclab-train` on the Isaac Lab task
 
 Writes one JSON summary (machine, versions, each section's figures or its error) to
 ``--out`` and prints it. Needs no network.
@@ -143,9 +143,9 @@ def train(framework: str, envs: int, device: str, iterations: int, limit: float)
             cmd += ["--env.scene.num-envs", str(envs), "--agent.max-iterations", str(iterations)]
             cmd += [*gpu, "--log-root", logs]
         else:
-            cmd = [sys.executable, "-m", "robotwright.sensors.isaaclab.train"]
-            cmd += ["Robotwright-Isaac-SemanticNav-Go2-v0", "--num_envs", str(envs)]
-            cmd += ["--max_iterations", str(iterations), "--device", device, "--log_root", logs]
+            cmd = [sys.executable, "-m", "robotwright", "isaaclab-train"]
+            cmd += ["Robotwright-Isaac-SemanticNav-Go2-v0", "--num-envs", str(envs)]
+            cmd += ["--max-iterations", str(iterations), "--device", device, "--log-root", logs]
         t0 = time.perf_counter()
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=limit, cwd=logs)
         if done.returncode != 0:

@@ -7,7 +7,7 @@ its semantic scan coloured by class (docs/images/semantic_nav_<framework>.png).
 mjlab runs in the MuJoCo 3.11 environment, Isaac Lab in its own (``.ci/run``); both on
 warp's CPU device. One environment on flat ground; the robot stands (zero actions hold
 its default pose) for ``--steps`` policy steps while the obstacles move, then the last
-scan is drawn by :func:`robotwright.sensors.nav_picture.draw_nav_scene`.
+scan is drawn by :func:`robotwright.render.nav_scene.draw_nav_scene`.
 """
 
 from __future__ import annotations
@@ -70,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
         from robotwright.sensors.isaaclab.semantic_nav import picture_state
 
         state = picture_state(args.steps, args.seed)
-    from robotwright.sensors.nav_picture import draw_nav_scene
+    from robotwright.render.nav_scene import draw_nav_scene
 
     hits = int(np.isfinite(state["points"]).all(axis=1).sum())
     draw_nav_scene(

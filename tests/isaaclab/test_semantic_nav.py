@@ -176,15 +176,15 @@ def _losses(stdout: str, name: str) -> list[float]:
 
 
 @pytest.mark.parametrize(("pointnet", "iterations"), [(False, 5), (True, 2)])
-def test_the_kit_less_rsl_rl_train_runs_the_task(tmp_path, pointnet, iterations) -> None:
+def test_robotwright_isaaclab_train_runs_the_task(tmp_path, pointnet, iterations) -> None:
     """4 envs on the CPU: every loss finite; with 5 iterations the value loss falls below
     its first value."""
     from robotwright.sensors.isaaclab import semantic_nav
 
     task = semantic_nav.POINTNET_TASK_ID if pointnet else semantic_nav.TASK_ID
-    args = [sys.executable, "-m", "robotwright.sensors.isaaclab.train", task]
-    args += ["--num_envs", "4", "--max_iterations", str(iterations), "--log_root", str(tmp_path)]
-    args += ["--terrain_rows", "2", "--terrain_cols", "2"]
+    args = [sys.executable, "-m", "robotwright", "isaaclab-train", task]
+    args += ["--num-envs", "4", "--max-iterations", str(iterations), "--log-root", str(tmp_path)]
+    args += ["--terrain-rows", "2", "--terrain-cols", "2"]
     done = subprocess.run(args, capture_output=True, text=True, timeout=1500, cwd=tmp_path)
     assert done.returncode == 0, (done.stdout[-3000:], done.stderr[-3000:])
     value, surrogate = _losses(done.stdout, "value"), _losses(done.stdout, "surrogate")
@@ -197,10 +197,11 @@ def test_the_kit_less_rsl_rl_train_runs_the_task(tmp_path, pointnet, iterations)
 
 
 def test_the_train_entry_refuses_an_unknown_task_and_bad_numbers(tmp_path) -> None:
-    base = [sys.executable, "-m", "robotwright.sensors.isaaclab.train"]
+    base = [sys.executable, "-m", "robotwright", "isaaclab-train"]
     for extra, said in (
         (["Nope-v0"], "not registered"),
-        (["Robotwright-Isaac-SemanticNav-Go2-v0", "--num_envs", "0"], "expected a whole number"),
+        (["Robotwright-Isaac-SemanticNav-Go2-v0", "--num-envs", "0"], "expected a whole number"),
+        (["Robotwright-Isaac-SemanticNav-Go2-v0", "--device", "gpu;rm"], "expected cpu"),
     ):
         done = subprocess.run(
             base + extra, capture_output=True, text=True, timeout=600, cwd=tmp_path

@@ -45,6 +45,7 @@ _COMMAND_MODULES: tuple[str, ...] = (
     "robotwright.cli.view",
     "robotwright.cli.render",
     "robotwright.cli.robots",
+    "robotwright.cli.train",
 )
 
 #: Commands that read robots from files: they take ``--asset-root DIR`` (see

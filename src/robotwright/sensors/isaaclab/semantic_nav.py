@@ -17,8 +17,8 @@ generator and curriculum, twist commands, rewards, height scanner, contact senso
   class channels for the MLP, or a ``points`` group for PointNet).
 
 Registered with gym when this module is imported (``import
-robotwright.sensors.isaaclab.semantic_nav``); ``python -m
-robotwright.sensors.isaaclab.train TASK`` trains it with rsl_rl.
+robotwright.sensors.isaaclab.semantic_nav``); ``robotwright isaaclab-train TASK`` trains
+it with rsl_rl (:mod:`robotwright.sensors.isaaclab.train`).
 """
 
 from __future__ import annotations
@@ -265,7 +265,7 @@ _register()
 def picture_state(steps: int, seed: int) -> dict[str, Any]:
     """One environment on nearly flat ground (height noise of at most 5 mm) run for
     ``steps`` policy steps with zero actions (the standing pose), and what
-    :func:`robotwright.sensors.nav_picture.draw_nav_scene` draws of it: the robot's MJCF
+    :func:`robotwright.render.nav_scene.draw_nav_scene` draws of it: the robot's MJCF
     and pose, the objects' poses, the last scan (tools/picture_semantic_nav.py)."""
     import isaaclab.terrains as terrain_gen
     from isaaclab_tasks.utils.hydra import resolve_presets
