@@ -113,6 +113,13 @@ def test_paths_bounce_off_the_arena_sides_and_keep_their_speed() -> None:
         ({"obstacles": (SceneAssetCfg("can", "cone", (0.1, 0.1)),)}, "obstacles[0].shape"),
         ({"valuables": (SceneAssetCfg("sofa", "box", (0.1, 0.1)),)}, "valuables[0].size"),
         ({"valuables": (SceneAssetCfg("sofa", "box", (0.1, -1.0, 0.1)),)}, "valuables[0].size"),
+        ({"valuables": (SceneAssetCfg("sofa", "box", 0.5),)}, "valuables[0].size"),
+        (
+            {"valuables": (SceneAssetCfg("sofa", "box", (1, 1, 1), (1, 2, 0, 1)),)},
+            "valuables[0].rgba",
+        ),
+        ({"valuables": ("sofa",)}, "valuables"),
+        ({"mapping": {"valuable": "sofa"}}, "mapping"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_field(change: dict, field: str) -> None:

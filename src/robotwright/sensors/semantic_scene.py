@@ -33,7 +33,7 @@ import torch
 
 from robotwright._bounds import Bound
 from robotwright.errors import SensorError
-from robotwright.sensors.config import DEFAULT_SEMANTIC_CLASS_MAPPING
+from robotwright.sensors.config import DEFAULT_SEMANTIC_CLASS_MAPPING, check_class_mapping
 from robotwright.sensors.semantic import classify_path
 
 __all__ = [
@@ -53,6 +53,8 @@ __all__ = [
 MAX_OBJECTS = 64
 #: Sizes and distances a scene config accepts [m].
 LENGTH_BOUND = Bound(0.0, 100.0, unit="m", open_low=True)
+#: Colour components.
+COLOUR_BOUND = Bound(0.0, 1.0)
 #: Gaps that may be zero [m].
 GAP_BOUND = Bound(0.0, 100.0, unit="m")
 #: Obstacle speeds [m/s].
@@ -98,9 +100,23 @@ class SceneAssetCfg:
         want = {"box": 3, "cylinder": 2}.get(self.shape)
         if want is None:
             raise SensorError(f"{where}.shape {self.shape!r}: expected 'box' or 'cylinder'")
-        if len(self.size) != want or any(LENGTH_BOUND.check(v) is None for v in self.size):
+        size = self.size
+        if (
+            not isinstance(size, (tuple, list))
+            or len(size) != want
+            or any(LENGTH_BOUND.check(v) is None for v in size)
+        ):
             raise SensorError(
                 f"{where}.size {self.size!r}: expected {want} sizes, each {LENGTH_BOUND.describe()}"
+            )
+        rgba = self.rgba
+        if (
+            not isinstance(rgba, (tuple, list))
+            or len(rgba) != 4
+            or any(COLOUR_BOUND.check(v) is None for v in rgba)
+        ):
+            raise SensorError(
+                f"{where}.rgba {rgba!r}: expected 4 values, each {COLOUR_BOUND.describe()}"
             )
 
 
@@ -163,6 +179,10 @@ class SemanticSceneCfg:
                     f"SemanticSceneCfg.num_{group} {count!r}: expected a whole number in "
                     f"[0, {MAX_OBJECTS}]"
                 )
+            if not isinstance(assets, (tuple, list)) or not all(
+                isinstance(a, SceneAssetCfg) for a in assets
+            ):
+                raise SensorError(f"SemanticSceneCfg.{group}: expected a tuple of SceneAssetCfg")
             if count and not assets:
                 raise SensorError(f"SemanticSceneCfg.{group}: empty, but num_{group} is {count}")
             for i, asset in enumerate(assets):
@@ -176,6 +196,8 @@ class SemanticSceneCfg:
                 raise SensorError(
                     f"SemanticSceneCfg.{name} {getattr(self, name)!r}: {bound.expected()}"
                 )
+        if self.mapping is not None:
+            check_class_mapping(self.mapping, "SemanticSceneCfg.mapping")
         speed = self.obstacle_speed
         low, high = speed if isinstance(speed, (tuple, list)) and len(speed) == 2 else (None, None)
         if SPEED_BOUND.check(low) is None or SPEED_BOUND.check(high) is None or low > high:
