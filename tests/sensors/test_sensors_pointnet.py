@@ -22,6 +22,7 @@ from mjlab_train import run_train  # noqa: E402
 from tensordict import TensorDict  # noqa: E402
 
 from robotwright.sensors.mjlab import seeker  # noqa: E402
+from robotwright.sensors.mjlab.rl import POINTNET_MODEL  # noqa: E402
 from robotwright.sensors.pointnet import PointNetEncoder, PointNetModel  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -73,7 +74,7 @@ def test_the_model_reads_points_and_flat_groups_as_rsl_rl_expects() -> None:
 def test_the_pointnet_seeker_observes_points_with_classes() -> None:
     assert seeker.POINTNET_TASK_ID in list_tasks()
     rl = load_rl_cfg(seeker.POINTNET_TASK_ID)
-    assert rl.actor.class_name == rl.critic.class_name == seeker.POINTNET_MODEL
+    assert rl.actor.class_name == rl.critic.class_name == POINTNET_MODEL
     assert rl.obs_groups == {"actor": ("actor", "points"), "critic": ("critic", "points")}
     mlp = load_rl_cfg(seeker.TASK_ID)
     assert rl.actor.hidden_dims == mlp.actor.hidden_dims and rl.algorithm == mlp.algorithm

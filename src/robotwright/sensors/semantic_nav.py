@@ -73,9 +73,9 @@ MAX_POINTS = 256
 NEAR_VALUABLE, NEAR_OBSTACLE = 0.5, 0.4
 #: Reward weights: per second near a valuable, near an obstacle.
 VALUABLE_WEIGHT, OBSTACLE_WEIGHT = 1.0, -2.0
-#: Policies: an MLP on the range image, PointNet on the points.
+#: Policies: an MLP on the flat observations (a range image), or PointNet on the points.
 POLICIES = ("mlp", "pointnet")
-#: rsl_rl's name of the point-cloud model.
+#: rsl_rl's name of the point-cloud model (resolved by rsl_rl when the runner starts).
 POINTNET_MODEL = "robotwright.sensors.pointnet:PointNetModel"
 
 

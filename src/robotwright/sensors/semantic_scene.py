@@ -46,6 +46,7 @@ __all__ = [
     "SceneState",
     "SemanticSceneCfg",
     "advance",
+    "clutter_share",
     "sample_layout",
 ]
 
@@ -298,6 +299,17 @@ def advance(
 #: How far under its environment's origin an inactive obstacle is parked [m]: where no
 #: ray from above the terrain reaches it.
 PARK_DEPTH = 10.0
+
+
+def clutter_share(terrain: object, env_ids: torch.Tensor) -> torch.Tensor | None:
+    """The clutter curriculum's share for ``env_ids``: (terrain level + 1) / the levels,
+    read from a terrain with a curriculum (mjlab's and Isaac Lab's both keep
+    ``terrain_levels`` and ``max_terrain_level``); ``None`` without one."""
+    levels = getattr(terrain, "terrain_levels", None)
+    if levels is None:
+        return None
+    top = max(int(getattr(terrain, "max_terrain_level", 1)), 1)
+    return (levels[env_ids].float() + 1.0) / top
 
 
 class SceneState:

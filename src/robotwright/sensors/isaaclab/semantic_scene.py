@@ -27,7 +27,12 @@ import torch
 from isaaclab.assets import RigidObjectCfg
 from isaaclab.managers import EventTermCfg, ManagerTermBase
 
-from robotwright.sensors.semantic_scene import SceneAssetCfg, SceneState, SemanticSceneCfg
+from robotwright.sensors.semantic_scene import (
+    SceneAssetCfg,
+    SceneState,
+    SemanticSceneCfg,
+    clutter_share,
+)
 
 __all__ = ["EVENT_NAME", "SemanticSceneEvent", "add_semantic_scene", "object_distances"]
 
@@ -114,12 +119,9 @@ class SemanticSceneEvent(ManagerTermBase):
             self._write(torch.arange(self.num_envs, device=self.device), self.state.dynamic)
 
     def _clutter(self, env_ids: torch.Tensor) -> torch.Tensor | None:
-        terrain = getattr(self._env.scene, "terrain", None)
-        levels = getattr(terrain, "terrain_levels", None)
-        if not self.curriculum or levels is None:
+        if not self.curriculum:
             return None
-        top = max(int(getattr(terrain, "max_terrain_level", 1)), 1)
-        return (levels[env_ids].float() + 1.0) / top
+        return clutter_share(getattr(self._env.scene, "terrain", None), env_ids)
 
     def _write(self, env_ids: torch.Tensor, slots: Any) -> None:
         origins = self._env.scene.env_origins[env_ids]

@@ -40,7 +40,7 @@ from mjlab.managers.observation_manager import ObservationGroupCfg, ObservationT
 from mjlab.managers.reward_manager import RewardTermCfg
 from mjlab.managers.scene_entity_config import SceneEntityCfg
 from mjlab.managers.termination_manager import TerminationTermCfg
-from mjlab.rl import RslRlModelCfg, RslRlOnPolicyRunnerCfg, RslRlPpoAlgorithmCfg
+from mjlab.rl import RslRlOnPolicyRunnerCfg
 from mjlab.scene import SceneCfg
 from mjlab.sensor.builtin_sensor import ObjRef
 from mjlab.sim import MujocoCfg, SimulationCfg
@@ -52,6 +52,7 @@ from robotwright.sensors.mjlab.observations import (
     lidar_one_hot_classes,
     lidar_point_cloud,
 )
+from robotwright.sensors.mjlab.rl import POLICIES, ppo_runner_cfg
 from robotwright.sensors.patterns import SpinningLidarPatternCfg
 
 __all__ = [
@@ -275,58 +276,16 @@ def seeker_runner_cfg(labels: bool = True, policy: str = "mlp") -> RslRlOnPolicy
     """PPO for the seeker (every variant alike): MLP head 128-64, 32 steps per env;
     ``policy="pointnet"``: a PointNet encoder (shared point MLP 64-128, max-pooled) on
     the ``"points"`` group before the head, actor and critic alike."""
-    model: dict[str, Any] = {
-        "hidden_dims": (128, 64),
-        "activation": "elu",
-        "obs_normalization": False,
-    }
-    obs_groups = {"actor": ("actor",), "critic": ("critic",)}
-    if policy == "pointnet":
-        model["class_name"] = POINTNET_MODEL
-        obs_groups = {"actor": ("actor", "points"), "critic": ("critic", "points")}
-    return RslRlOnPolicyRunnerCfg(
-        actor=RslRlModelCfg(
-            **model,
-            distribution_cfg={
-                "class_name": "GaussianDistribution",
-                "init_std": 1.0,
-                "std_type": "scalar",
-            },
-        ),
-        critic=RslRlModelCfg(**model),
-        algorithm=RslRlPpoAlgorithmCfg(
-            value_loss_coef=1.0,
-            use_clipped_value_loss=True,
-            clip_param=0.2,
-            entropy_coef=0.005,
-            num_learning_epochs=5,
-            num_mini_batches=4,
-            learning_rate=1.0e-3,
-            schedule="adaptive",
-            gamma=0.99,
-            lam=0.95,
-            desired_kl=0.01,
-            max_grad_norm=1.0,
-        ),
-        experiment_name=(
-            f"semantic_seeker_{policy}"
-            if policy != "mlp"
-            else "semantic_seeker"
-            if labels
-            else "semantic_seeker_no_labels"
-        ),
-        logger="tensorboard",
-        save_interval=50,
+    name = "semantic_seeker" if labels else "semantic_seeker_no_labels"
+    return ppo_runner_cfg(
+        policy=policy,
+        hidden_dims=(128, 64),
+        obs_normalization=False,
+        entropy_coef=0.005,
+        experiment_name=f"semantic_seeker_{policy}" if policy != "mlp" else name,
         num_steps_per_env=STEPS_PER_ENV,
         max_iterations=150,
-        obs_groups=obs_groups,
     )
-
-
-#: Policies of the seeker: an MLP on the flattened rays, or PointNet on the points.
-POLICIES = ("mlp", "pointnet")
-#: rsl_rl's name of the point-cloud model (resolved by rsl_rl when the runner starts).
-POINTNET_MODEL = "robotwright.sensors.pointnet:PointNetModel"
 
 
 def register() -> None:

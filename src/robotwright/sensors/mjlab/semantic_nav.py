@@ -31,13 +31,14 @@ from mjlab.managers import TerminationTermCfg
 from mjlab.managers.metrics_manager import MetricsTermCfg
 from mjlab.managers.observation_manager import ObservationGroupCfg, ObservationTermCfg
 from mjlab.managers.reward_manager import RewardTermCfg
-from mjlab.rl import RslRlModelCfg, RslRlOnPolicyRunnerCfg, RslRlPpoAlgorithmCfg
+from mjlab.rl import RslRlOnPolicyRunnerCfg
 from mjlab.sensor import ContactMatch, ContactSensorCfg, ObjRef, RingPatternCfg
 from mjlab.tasks.velocity import mdp
 from mjlab.tasks.velocity.velocity_env_cfg import make_velocity_env_cfg
 
 from robotwright.sensors.mjlab.config import SemanticLidarSensorCfg
 from robotwright.sensors.mjlab.observations import lidar_point_cloud, lidar_range_image
+from robotwright.sensors.mjlab.rl import ppo_runner_cfg
 from robotwright.sensors.mjlab.semantic_scene import add_semantic_scene, object_distances
 from robotwright.sensors.semantic_nav import (
     FEET,
@@ -50,7 +51,6 @@ from robotwright.sensors.semantic_nav import (
     NEAR_OBSTACLE,
     NEAR_VALUABLE,
     OBSTACLE_WEIGHT,
-    POINTNET_MODEL,
     VALUABLE_WEIGHT,
     check_policy,
     go2_robot,
@@ -260,49 +260,17 @@ def _add_scan_observations(cfg: ManagerBasedRlEnvCfg, policy: str) -> None:
 
 
 def semantic_nav_runner_cfg(policy: str = "mlp") -> RslRlOnPolicyRunnerCfg:
-    """PPO as mjlab's Go1 velocity task has it (MLP 512-256-128, 24 steps per env);
-    ``policy="pointnet"`` puts the PointNet encoder on the ``"points"`` group before the
-    head, actor and critic alike."""
-    check_policy(policy)
-    model: dict[str, Any] = {
-        "hidden_dims": (512, 256, 128),
-        "activation": "elu",
-        "obs_normalization": True,
-    }
-    obs_groups = {"actor": ("actor",), "critic": ("critic",)}
-    if policy == "pointnet":
-        model["class_name"] = POINTNET_MODEL
-        obs_groups = {"actor": ("actor", "points"), "critic": ("critic", "points")}
-    return RslRlOnPolicyRunnerCfg(
-        actor=RslRlModelCfg(
-            **model,
-            distribution_cfg={
-                "class_name": "GaussianDistribution",
-                "init_std": 1.0,
-                "std_type": "scalar",
-            },
-        ),
-        critic=RslRlModelCfg(**model),
-        algorithm=RslRlPpoAlgorithmCfg(
-            value_loss_coef=1.0,
-            use_clipped_value_loss=True,
-            clip_param=0.2,
-            entropy_coef=0.01,
-            num_learning_epochs=5,
-            num_mini_batches=4,
-            learning_rate=1.0e-3,
-            schedule="adaptive",
-            gamma=0.99,
-            lam=0.95,
-            desired_kl=0.01,
-            max_grad_norm=1.0,
-        ),
+    """PPO as mjlab's Go1 velocity task has it (MLP 512-256-128 with observation
+    normalisation, 24 steps per env); ``policy="pointnet"`` puts the PointNet encoder on
+    the ``"points"`` group before the head, actor and critic alike."""
+    return ppo_runner_cfg(
+        policy=policy,
+        hidden_dims=(512, 256, 128),
+        obs_normalization=True,
+        entropy_coef=0.01,
         experiment_name="go2_semantic_nav" + ("_pointnet" if policy == "pointnet" else ""),
-        logger="tensorboard",
-        save_interval=50,
         num_steps_per_env=24,
         max_iterations=10_000,
-        obs_groups=obs_groups,
     )
 
 

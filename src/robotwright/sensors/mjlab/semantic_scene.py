@@ -33,6 +33,7 @@ from robotwright.sensors.semantic_scene import (
     SceneAssetCfg,
     SceneState,
     SemanticSceneCfg,
+    clutter_share,
 )
 
 __all__ = [
@@ -111,12 +112,9 @@ class SemanticSceneEvent:
 
     def _clutter(self, env_ids: torch.Tensor) -> torch.Tensor | None:
         """The curriculum's share of obstacles for ``env_ids`` (see the module)."""
-        terrain = getattr(self.env.scene, "terrain", None)
-        levels = getattr(terrain, "terrain_levels", None)
-        if not self.curriculum or levels is None:
+        if not self.curriculum:
             return None
-        top = max(int(getattr(terrain, "max_terrain_level", 1)), 1)
-        return (levels[env_ids].float() + 1.0) / top
+        return clutter_share(getattr(self.env.scene, "terrain", None), env_ids)
 
     def _write(self, env_ids: torch.Tensor, slots: Any) -> None:
         origins = self.env.scene.env_origins[env_ids]
