@@ -1,7 +1,7 @@
 """Headless Chromium driven over the DevTools protocol: load a page, take screenshots.
 
 One browser serves several screenshots (its start-up costs seconds). Chromium is
-Debian's ``chromium`` package (``tools/fetch_test_data.py`` installs it where it can);
+Debian's ``chromium`` package (``.ci/run`` installs it for CI; the test set-up does not);
 :func:`find_chromium` returns ``None`` when there is none, and the tests skip.
 """
 

@@ -33,8 +33,8 @@ def chromium() -> str:
     path = find_chromium()
     if path is None:
         pytest.skip(
-            "no Chromium: tools/fetch_test_data.py installs Debian's 'chromium' with apt-get "
-            "(as root); or set $CHROMIUM to a Chromium executable"
+            "no Chromium: install Debian's 'chromium' package (apt-get install chromium; "
+            ".ci/run does for CI) or set $CHROMIUM to a Chromium executable"
         )
     return path
 
