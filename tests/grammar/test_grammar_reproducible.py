@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from pathlib import Path
 
@@ -88,27 +89,59 @@ def _alive(pid: int) -> bool:
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's parent-death signal")
 def test_pool_workers_die_with_a_search_killed_by_sigkill(tmp_path: Path) -> None:
+    """Each pool worker says it is ready once its parent-death signal is set (the pool's
+    initializer, wrapped); the test waits on those lines, not on a clock, so a busy
+    machine only makes it slower. Then the search is killed and its workers must die."""
+    (tmp_path / "pool_probe.py").write_text(
+        textwrap.dedent(
+            """
+            import os
+            from robotwright._temporaries import die_with_parent
+
+            def ready(parent):
+                die_with_parent(parent)
+                print(f"worker {os.getpid()} ready", flush=True)
+            """
+        )
+    )
     script = textwrap.dedent(
         """
+        import pool_probe
+        import robotwright.grammar.search as search
         from robotwright.grammar.loader import default_grammar
         from robotwright.grammar.objectives import WorkspaceVolume
-        from robotwright.grammar.search import random_search
 
-        random_search(default_grammar(), [WorkspaceVolume(samples=4096)], budget=100_000,
-                      max_links=4, seed=0, workers=2, force_workers=True)
+        search.die_with_parent = pool_probe.ready
+        search.random_search(default_grammar(), [WorkspaceVolume(samples=4096)],
+                             budget=100_000, max_links=4, seed=0, workers=2,
+                             force_workers=True)
         """
     )
-    search = subprocess.Popen([sys.executable, "-c", script], cwd=tmp_path)
+    path = os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")]))
+    search = subprocess.Popen(
+        [sys.executable, "-c", script],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": path},
+    )
+    # Only a hung search (no line, no exit) is cut short, after 15 minutes.
+    watchdog = threading.Timer(900, search.kill)
+    watchdog.start()
+    workers: list[int] = []
     try:
-        deadline = time.monotonic() + 120
-        workers: list[int] = []
-        while len(workers) < 2 and time.monotonic() < deadline:
-            time.sleep(0.2)
-            workers = _children(search.pid)
-        assert len(workers) >= 2, "the search started no pool"
+        for line in search.stdout:
+            if line.startswith("worker ") and line.strip().endswith(" ready"):
+                workers.append(int(line.split()[1]))
+                if len(workers) == 2:
+                    break
+        assert len(workers) == 2, f"the search ended before its pool started: {search.poll()}"
+        assert set(workers) <= set(_children(search.pid))
     finally:
+        watchdog.cancel()
         os.kill(search.pid, signal.SIGKILL)
         search.wait()
+        search.stdout.close()
     deadline = time.monotonic() + 60
     while any(_alive(w) for w in workers) and time.monotonic() < deadline:
         time.sleep(0.2)
