@@ -95,6 +95,13 @@ def test_same_name_twice_in_one_source_is_named_by_folder(tmp_path, monkeypatch,
     assert "robot b_description" in capsys.readouterr().out
 
 
+def test_an_unknown_source_is_refused_with_the_sources_there(capsys):
+    assert main(["robots", "--source", "bundeld"]) == 2
+    err = capsys.readouterr().err
+    assert "--source 'bundeld': no robot comes from it" in err
+    assert "bundled" in err.split("sources here:")[1] and "did you mean 'bundled'?" in err
+
+
 def test_unknown_name_suggests_close_ones(capsys):
     assert main(["info", "arm66"]) == 2
     err = capsys.readouterr().err

@@ -87,6 +87,7 @@ def test_output_that_is_a_folder_or_under_a_file_is_a_clear_error(tmp_path, caps
     ("argv", "expected"),
     [
         (["export", "arm6", "-o", "OUT/a.txt"], "expected a file name ending in .xml or .mjcf"),
+        (["export", "arm6", "-o", "OUT/a.txt"], ".usd, .usda, .usdc (OpenUSD)"),
         (["export", "arm6", "--format", "urdf", "-o", "OUT/a.sdf"], "ending in .urdf or .xml"),
         (["compose", "arm6", "-o", "OUT/scene"], "cannot tell the format from '(no extension)'"),
         (["compose", "arm6", "--format", "mjcf", "-o", "OUT/scene"], "got '(none)'"),

@@ -38,6 +38,7 @@ def test_cli_existing_output_needs_overwrite(tmp_path: Path, capsys) -> None:
     [
         (["no_such_robot"], "no robot named 'no_such_robot'"),
         (["arm6", "--camera", "sideways"], "camera 'sideways': not a camera of the model"),
+        (["arm6", "--camera", "isso"], "did you mean 'iso'?"),
         (["arm6", "--size", "4x4"], "picture width 4: expected an integer in 16..4096"),
         (["arm6", "--size", "big"], "argument --size: 'big': expected WIDTHxHEIGHT"),
         (["arm6", "--backend", "vulkan"], "invalid choice: 'vulkan'"),

@@ -55,7 +55,10 @@ def test_cli_bad_sensor_writes_nothing(tmp_path, capsys):
     scene.write_text(CLUTTER_XML, encoding="utf-8")
     rc = main(["lidar", str(scene), "--sensor", "lidr", "-o", str(tmp_path / "scan.npz")])
     assert rc == 2
-    assert "no body or site named 'lidr'" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    # In the command's own terms (the option, not the Python field), with the close name.
+    assert "--sensor 'lidr': no body or site" in err and "prim_path" not in err
+    assert "did you mean 'lidar'" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.xml"]
 
 

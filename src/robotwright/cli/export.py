@@ -74,7 +74,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "export",
         help="write a robot as MJCF, URDF or USD",
-        description="Write a robot (bundled name or HRDF folder) as MJCF, URDF or OpenUSD. "
+        description="Write a robot (a name, HRDF folder, URDF, xacro, MJCF or USD file) as "
+        "MJCF, URDF or OpenUSD. "
         "Mesh paths are written relative to the output file, so it loads as is. USD (for "
         "Isaac Lab and Newton) goes through mujoco-usd-converter with joint drives and "
         "velocity limits added, and is read back by Newton and compared with the robot "
@@ -204,7 +205,8 @@ def output_format(output: str, fmt: str | None) -> str:
             return "usd"
         raise GeneratorError(
             f"{output}: cannot tell the format from '{suffix or '(no extension)'}': "
-            "expected a file name ending in .xml or .mjcf (MJCF) or .urdf (URDF), or --format"
+            "expected a file name ending in .xml or .mjcf (MJCF), .urdf (URDF) or "
+            f"{', '.join(USD_SUFFIXES)} (OpenUSD), or --format"
         )
     if suffix not in _EXTENSIONS[fmt]:
         raise GeneratorError(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from robotwright._atomic import check_output_path
 from robotwright._outputs import check_overwrite
@@ -102,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
         from robotwright.scene.load import load_source
 
         model = load_source(str(args.scene)).model
+    _check_sensor_name(model, args.sensor, args.scene)
     data = mujoco.MjData(model)
     if model.nkey:
         mujoco.mj_resetDataKeyframe(model, data, 0)
@@ -126,3 +128,21 @@ def run(args: argparse.Namespace) -> int:
         if summary[key]:
             print(f"wrote {summary[key]}")
     return 0
+
+
+def _check_sensor_name(model: Any, name: str, scene: object) -> None:
+    """``--sensor`` names a body or a site of the model (said in the command's terms,
+    with the close names)."""
+    import mujoco
+
+    from robotwright._suggest import did_you_mean
+
+    for kind in (mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_SITE):
+        if mujoco.mj_name2id(model, kind, name) >= 0:
+            return
+    names = [model.body(i).name for i in range(model.nbody)]
+    names += [model.site(i).name for i in range(model.nsite)]
+    raise SensorError(
+        f"--sensor {name!r}: no body or site of that name in {scene}"
+        f"{did_you_mean(name, [n for n in names if n])}"
+    )

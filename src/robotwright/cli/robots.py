@@ -23,9 +23,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     import json
 
+    from robotwright._suggest import did_you_mean
     from robotwright.catalog import list_robots, not_downloaded
+    from robotwright.errors import RobotwrightError
 
-    robots = [r for r in list_robots() if args.source in (None, r.source)]
+    every = list_robots()
+    sources = sorted({r.source for r in every})
+    if args.source is not None and args.source not in sources:
+        raise RobotwrightError(
+            f"--source {args.source!r}: no robot comes from it; the sources here: "
+            f"{', '.join(sources) or 'none'}{did_you_mean(args.source, sources)}"
+        )
+    robots = [r for r in every if args.source in (None, r.source)]
     if args.json:
         rows = [
             {

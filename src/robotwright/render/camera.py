@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from robotwright._suggest import did_you_mean
 from robotwright.errors import RobotwrightError
 
 __all__ = ["VIEWS", "CameraError", "CameraSpec", "make_camera", "parse_camera"]
@@ -165,9 +166,10 @@ def make_camera(
                 mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam)
             ]
             listed = ", ".join(n or f"#{i}" for i, n in enumerate(names)) or "none"
+            hint = did_you_mean(spec.name, [*VIEWS, *(n for n in names if n)])
             raise CameraError(
                 f"camera '{spec.name}': not a camera of the model (its cameras: {listed}) "
-                f"nor a view ({', '.join(VIEWS)}) nor AZIMUTH,ELEVATION[,DISTANCE]"
+                f"nor a view ({', '.join(VIEWS)}) nor AZIMUTH,ELEVATION[,DISTANCE]{hint}"
             )
         cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
         cam.fixedcamid = cid
