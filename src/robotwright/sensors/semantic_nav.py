@@ -7,9 +7,10 @@ locomotion task on the Go2 of example-robot-data plus
 
 * the clutter of :class:`~robotwright.sensors.semantic_scene.SemanticSceneCfg` (three
   moving YCB obstacles and three pieces of furniture per environment);
-* the semantic LiDAR on the Go2's own LiDAR body (``radar``, at the front of the head):
-  :data:`LIDAR_CHANNELS` x :data:`LIDAR_COLUMNS` rays from :data:`LIDAR_ELEVATION`,
-  range :data:`LIDAR_RANGE`;
+* the semantic LiDAR where the Go2 carries its own (the ``radar`` body, at the front of
+  the head), its axes the base's (:func:`lidar_mount`: the ``radar`` frame itself is
+  pitched 165 degrees, upside down): :data:`LIDAR_CHANNELS` x :data:`LIDAR_COLUMNS` rays
+  from :data:`LIDAR_ELEVATION` above the base's horizontal, range :data:`LIDAR_RANGE`;
 * rewards for standing near a valuable and penalties for coming near a dynamic obstacle
   (the seeker's idea on legs): :data:`NEAR_VALUABLE`, :data:`NEAR_OBSTACLE`;
 * the policy reads the scan either as a range image with class channels through an MLP
@@ -27,6 +28,8 @@ import functools
 import math
 from typing import TYPE_CHECKING
 
+import mujoco
+
 from robotwright.sensors.patterns import SpinningLidarPatternCfg
 
 if TYPE_CHECKING:
@@ -37,6 +40,7 @@ __all__ = [
     "GO2_OPTIONS",
     "POLICIES",
     "go2_robot",
+    "lidar_mount",
     "lidar_pattern",
 ]
 
@@ -87,6 +91,17 @@ def lidar_pattern() -> SpinningLidarPatternCfg:
         vertical_angles=tuple(low + i * step for i in range(LIDAR_CHANNELS)),
         horizontal_resolution=2.0 * math.pi / LIDAR_COLUMNS,
     )
+
+
+def lidar_mount(model: mujoco.MjModel) -> tuple[float, float, float]:
+    """Position [m] of the LiDAR body (:data:`LIDAR_BODY`) in the ``base`` body's frame,
+    from the compiled robot at its reference pose: the sensor sits there with the
+    base's axes."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    base, radar = model.body("base").id, model.body(LIDAR_BODY).id
+    offset = data.xmat[base].reshape(3, 3).T @ (data.xpos[radar] - data.xpos[base])
+    return (float(offset[0]), float(offset[1]), float(offset[2]))
 
 
 def check_policy(policy: str) -> None:

@@ -11,8 +11,9 @@ generator and curriculum, twist commands, rewards, height scanner, contact senso
   needed; the terrain's Nucleus material and the sky texture are left out;
 * the clutter (:func:`~robotwright.sensors.isaaclab.semantic_scene.add_semantic_scene`,
   the obstacles' count following the terrain level);
-* the semantic LiDAR on ``{ENV_REGEX_NS}/Robot/base`` at the pose of the Go2's LiDAR body
-  (``radar``), seeing the terrain and the objects (the robot itself is see-through);
+* the semantic LiDAR on ``{ENV_REGEX_NS}/Robot/base`` at the position of the Go2's LiDAR
+  body (``radar``) with the base's axes, seeing the terrain and the objects (the robot
+  itself is see-through);
 * the valuable/obstacle rewards, and the scan in the policy's view (range image with
   class channels for the MLP, or a ``points`` group for PointNet).
 
@@ -56,7 +57,6 @@ from robotwright.sensors.semantic_nav import (
     GO2_JOINT_POS,
     IMAGE_HEIGHT,
     IMAGE_WIDTH,
-    LIDAR_BODY,
     LIDAR_RANGE,
     MAX_POINTS,
     NEAR_OBSTACLE,
@@ -65,6 +65,7 @@ from robotwright.sensors.semantic_nav import (
     POINTNET_MODEL,
     VALUABLE_WEIGHT,
     go2_robot,
+    lidar_mount,
     lidar_pattern,
 )
 from robotwright.sensors.semantic_scene import SemanticSceneCfg
@@ -82,12 +83,10 @@ POINTNET_TASK_ID = "Robotwright-Isaac-SemanticNav-Go2-PointNet-v0"
 
 
 @functools.cache
-def _go2_usd() -> tuple[str, tuple[float, ...], dict[str, float], tuple, tuple]:
+def _go2_usd() -> tuple[str, tuple[float, ...], dict[str, float], tuple[float, float, float]]:
     """The Go2's USD (flat layout, root at its prim's origin) in a private temporary
     folder removed at exit; its standing base position [m], joint positions [rad], and
-    the LiDAR body's pose in the base frame (position [m], quaternion x, y, z, w)."""
-    import mujoco
-
+    the LiDAR's position in the base frame [m] (:func:`lidar_mount`)."""
     from robotwright._temporaries import prefix
     from robotwright.generators.isaaclab_cfg import initial_state
     from robotwright.generators.usd import to_usd
@@ -95,21 +94,8 @@ def _go2_usd() -> tuple[str, tuple[float, ...], dict[str, float], tuple, tuple]:
     folder = Path(tempfile.mkdtemp(prefix=prefix("semantic-nav")))
     atexit.register(shutil.rmtree, folder, ignore_errors=True)
     done = to_usd(go2_robot(), folder / "go2.usd", layout="flat", root_at_origin=True)
-    model = done.mjcf_model
-    pos, joint_pos, _ = initial_state(model, GO2_JOINT_POS)
-    data = mujoco.MjData(model)
-    mujoco.mj_kinematics(model, data)
-    base, radar = model.body("base").id, model.body(LIDAR_BODY).id
-    rot = data.xmat[base].reshape(3, 3)
-    offset = rot.T @ (data.xpos[radar] - data.xpos[base])
-    quat = np.zeros(4)
-    mujoco.mju_mulQuat(quat, _conjugate(data.xquat[base]), data.xquat[radar])
-    xyzw = (float(quat[1]), float(quat[2]), float(quat[3]), float(quat[0]))
-    return str(done.path), tuple(pos), dict(joint_pos), tuple(map(float, offset)), xyzw
-
-
-def _conjugate(q: np.ndarray) -> np.ndarray:
-    return np.array([q[0], -q[1], -q[2], -q[3]])
+    pos, joint_pos, _ = initial_state(done.mjcf_model, GO2_JOINT_POS)
+    return str(done.path), tuple(pos), dict(joint_pos), lidar_mount(done.mjcf_model)
 
 
 def go2_articulation_cfg() -> ArticulationCfg:
@@ -118,7 +104,7 @@ def go2_articulation_cfg() -> ArticulationCfg:
     contact reports on and self-collisions off, as Isaac Lab's own Go2 has them."""
     from robotwright.generators.isaaclab_cfg import actuator_groups
 
-    usd, pos, joint_pos, _, _ = _go2_usd()
+    usd, pos, joint_pos, _ = _go2_usd()
     actuators = {}
     for k, (values, joints) in enumerate(actuator_groups(go2_robot())):
         actuators[f"group_{k}"] = ImplicitActuatorCfg(
@@ -184,10 +170,10 @@ class SemanticNavGo2EnvCfg(UnitreeGo2RoughEnvCfg):
         self.scene.robot = go2_articulation_cfg()
         self.scene.terrain.visual_material = None  # a Nucleus material
         self.scene.sky_light = None  # a Nucleus texture
-        _, _, _, offset, rot = _go2_usd()
+        offset = _go2_usd()[3]
         self.scene.lidar = SemanticLidarCfg(
             prim_path="{ENV_REGEX_NS}/Robot/base",
-            offset=SemanticLidarCfg.OffsetCfg(pos=offset, rot=rot),
+            offset=SemanticLidarCfg.OffsetCfg(pos=offset),  # the base's axes
             pattern_cfg=lidar_pattern(),
             max_distance=LIDAR_RANGE,
             mesh_prim_paths=["/World/ground", *OBJECT_PRIM_PATHS],

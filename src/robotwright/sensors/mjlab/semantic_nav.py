@@ -7,7 +7,8 @@ twist commands, the locomotion rewards) on the Go2 of example-robot-data, instru
 the way mjlab's Go1 is: an IMU site with gyro, velocimeter and angular-momentum sensors
 on the base, a site and a named collision geom per foot. Added: the clutter
 (:func:`~robotwright.sensors.mjlab.semantic_scene.add_semantic_scene`, the obstacles'
-count following the terrain level), the semantic LiDAR on the ``radar`` body, the
+count following the terrain level), the semantic LiDAR where the Go2's LiDAR (``radar``)
+is, with the base's axes, the
 valuable/obstacle rewards and their metrics, and the policy's view of the scan.
 
 The Go2 is read when a task config is first copied (mjlab's ``train``/``play`` do that
@@ -45,7 +46,6 @@ from robotwright.sensors.semantic_nav import (
     GO2_JOINT_POS,
     IMAGE_HEIGHT,
     IMAGE_WIDTH,
-    LIDAR_BODY,
     LIDAR_RANGE,
     MAX_POINTS,
     NEAR_OBSTACLE,
@@ -54,6 +54,7 @@ from robotwright.sensors.semantic_nav import (
     VALUABLE_WEIGHT,
     check_policy,
     go2_robot,
+    lidar_mount,
     lidar_pattern,
 )
 from robotwright.sensors.semantic_scene import SemanticSceneCfg
@@ -75,16 +76,18 @@ _LEGS = ("FL", "FR", "RL", "RR")
 
 
 @functools.cache
-def _go2_mjcf() -> tuple[str, tuple[float, float, float], dict[str, float]]:
+def _go2_mjcf() -> tuple[
+    str, tuple[float, float, float], dict[str, float], tuple[float, float, float]
+]:
     """The Go2's MJCF text (meshes by absolute path, no floor), its standing base
-    position [m] and joint positions [rad]."""
+    position [m], joint positions [rad] and the LiDAR's position on the base [m]."""
     from robotwright.generators.isaaclab_cfg import initial_state
     from robotwright.generators.mjcf import MJCFHumanoidGenerator
 
     text = MJCFHumanoidGenerator.from_hrdf(go2_robot()).export(None, add_scene=False)
     model = mujoco.MjSpec.from_string(text).compile()
     pos, joint_pos, _ = initial_state(model, GO2_JOINT_POS)
-    return text, tuple(pos), dict(joint_pos)
+    return text, tuple(pos), dict(joint_pos), lidar_mount(model)
 
 
 def _go2_spec() -> mujoco.MjSpec:
@@ -122,7 +125,7 @@ def _go2_spec() -> mujoco.MjSpec:
 
 def go2_entity_cfg() -> EntityCfg:
     """The Go2 entity: its MJCF's position actuators (kp 50, kv 1), standing pose."""
-    _, pos, joint_pos = _go2_mjcf()
+    _, pos, joint_pos, _ = _go2_mjcf()
     return EntityCfg(
         spec_fn=_go2_spec,
         init_state=EntityCfg.InitialStateCfg(pos=pos, joint_pos=joint_pos, joint_vel={".*": 0.0}),
@@ -182,7 +185,8 @@ def semantic_nav_env_cfg(
     )
     lidar = SemanticLidarSensorCfg(
         name="lidar",
-        frame=ObjRef(type="body", name=LIDAR_BODY, entity="robot"),
+        frame=ObjRef(type="body", name="base", entity="robot"),
+        offset_pos=_go2_mjcf()[3],  # where the Go2's LiDAR is, the base's axes
         pattern=lidar_pattern(),
         max_distance=LIDAR_RANGE,
     )
