@@ -224,3 +224,16 @@ def test_a_bad_scene_config_is_refused_when_the_task_is_built() -> None:
     scene = SemanticSceneCfg(num_obstacles=-2)
     with pytest.raises(SensorError, match="num_obstacles"):
         semantic_nav.semantic_nav_env_cfg(scene=scene)
+
+
+def test_the_lidar_sits_where_the_go2_carries_its_own_with_the_base_s_axes(nav_env) -> None:
+    env = nav_env
+    _step(env, 2)
+    lidar, robot = env.scene["lidar"], env.scene["robot"]
+    radar = robot.body_names.index("radar")
+    torch.testing.assert_close(
+        lidar.data.sensor_pos_w, robot.data.body_link_pos_w[:, radar], atol=1e-5, rtol=0
+    )
+    base_quat = robot.data.root_link_quat_w
+    dot = (lidar.data.sensor_quat_w * base_quat).sum(-1).abs()
+    torch.testing.assert_close(dot, torch.ones_like(dot), atol=1e-5, rtol=0)
