@@ -20,8 +20,6 @@ from robotwright.sensors.semantic_scene import SceneAssetCfg
 
 __all__ = ["draw_nav_scene"]
 
-_SHAPES = {"box": mujoco.mjtGeom.mjGEOM_BOX, "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER}
-
 
 def draw_nav_scene(
     robot_xml: str,
@@ -51,8 +49,7 @@ def draw_nav_scene(
     )
     for i, (asset, pose) in enumerate(objects):
         body = spec.worldbody.add_body(name=f"object_{i}", pos=pose[:3], quat=pose[3:7])
-        dims = tuple(asset.size) + (0.0,) * (3 - len(asset.size))
-        body.add_geom(name=asset.name, type=_SHAPES[asset.shape], size=dims, rgba=asset.rgba)
+        asset.add_geom(body)
     model = spec.compile()
     data = mujoco.MjData(model)
     free = next(j for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE)

@@ -39,6 +39,7 @@ __all__ = [
     "GO2_JOINT_POS",
     "GO2_OPTIONS",
     "POLICIES",
+    "go2_mjcf",
     "go2_robot",
     "lidar_mount",
     "lidar_pattern",
@@ -128,3 +129,11 @@ def go2_robot() -> HRDF:
         # note is shown.
         warnings.filterwarnings("ignore", r".*\(cosmetic\)", ConversionWarning)
         return load_robot(GO2_SOURCE, **GO2_OPTIONS)
+
+
+@functools.cache
+def go2_mjcf() -> str:
+    """The MJCF text of :func:`go2_robot` (meshes by absolute path, no floor)."""
+    from robotwright.generators.mjcf import MJCFHumanoidGenerator
+
+    return MJCFHumanoidGenerator.from_hrdf(go2_robot()).export(None, add_scene=False)

@@ -14,7 +14,7 @@ mapping; the adapters' tests compare that with what the sensor reads).
 At every reset of an environment its objects are drawn anew (:func:`sample_layout`):
 uniformly with their footprints in the square arena of half side ``arena_half`` around the environment origin,
 outside the keep-out disc of radius ``keep_out`` around the robot's spawn, every two
-centres ``min_separation`` apart (a bounded number of tries), a uniform yaw. The dynamic
+footprints ``min_separation`` apart (a bounded number of tries), a uniform yaw. The dynamic
 obstacles move on straight kinematic paths at a speed drawn from ``obstacle_speed``,
 bouncing off the arena's sides (:func:`advance`); valuables stay put. Objects are
 kinematic: they push a robot, nothing pushes them.
@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
+import mujoco
 import torch
 
 from robotwright._bounds import Bound
@@ -62,6 +63,8 @@ GAP_BOUND = Bound(0.0, 100.0, unit="m")
 SPEED_BOUND = Bound(0.0, 10.0, unit="m/s")
 #: Candidate positions per object and environment.
 LAYOUT_TRIES = 64
+#: MuJoCo geom type of each asset shape.
+_GEOM_TYPES = {"box": mujoco.mjtGeom.mjGEOM_BOX, "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER}
 
 
 @dataclass
@@ -93,6 +96,14 @@ class SceneAssetCfg:
         if self.shape == "box":
             return math.hypot(self.size[0], self.size[1])
         return float(self.size[0])
+
+    def add_geom(self, body: mujoco.MjsBody) -> mujoco.MjsGeom:
+        """Add the asset to a MuJoCo spec ``body`` as one geom named after it, its centre
+        at the body's origin (the mjlab scene and the task's picture build it so)."""
+        size = tuple(self.size) + (0.0,) * (3 - len(self.size))
+        return body.add_geom(
+            name=self.name, type=_GEOM_TYPES[self.shape], size=size, rgba=self.rgba
+        )
 
     def check(self, where: str) -> None:
         """Raise :class:`SensorError` naming ``where`` and the field on a bad value."""
@@ -264,14 +275,14 @@ def sample_layout(cfg: SemanticSceneCfg, n: int, device: torch.device | str) -> 
     s = len(slots)
     xy = torch.zeros(n, s, 2, device=device)
     rows = torch.arange(n, device=device)
-    for k, slot in enumerate(slots):
-        r = slot.asset.footprint_radius
+    radii = [sl.asset.footprint_radius for sl in slots]
+    placed = torch.tensor(radii, device=device)
+    for k, r in enumerate(radii):
         half = max(cfg.arena_half - r, 0.0)  # the whole footprint inside the arena
         cand = (torch.rand(n, LAYOUT_TRIES, 2, device=device) * 2.0 - 1.0) * half
         worst = cand.norm(dim=-1) - r - cfg.keep_out  # (n, T)
         if k:
-            placed = torch.tensor([sl.asset.footprint_radius for sl in slots[:k]], device=device)
-            gaps = torch.cdist(cand, xy[:, :k]) - r - placed - cfg.min_separation
+            gaps = torch.cdist(cand, xy[:, :k]) - r - placed[:k] - cfg.min_separation
             worst = torch.minimum(worst, gaps.amin(dim=-1))
         ok = worst >= 0
         pick = torch.where(ok.any(1), ok.float().argmax(1), worst.argmax(1))

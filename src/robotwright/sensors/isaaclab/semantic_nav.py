@@ -33,7 +33,6 @@ from typing import Any
 
 import gymnasium as gym
 import isaaclab.sim as sim_utils
-import numpy as np
 import torch
 from isaaclab.actuators import ImplicitActuatorCfg
 from isaaclab.assets import ArticulationCfg
@@ -246,58 +245,3 @@ def _register() -> None:
 
 
 _register()
-
-
-def picture_state(steps: int, seed: int) -> dict[str, Any]:
-    """One environment on nearly flat ground (height noise of at most 5 mm) run for
-    ``steps`` policy steps with zero actions (the standing pose), and what
-    :func:`robotwright.render.nav_scene.draw_nav_scene` draws of it: the robot's MJCF
-    and pose, the objects' poses, the last scan (tools/picture_semantic_nav.py)."""
-    import isaaclab.terrains as terrain_gen
-    from isaaclab_tasks.utils.hydra import resolve_presets
-
-    from robotwright.generators.mjcf import MJCFHumanoidGenerator
-
-    cfg = resolve_presets(SemanticNavGo2EnvCfg())
-    cfg.scene.num_envs = 1
-    cfg.sim.device = "cpu"
-    cfg.seed = seed
-    generator = cfg.scene.terrain.terrain_generator
-    generator.num_rows = generator.num_cols = 1
-    generator.curriculum = False
-    generator.sub_terrains = {
-        "flat": terrain_gen.HfRandomUniformTerrainCfg(
-            proportion=1.0, noise_range=(0.0, 0.005), noise_step=0.005
-        )
-    }
-    cfg.curriculum.terrain_levels = None
-    env = gym.make(TASK_ID, cfg=cfg).unwrapped
-    try:
-        env.reset()
-        action = torch.zeros(1, env.action_manager.total_action_dim)
-        for _ in range(steps):
-            env.step(action)
-        robot, lidar = env.scene["robot"], env.scene["lidar"]
-        term = env.event_manager.get_term_cfg("semantic_scene").func
-
-        def pose(asset: Any) -> list[float]:  # Isaac Lab: x y z qx qy qz qw
-            p = asset.data.root_pose_w.torch[0].tolist()
-            return [*p[:3], p[6], *p[3:6]]
-
-        hit = lidar.data.hit_mask.torch[0].numpy()
-        points = np.where(hit[:, None], lidar.data.ray_hits_w.torch[0].numpy(), np.nan)
-        return {
-            "xml": MJCFHumanoidGenerator.from_hrdf(go2_robot()).export(None, add_scene=False),
-            "root": pose(robot),
-            "joints": dict(
-                zip(robot.joint_names, robot.data.joint_pos.torch[0].tolist(), strict=True)
-            ),
-            "objects": [(s.asset, pose(env.scene[s.name])) for s in term.state.slots],
-            "points": points,
-            "labels": lidar.data.semantic_labels.torch[0].numpy(),
-            "class_names": lidar.class_names,
-            "mapping": lidar.semantic_class_mapping,
-            "framework": "Isaac Lab 3 (Newton, CPU)",
-        }
-    finally:
-        env.close()

@@ -270,25 +270,26 @@ class LidarSensor(NewtonRaycastSensor):
         self._shape_class = wp.array(
             self.shapes.classes.astype(np.int32), dtype=wp.int32, device=dev
         )
-        self._hit_shape = wp.empty(count, dtype=wp.int32, device=dev)
         self._total = wp.empty(count, dtype=wp.float32, device=dev)
         self._final_shape = wp.empty(count, dtype=wp.int32, device=dev)
         self._final_normal = wp.empty(count, dtype=wp.vec3f, device=dev)
-        self._pending = [wp.empty(count, dtype=wp.int32, device=dev) for _ in range(2)]
-        self._pending_count = [wp.zeros(1, dtype=wp.int32, device=dev) for _ in range(2)]
         # Hits lost when max_pass_through runs out, summed on the device since the
         # start; read on the host only every LOST_CHECK_EVERY casts (one warning).
         self._lost = wp.zeros(1, dtype=wp.int32, device=dev)
         self._casts = 0
         self._lost_warned = False
-        self._sub = {
-            "starts": wp.empty(count, dtype=wp.vec3f, device=dev),
-            "dirs": wp.empty(count, dtype=wp.vec3f, device=dev),
-            "worlds": wp.empty(count, dtype=wp.int32, device=dev),
-            "dist": wp.empty(count, dtype=wp.float32, device=dev),
-            "shape": wp.empty(count, dtype=wp.int32, device=dev),
-            "normal": wp.empty(count, dtype=wp.vec3f, device=dev),
-        }
+        if self._skip_cast is None:  # the re-casts' queues and sub-casts, ~50 B a ray
+            self._hit_shape = wp.empty(count, dtype=wp.int32, device=dev)
+            self._pending = [wp.empty(count, dtype=wp.int32, device=dev) for _ in range(2)]
+            self._pending_count = [wp.zeros(1, dtype=wp.int32, device=dev) for _ in range(2)]
+            self._sub = {
+                "starts": wp.empty(count, dtype=wp.vec3f, device=dev),
+                "dirs": wp.empty(count, dtype=wp.vec3f, device=dev),
+                "worlds": wp.empty(count, dtype=wp.int32, device=dev),
+                "dist": wp.empty(count, dtype=wp.float32, device=dev),
+                "shape": wp.empty(count, dtype=wp.int32, device=dev),
+                "normal": wp.empty(count, dtype=wp.vec3f, device=dev),
+            }
         self._warn_scene()
 
     def _classify(self, path: str) -> int:
@@ -490,9 +491,10 @@ class LidarSensor(NewtonRaycastSensor):
             queue, nxt = nxt, queue
         if passes == 0:  # every ray queued by the first pass is a lost hit
             wp.launch(k.add_count, dim=1, inputs=[self._pending_count[0], self._lost], device=dev)
+        self._check_lost()  # only re-casts can lose hits
 
     def _finish(self) -> None:
-        """Isaac Lab's outputs and ours from the final hits; the lost-hit check."""
+        """Isaac Lab's outputs and ours from the final hits."""
         e, n, data = self._view_count, self.num_rays, self._data
         wp.launch(
             k.finish_rays,
@@ -519,7 +521,6 @@ class LidarSensor(NewtonRaycastSensor):
             ],
             device=self._device,
         )
-        self._check_lost()
 
     def direction_bounds(self) -> tuple[float, float, float, float, bool]:
         """Azimuth and elevation bounds [rad] of every ray of the pattern (all windows),

@@ -53,7 +53,7 @@ from robotwright.sensors.semantic_nav import (
     OBSTACLE_WEIGHT,
     VALUABLE_WEIGHT,
     check_policy,
-    go2_robot,
+    go2_mjcf,
     lidar_mount,
     lidar_pattern,
 )
@@ -82,9 +82,8 @@ def _go2_mjcf() -> tuple[
     """The Go2's MJCF text (meshes by absolute path, no floor), its standing base
     position [m], joint positions [rad] and the LiDAR's position on the base [m]."""
     from robotwright.generators.isaaclab_cfg import initial_state
-    from robotwright.generators.mjcf import MJCFHumanoidGenerator
 
-    text = MJCFHumanoidGenerator.from_hrdf(go2_robot()).export(None, add_scene=False)
+    text = go2_mjcf()
     model = mujoco.MjSpec.from_string(text).compile()
     pos, joint_pos, _ = initial_state(model, GO2_JOINT_POS)
     return text, tuple(pos), dict(joint_pos), lidar_mount(model)
@@ -221,7 +220,6 @@ def semantic_nav_env_cfg(
     cfg.rewards["near_obstacle"] = RewardTermCfg(func=near_obstacle, weight=OBSTACLE_WEIGHT)
     cfg.metrics["near_valuable"] = MetricsTermCfg(func=near_valuable)
     cfg.metrics["near_obstacle"] = MetricsTermCfg(func=near_obstacle)
-    cfg.terminations.pop("fell_over", None)
     cfg.terminations["fell_over"] = TerminationTermCfg(
         func=mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}
     )

@@ -47,8 +47,6 @@ __all__ = [
 #: The event term's name in ``env_cfg.events``.
 EVENT_NAME = "semantic_scene"
 
-_SHAPES = {"box": mujoco.mjtGeom.mjGEOM_BOX, "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER}
-
 
 def _object_spec(asset: SceneAssetCfg) -> Any:
     """A spec function: one fixed body holding the asset's geom (named after the asset,
@@ -56,9 +54,7 @@ def _object_spec(asset: SceneAssetCfg) -> Any:
 
     def spec_fn() -> mujoco.MjSpec:
         spec = mujoco.MjSpec()
-        body = spec.worldbody.add_body(name="object")
-        size = tuple(asset.size) + (0.0,) * (3 - len(asset.size))
-        body.add_geom(name=asset.name, type=_SHAPES[asset.shape], size=size, rgba=asset.rgba)
+        asset.add_geom(spec.worldbody.add_body(name="object"))
         return spec
 
     return spec_fn
