@@ -184,3 +184,25 @@ def test_cli_log_and_resume(tmp_path, capsys):
     # --log and --resume the same file: appended to
     assert main([*argv, "--resume", str(log), "--log", str(log)]) == 0
     assert len(log.read_text().splitlines()) == 13
+
+
+def test_random_search_draws_in_rounds_with_the_same_result(monkeypatch):
+    """Random search evaluates and reports progress round by round (its pool starts
+    before all ``budget`` designs are drawn); the designs chosen do not depend on the
+    round's size."""
+    import robotwright.grammar.search as search
+
+    g = default_grammar()
+    whole = random_search(g, [Mass()], budget=40, seed=3, executor=Inline())
+    monkeypatch.setattr(search, "RANDOM_BATCH", 7)
+    reports: list[int] = []
+    rounds = random_search(
+        g,
+        [Mass()],
+        budget=40,
+        seed=3,
+        executor=Inline(),
+        progress=lambda n, best: reports.append(n),
+    )
+    assert _key(rounds) == _key(whole)
+    assert reports[:3] == [7, 14, 21] and reports[-1] == 40

@@ -65,6 +65,11 @@ def check_workers(
 #: workers: the same seed then gives the same search on any machine, pool or Ray cluster.
 MCTS_BATCH = 8
 
+#: Designs random search draws per round: the pool starts, the log fills and progress
+#: is reported from the first round, not after all ``budget`` draws. The result does not
+#: depend on it: every round takes the next distinct designs of the same stream.
+RANDOM_BATCH = 256
+
 
 @dataclass
 class SearchResult:
@@ -224,7 +229,8 @@ def random_search(
     ) as ev:
         tries = 0
         while ev.left > 0 and tries < 20 * budget:
-            batch = [sample(grammar, max_links, rng, counter) for _ in range(ev.left)]
+            size = min(ev.left, RANDOM_BATCH)
+            batch = [sample(grammar, max_links, rng, counter) for _ in range(size)]
             tries += len(batch)
             ev.run(batch)
         stopped = (
