@@ -140,12 +140,39 @@ def resolve_source(text: str | os.PathLike[str]) -> ResolvedSource:
         from robotwright._suggest import did_you_mean
         from robotwright.catalog import list_robots
 
-        refs = [e.ref for e in list_robots()]
+        entries = list_robots()
+        refs = [e.ref for e in entries]
         raise SourceNotFoundError(
             f"no robot named '{raw}' and no such file or folder ('robotwright robots' lists "
-            f"the {len(refs)} robots known by name)" + did_you_mean(raw, refs)
+            f"the {len(refs)} robots known by name)"
+            + did_you_mean(raw, refs)
+            + _more_robots({e.source for e in entries})
         )
     return _from_entry(entry)
+
+
+#: Packages that bring robots by name, when they are not installed: (the catalog's
+#: source name, what they hold, how to install them).
+_ROBOT_PACKAGES = (
+    (
+        "example-robot-data",
+        "go2, solo12, talos, anymal, a1, ur5 and 50 more",
+        "pip install example-robot-data",
+    ),
+    (
+        "menagerie",
+        "MuJoCo Menagerie's: unitree_go2, unitree_g1, franka_emika_panda, ...",
+        "pip install 'robotwright[menagerie]'",
+    ),
+)
+
+
+def _more_robots(sources: set[str]) -> str:
+    """Where robots the user may be looking for come from, for the packages missing."""
+    missing = [
+        f"{what} with `{how}`" for source, what, how in _ROBOT_PACKAGES if source not in sources
+    ]
+    return f"; more robots by name: {'; '.join(missing)}" if missing else ""
 
 
 def _looks_like_path(text: str) -> bool:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
 import warnings
 from pathlib import Path
 
@@ -12,7 +13,7 @@ from robotwright._names import shown
 from robotwright._outputs import check_overwrite
 from robotwright._usd_format import USD_SUFFIXES
 from robotwright.cli.options import ROBOT_SOURCE_HELP, add_overwrite_flag, add_strict_flags
-from robotwright.errors import ConversionWarning, GeneratorError
+from robotwright.errors import ConversionWarning, GeneratorError, RobotSetupWarning
 from robotwright.generators.placement import Placement
 
 #: Meshes that exist only while a source is read are always copied.
@@ -43,16 +44,16 @@ def _add_usd_layout(p: argparse.ArgumentParser, default: str = "nested") -> None
 JOINT_POS_BOUND = Bound(-1e3, 1e3)
 
 
-def _add_joint_pos(p: argparse.ArgumentParser) -> None:
+def _add_joint_pos(p: argparse.ArgumentParser, lead: str = "") -> None:
     p.add_argument(
         "--joint-pos",
         action="append",
         type=_joint_pos,
         default=[],
         metavar="PATTERN=VALUE",
-        help="initial position [rad or m] of the joints whose name matches PATTERN (fnmatch; "
-        "first match wins; repeatable): a legged robot's standing pose; other joints keep "
-        "their reference position",
+        help=f"{lead}initial position [rad or m] of the joints whose name matches PATTERN "
+        "(fnmatch; first match wins; repeatable): a legged robot's standing pose; other "
+        "joints keep their reference position",
     )
 
 
@@ -107,6 +108,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         all_help="as --strict, and also when a cosmetic value (a name, a colour) is lost",
     )
     _add_usd_layout(p)
+    _add_joint_pos(p, "MJCF: the pose of the 'home' keyframe; ")
     p.add_argument(
         "-o",
         "--output",
@@ -226,6 +228,11 @@ def _export(args: argparse.Namespace) -> int:
     if args.usd_layout != "nested" and args.format != "usd":
         raise GeneratorError(f"--usd-layout applies to USD output, not {args.format.upper()}")
     check_overwrite(args.output, args.overwrite)
+    if args.joint_pos and args.format != "mjcf":
+        raise GeneratorError(
+            f"--joint-pos sets the home keyframe of MJCF output, not {args.format.upper()} "
+            "(isaaclab-cfg and mjlab-cfg take it for a framework's initial state)"
+        )
     hrdf = load_robot(args.robot)
     out = Path(args.output)
     # What MuJoCo refuses is not written (validate calls such a robot invalid).
@@ -247,6 +254,11 @@ def _export(args: argparse.Namespace) -> int:
         )
         return 0
     if args.format == "mjcf":
+        from robotwright.generators.standing import stand_on_floor
+
+        hrdf, changes = stand_on_floor(hrdf, args.joint_pos)
+        for line in changes:
+            print(f"note: {line}", file=sys.stderr)
         MJCFHumanoidGenerator.from_hrdf(hrdf).export(
             out,
             copy_meshes=args.copy_meshes,
@@ -270,8 +282,33 @@ def _export(args: argparse.Namespace) -> int:
             add_mujoco_tag=not args.no_mujoco_tag,
             strict=args.strict,
         )
-    print(f"wrote {out} ({args.format}, robot '{hrdf.name}', {len(hrdf.bodies)} bodies)")
+    print(
+        f"wrote {out} ({args.format}, robot {shown(hrdf.name)}, {len(hrdf.bodies)} bodies, "
+        f"{sum(j.type in ('hinge', 'slide', 'ball') for j in hrdf.joints)} joints, "
+        f"{'free' if hrdf.floating_base else 'fixed'} base, {len(hrdf.actuators)} actuators)"
+    )
+    for line in _export_warnings(hrdf):
+        warnings.warn(line, RobotSetupWarning, stacklevel=1)
     return 0
+
+
+def _export_warnings(hrdf) -> list[str]:
+    """What a user of the written file would trip on: joints that nothing drives, a
+    walking robot with its base fixed (its legs through the floor)."""
+    from robotwright.generators.standing import fixed_walker, walking_bodies
+
+    out = []
+    moving = [j for j in hrdf.joints if j.type in ("hinge", "slide")]
+    if moving and not hrdf.actuators:
+        out.append(
+            f"robot {shown(hrdf.name)} has no actuators: its {len(moving)} joints move "
+            "freely; give --actuators position --actuator-gain 'PATTERN=KP,KV' (URDF "
+            "sources) or a robot file with actuators"
+        )
+    feet = walking_bodies(hrdf)
+    if feet and not hrdf.floating_base:
+        out.append(fixed_walker(hrdf.name, feet))
+    return out
 
 
 def _isaaclab_cfg(args: argparse.Namespace) -> int:

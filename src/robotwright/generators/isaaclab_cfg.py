@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Sequence
-from fnmatch import fnmatchcase
 from pathlib import Path
 
 import mujoco
@@ -35,6 +34,7 @@ from robotwright._names import shown
 from robotwright._notes import name_list
 from robotwright._outputs import check_overwrite
 from robotwright.errors import GeneratorError
+from robotwright.generators.standing import fixed_walker, initial_state, walking_bodies
 from robotwright.hrdf.model import HRDF
 
 __all__ = [
@@ -78,88 +78,6 @@ def actuator_groups(hrdf: HRDF) -> list[tuple[dict[str, float], list[str]]]:
     return list(groups.values())
 
 
-def initial_state(
-    model: mujoco.MjModel, joint_pos: Sequence[tuple[str, float]] = ()
-) -> tuple[tuple[float, float, float], dict[str, float], list[str]]:
-    """Root position [m] and joint positions, with a line per clamped joint.
-
-    A joint's position is the value of the first ``(pattern, value)`` of ``joint_pos``
-    whose fnmatch pattern matches its name (a user's standing pose, rad or m), else the
-    MJCF's reference pose clamped into the joint's range (Isaac Lab checks ranges). A
-    free base is raised so that its collision geometry, in that pose, stands on z = 0
-    (in the USD of :func:`write_articulation_cfg` the root body sits at its prim's
-    origin, so this position is where the base spawns and where a reset puts it).
-
-    Raises:
-        GeneratorError: a pattern matches no joint, or a value lies outside the range of
-            a joint it sets.
-    """
-    pos = (0.0, 0.0, 0.0)
-    positions: dict[str, float] = {}
-    clamped = []
-    used = [False] * len(joint_pos)
-    problems = []
-    for j in range(model.njnt):
-        adr = int(model.jnt_qposadr[j])
-        kind = int(model.jnt_type[j])
-        if kind == int(mujoco.mjtJoint.mjJNT_FREE):
-            pos = tuple(float(v) for v in model.qpos0[adr : adr + 3])  # type: ignore[assignment]
-            continue
-        if kind not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
-            continue
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
-        lo, hi = (float(v) for v in model.jnt_range[j])
-        limited = bool(model.jnt_limited[j])
-        given = next((k for k, (pat, _) in enumerate(joint_pos) if fnmatchcase(name, pat)), None)
-        if given is not None:
-            used[given] = True
-            q = float(joint_pos[given][1])
-            if limited and not lo <= q <= hi:
-                problems.append(
-                    f"--joint-pos {shown(joint_pos[given][0])}={q:g}: joint {shown(name)} "
-                    f"moves in [{lo:g}, {hi:g}]"
-                )
-            positions[name] = q
-            continue
-        q = float(model.qpos0[adr])
-        if limited and not lo <= q <= hi:
-            new = min(max(q, lo), hi)
-            clamped.append(
-                f"{name}: reference position {q:g} outside [{lo:g}, {hi:g}], written as {new:g}"
-            )
-            q = new
-        positions[name] = q
-    problems += [
-        f"--joint-pos {shown(pat)}: matches no hinge or slide joint"
-        for (pat, _), hit in zip(joint_pos, used, strict=True)
-        if not hit
-    ]
-    if problems:
-        raise GeneratorError("; ".join(problems))
-    if not model.njnt or int(model.jnt_type[0]) != int(mujoco.mjtJoint.mjJNT_FREE):
-        pos = tuple(float(v) for v in model.body_pos[1])  # type: ignore[assignment]
-    else:
-        pos = (pos[0], pos[1], pos[2] + _floor_clearance(model, positions))
-    return pos, positions, clamped
-
-
-def _floor_clearance(model: mujoco.MjModel, joint_pos: dict[str, float]) -> float:
-    """How far [m] to raise a free-base robot (at its initial joint positions) so that
-    the lowest corner of its collision geoms' bounding boxes is on z = 0."""
-    from robotwright._mjmodel import lowest_collision_point
-
-    data = mujoco.MjData(model)
-    for name, q in joint_pos.items():
-        data.joint(name).qpos[0] = q
-    mujoco.mj_kinematics(model, data)
-    lowest = lowest_collision_point(model, data)
-    return 0.0 if not math.isfinite(lowest) else -lowest
-
-
-#: Body names that say a robot walks (its feet and the links above them).
-_LEGGED = re.compile(r"(foot|feet|toe|ankle|calf|shin|sole)", re.IGNORECASE)
-
-
 def setup_warnings(hrdf: HRDF) -> list[str]:
     """What would surprise a user training this robot: no drives at all, a fixed base on
     a robot whose bodies say it walks, a position drive without damping. One line each,
@@ -172,12 +90,9 @@ def setup_warnings(hrdf: HRDF) -> list[str]:
             "actuators={}; give --actuators position --actuator-gain 'PATTERN=KP,KV' (URDF "
             "sources) or a robot file with actuators"
         )
-    feet = [b.name for b in hrdf.bodies if _LEGGED.search(b.name)]
-    if not hrdf.floating_base and len(feet) >= 2:
-        out.append(
-            f"robot {name} has a fixed base but its bodies say it walks "
-            f"({name_list(feet, 4)}): give --floating-base for a free base"
-        )
+    feet = walking_bodies(hrdf)
+    if not hrdf.floating_base and feet:
+        out.append(fixed_walker(hrdf.name, feet))
     undamped = [
         a.joint
         for a in hrdf.actuators

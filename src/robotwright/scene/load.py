@@ -216,9 +216,21 @@ def _robot_scene(text: str, asset_roots: tuple[SourceLike, ...]) -> ViewScene:
             f"robot '{hrdf.name}' floats: placed {'up' if shift > 0 else 'down'} by "
             f"{abs(shift):.3g} m so that its lowest collision geom touches the floor (z = 0)"
         )
+    _warn_fixed_walker(hrdf)
     kind = "robot" if resolved.kind == "hrdf" else resolved.kind.replace("xacro", "urdf")
     title = hrdf.name  # the robot's own name, as info and the outputs call it
     return ViewScene(model, title, kind, text, notes=notes + more, warnings=shown)
+
+
+def _warn_fixed_walker(hrdf: HRDF) -> None:
+    """A walking robot read with its base fixed is drawn and scanned with its legs
+    through the floor: said, as a :class:`~robotwright.errors.RobotSetupWarning`."""
+    from robotwright.errors import RobotSetupWarning
+    from robotwright.generators.standing import fixed_walker, walking_bodies
+
+    feet = walking_bodies(hrdf)
+    if feet and not hrdf.floating_base:
+        warnings.warn(fixed_walker(hrdf.name, feet), RobotSetupWarning, stacklevel=3)
 
 
 def compile_mjcf(
