@@ -23,7 +23,8 @@ def test_usd_export_without_converter_names_what_to_install(tmp_path):
         cwd=tmp_path,
     )
     assert run.returncode == 2
-    assert "mujoco-usd-converter" in run.stderr and "isaacsim-asset-isolated" in run.stderr
+    assert "mujoco-usd-converter" in run.stderr and "pip install 'robotwright[usd]'" in run.stderr
+    assert "Python 3.12" in run.stderr
     assert "Traceback" not in run.stderr
     assert not out.exists()
 
@@ -41,6 +42,6 @@ def test_usd_input_without_newton_names_what_to_install(tmp_path):
         cwd=tmp_path,
     )
     assert run.returncode == 2, run.stderr
-    assert "Newton" in run.stderr and "robotwright[isaaclab]" in run.stderr
+    assert "Newton" in run.stderr and "robotwright[usd]" in run.stderr
     assert "Traceback" not in run.stderr
     assert not (tmp_path / "out").exists()

@@ -98,6 +98,12 @@ def test_command_line_export_and_strict(tmp_path):
     run = _cli(tmp_path, "export", "arm6", "-o", str(tmp_path / "a.usd"))
     assert run.returncode == 0, run.stderr[-2000:]
     assert "0 difference(s)" in run.stdout and (tmp_path / "a.usd").is_file()
+    # The converter's and warp's own lines are caught: the output is ours alone.
+    assert run.stdout.startswith("wrote ") and len(run.stdout.splitlines()) == 1
+    assert [line.split()[1:3] for line in run.stderr.splitlines()] == [["conversion", "note(s)"]]
+    verbose = _cli(tmp_path, "export", "arm6", "-o", str(tmp_path / "v.usd"), "-v")
+    assert "mujoco-usd-converter: sensors are not supported" in verbose.stderr
+    assert "Status:" not in verbose.stderr + verbose.stdout
     # arm6's two sensors have no USD form: --strict refuses, naming them, writing nothing.
     strict = _cli(tmp_path, "export", "arm6", "-o", str(tmp_path / "b.usd"), "--strict")
     assert strict.returncode == 2

@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import re
 import tempfile
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -37,16 +38,21 @@ from robotwright._atomic import copy_file_atomic
 from robotwright._names import file_stem
 from robotwright._temporaries import prefix
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES
-from robotwright.errors import GeneratorError
+from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["USD_LAYOUTS", "USD_SUFFIXES", "UsdExport", "to_usd"]
 
 _MISSING = (
-    "USD export needs mujoco-usd-converter and usd-core (Isaac Lab's environment, Python "
-    '3.12: pip install "isaacsim-asset-isolated==6.2.0.0" "tinyobjloader==2.0.0rc13"); '
-    "not importable here: {error}"
+    "USD export needs Python 3.12 (as Isaac Lab) and the usd extra: pip install "
+    "'robotwright[usd]' (mujoco-usd-converter through isaacsim-asset-isolated 6.2.0.0 and "
+    "tinyobjloader 2.0.0rc13, usd-core, and Newton with warp and scipy, which read the USD "
+    "back); not importable here: {error}"
 )
+
+#: Lines the converter and warp print that say nothing about the robot: progress of
+#: usd-core's saves, and warp finding no GPU (the export and its proof run on the CPU).
+_CHATTER = ("Status: ", "Warp CUDA warning: Could not find or load the NVIDIA CUDA driver")
 
 
 @dataclass
@@ -77,13 +83,37 @@ class UsdExport:
     mjcf_model: mujoco.MjModel | None = None
 
 
-def _converter():
+def _converter(prove: bool):
+    """The converter module, once everything the export needs imports (the proof's
+    Newton too, when asked): a missing piece is named before anything is written."""
     try:
         import mujoco_usd_converter
         from pxr import Usd, UsdPhysics  # noqa: F401
+
+        if prove:
+            from robotwright._warp import quiet_warp
+
+            quiet_warp()  # before Newton initialises warp
+            import newton  # noqa: F401
+            import scipy  # noqa: F401  (Newton's mesh import)
     except ImportError as exc:
         raise GeneratorError(_MISSING.format(error=exc)) from None
     return mujoco_usd_converter
+
+
+#: usd-core's diagnostic heading: "Warning: in FUNCTION at line N of FILE -- message".
+_DIAGNOSTIC = re.compile(r"^(?:Warning|Error|Coding Error|Runtime Error): (?:in .*? -- )?")
+
+
+def _library_notes(lines: list[str], who: str) -> list[str]:
+    """The lines a library printed while it worked, as notes (its chatter dropped, the
+    place in its own source cut from usd-core's diagnostics)."""
+    notes = [
+        f"{who}: {_DIAGNOSTIC.sub('', line.strip())}"
+        for line in lines
+        if not line.startswith(_CHATTER)
+    ]
+    return list(dict.fromkeys(notes))
 
 
 def converter_model_name(name: str) -> str:
@@ -300,12 +330,18 @@ def to_usd(
         raise GeneratorError(f"{out_path} exists (pass overwrite=True / --overwrite)")
     if layout not in USD_LAYOUTS:
         raise GeneratorError(f"layout={layout!r}: expected one of {', '.join(USD_LAYOUTS)}")
-    converter = _converter()
+    converter = _converter(prove)
     from pxr import Usd
+
+    from robotwright._library_output import captured_library_output
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         mjcf, lost = _robot_mjcf(hrdf, Path(tmp), root_at_origin)
-        asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
+        with captured_library_output() as printed:
+            asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
+        # What the libraries said is passed on as notes, never as a difference: --strict
+        # refuses what the proof finds, not another library's remarks.
+        said = _library_notes(printed, "mujoco-usd-converter")
         stage = Usd.Stage.Open(asset.path)
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
@@ -347,9 +383,22 @@ def to_usd(
         if prove:
             from robotwright.generators.usd_proof import prove_usd
 
-            result.proof = prove_usd(written, model, hrdf)
+            with (
+                captured_library_output() as printed,
+                warnings.catch_warnings(record=True) as caught,
+            ):
+                warnings.simplefilter("always")
+                result.proof = prove_usd(written, model, hrdf)
+            for w in caught:  # Newton's warnings about the file are notes of the export
+                if issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+                else:
+                    printed.append(str(w.message))
             found += result.proof.differences
+            said += _library_notes(printed, "Newton reading it back")
         _report(found, out_path, strict)
+        for line in said:
+            warnings.warn(f"{out_path}: {line}", ConversionWarning, stacklevel=2)
         copy_file_atomic(written, out_path)
     return result
 

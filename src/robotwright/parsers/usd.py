@@ -56,8 +56,9 @@ __all__ = ["USD_SUFFIXES", "USDOptions", "parse_usd", "prepare_confined_read"]
 
 
 _MISSING = (
-    "reading USD needs Newton and usd-core (Isaac Lab's environment, Python 3.12: pip "
-    'install "robotwright[isaaclab]"); not importable here: {error}'
+    "reading USD needs Newton and usd-core (Python 3.12, as Isaac Lab: pip install "
+    "'robotwright[usd]', or 'robotwright[isaaclab]' in Isaac Lab's environment); not "
+    "importable here: {error}"
 )
 #: Newton's limits at or beyond this magnitude mean "unlimited".
 _UNLIMITED = 1e5
