@@ -132,3 +132,36 @@ def test_meshes_saved_into_an_hrdf_folder_show_progress(
     assert len(list(out.rglob("*.stl"))) == 6
     lines = _progress_lines(capsys.readouterr().err, "meshes copied")
     assert lines and all(int(m[2]) == 6 for m in lines)
+
+
+def test_a_long_single_step_says_it_is_still_at_work(monkeypatch) -> None:
+    """working(): one line every STEP_REPORT_S while the block runs; the block here waits
+    until the first line is written, so no clock decides the outcome."""
+    import io
+    import sys
+    import threading
+
+    written = threading.Event()
+
+    class Stderr(io.StringIO):
+        def write(self, text: str) -> int:
+            n = super().write(text)
+            written.set()
+            return n
+
+    err = Stderr()
+    monkeypatch.setattr(sys, "stderr", err)
+    monkeypatch.setattr(_progress, "STEP_REPORT_S", 0.01)
+    with _progress.shown(), _progress.working("drawing go2.png"):
+        assert written.wait(60)
+    lines = err.getvalue().splitlines()
+    assert lines and all(re.fullmatch(r"  drawing go2\.png \(\d+ s\)", line) for line in lines)
+    # The reporting thread ends with the block.
+    assert not [t for t in threading.enumerate() if t.name == "robotwright-progress"]
+
+
+def test_a_single_step_is_silent_in_the_library(monkeypatch, capsys) -> None:
+    monkeypatch.setattr(_progress, "STEP_REPORT_S", 0.0)
+    with _progress.working("drawing"):
+        pass
+    assert capsys.readouterr().err == ""

@@ -12,13 +12,14 @@ command never sits silent for long and a quick one prints nothing.
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import TypeVar
 
-__all__ = ["Progress", "duration", "shown", "steps"]
+__all__ = ["Progress", "duration", "shown", "steps", "working"]
 
 T = TypeVar("T")
 
@@ -91,3 +92,27 @@ def steps(items: Iterable[T], total: int, what: str) -> Iterator[T]:
     for done, item in enumerate(items):
         progress.update(done)
         yield item
+
+
+@contextmanager
+def working(what: str) -> Iterator[None]:
+    """Inside :func:`shown`, a block that runs past :data:`STEP_REPORT_S` seconds prints
+    ``  WHAT (4 s)`` that often until it ends (from a thread: the block is one call, a
+    picture drawn or a file written, with no loop to report from); silent otherwise."""
+    if not _SHOWN.get():
+        yield
+        return
+    done = threading.Event()
+    t0 = _clock()
+
+    def report() -> None:
+        while not done.wait(STEP_REPORT_S):
+            print(f"  {what} ({duration(_clock() - t0)})", file=sys.stderr, flush=True)
+
+    thread = threading.Thread(target=report, name="robotwright-progress", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join()

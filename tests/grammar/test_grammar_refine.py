@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
@@ -68,5 +69,11 @@ def test_search_cli_refines_the_best_design(capsys) -> None:
     assert main([*args, "--workers", "1", "--refine", "12"]) == 0
     out = capsys.readouterr().out
     assert "continuous parameter(s)" in out and "(CMA-ES): reach = " in out
+    # The search's and the refine's evaluations counted apart (the refine's first is
+    # the search's best, evaluated again).
+    assert "10 designs evaluated + 11 by the refine (CMA-ES)" in out
+    # Refined values are written as a designer reads them: 4 significant digits.
+    numbers = re.findall(r"=(-?\d+\.\d+)", out.split("# robotwright-design/1")[1])
+    assert numbers and all(len(n.lstrip("-0.").replace(".", "")) <= 4 for n in numbers)
     assert main([*args, "--objective", "mass", "--pareto", "--refine", "12"]) == 2
     assert "--refine" in capsys.readouterr().err

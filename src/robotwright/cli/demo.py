@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 from robotwright._names import file_stem
 from robotwright._notes import notes_of
+from robotwright._progress import working
 
 if TYPE_CHECKING:  # MuJoCo and Things load when the demo runs, not with `robotwright --help`
     from robotwright.things import World
@@ -275,7 +276,10 @@ def run_demo(out: Path = DEFAULT_OUT) -> dict[str, str]:
             t0 = time.perf_counter()
             print(f"[{i}/{len(STEPS)}] {title} ...", flush=True)
             # Conversion notes (values a format cannot hold) go to a file, not the terminal.
-            with warnings.catch_warnings(record=True) as caught:
+            with (
+                warnings.catch_warnings(record=True) as caught,
+                working(f"[{i}/{len(STEPS)}] still at work"),
+            ):
                 warnings.simplefilter("always")
                 results[title] = step(tmp, ctx)
             # One note per value or element, the unit the notes file lists (one per line).

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from robotwright._atomic import atomic_dir, check_output_path
 from robotwright._outputs import check_overwrite
-from robotwright._progress import Progress
+from robotwright._progress import STEP_REPORT_S, Progress, working
 from robotwright._progress import duration as _duration
 from robotwright.cli.options import add_overwrite_flag
 from robotwright.errors import GrammarError, InputFileError, Problem
@@ -436,7 +436,7 @@ def _sample(args: argparse.Namespace) -> int:
 def _search_progress(budget: int, name: str):
     """A callback printing ``evaluated/budget, best, time left`` to stderr every 2 s at
     most, with a warning once the first evaluations show the search will take long."""
-    progress = Progress(budget, "designs evaluated")
+    progress = Progress(budget, "designs evaluated", every=STEP_REPORT_S)
     warned = [False]
 
     def show(n: int, best) -> None:
@@ -593,11 +593,14 @@ def _search(args: argparse.Namespace) -> int:
         else:
             res = random_search(g, objectives, constraints, **kw)
         refined = ""
+        searched = res.n_evaluated
         if args.refine is not None and res.best is not None:
             refined = _refine(args, g, res, objectives, constraints, executor)
     dt = time.perf_counter() - t0
+    by_refine = res.n_evaluated - searched
+    also = f" + {by_refine} by the refine (CMA-ES)" if by_refine else ""
     print(
-        f"{args.method} search: {res.n_evaluated} designs evaluated in {dt:.1f} s "
+        f"{args.method} search: {searched} designs evaluated{also} in {dt:.1f} s "
         f"(stopped: {res.stopped})"
     )
     if refined:
@@ -617,15 +620,16 @@ def _search(args: argparse.Namespace) -> int:
         from robotwright.grammar.winners import write_winners
         from robotwright.render.api import draw_pose
 
-        folders = write_winners(
-            g,
-            res.evaluations,
-            objectives,
-            args.out,
-            k=args.top,
-            pictures=not args.no_picture,
-            draw_carrier=draw_pose,
-        )
+        with working(f"writing the winners to {args.out}"):
+            folders = write_winners(
+                g,
+                res.evaluations,
+                objectives,
+                args.out,
+                k=args.top,
+                pictures=not args.no_picture,
+                draw_carrier=draw_pose,
+            )
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
     return 0
 
@@ -680,15 +684,16 @@ def _report_front(args: argparse.Namespace, g, res, objectives: list) -> int:  #
     if args.out:
         from robotwright.render.api import draw_pose
 
-        folders = write_front(
-            g,
-            front,
-            objectives,
-            args.out,
-            evaluated=res.evaluations,
-            pictures=not args.no_picture,
-            draw_carrier=draw_pose,
-        )
+        with working(f"writing the front to {args.out}"):
+            folders = write_front(
+                g,
+                front,
+                objectives,
+                args.out,
+                evaluated=res.evaluations,
+                pictures=not args.no_picture,
+                draw_carrier=draw_pose,
+            )
         extra = "" if args.no_picture else ", pareto.png"
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}, front.json{extra}")
     return 0

@@ -212,14 +212,17 @@ def run(args: argparse.Namespace) -> int:
             f"{args.fps:g} frames/s, {animation.backend} renderer, camera {args.camera})"
         )
         return 0
-    picture = render(
-        args.source,
-        out,
-        options,
-        scene=args.scene,
-        title=args.title,
-        asset_roots=roots,
-    )
+    from robotwright._progress import working
+
+    with working(f"drawing {out}"):
+        picture = render(
+            args.source,
+            out,
+            options,
+            scene=args.scene,
+            title=args.title,
+            asset_roots=roots,
+        )
     for note in picture.notes:
         print(f"note: {note}", file=sys.stderr)
     print(f"wrote {out} ({width}x{height}, {picture.backend} renderer, camera {picture.camera})")

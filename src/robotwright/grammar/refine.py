@@ -67,12 +67,18 @@ def parameters(grammar: Grammar, design: Design) -> list[Parameter]:
     return out
 
 
+#: Significant digits a refined parameter keeps: 0.1 % steps, values a designer reads
+#: and builds (0.33 m, not 0.3299542718072217 m); the design evaluated is the one written.
+REFINED_DIGITS = 4
+
+
 def with_values(design: Design, params: Sequence[Parameter], values: Sequence[float]) -> Design:
-    """``design`` with parameter ``params[k]`` set to ``values[k]`` (clipped to its domain)."""
+    """``design`` with parameter ``params[k]`` set to ``values[k]``, rounded to
+    :data:`REFINED_DIGITS` significant digits and clipped to its domain."""
     steps = [list(s.choices) for s in design.steps]
     for p, v in zip(params, values, strict=True):
         ch: Choice = steps[p.step][p.choice]
-        new = min(max(float(v), p.low), p.high)
+        new = min(max(float(f"{float(v):.{REFINED_DIGITS}g}"), p.low), p.high)
         steps[p.step][p.choice] = replace(
             ch, params=tuple((k, new if k == p.name else x) for k, x in ch.params)
         )
