@@ -11,7 +11,14 @@ import numpy as np
 import pytest
 
 from robotwright.render.scan import class_legend, render_scan
-from robotwright.sensors.plot import _limits, class_color, plot_scan, upside_down
+from robotwright.sensors.plot import (
+    _limits,
+    class_color,
+    plot_scan,
+    tilt_deg,
+    upside_down,
+    view_stretch,
+)
 
 
 @pytest.mark.parametrize(
@@ -88,3 +95,23 @@ def test_scene_picture_draws_points_in_their_class_colour(tmp_path) -> None:
     near = (np.abs(picture.image.astype(int) - rgb).max(axis=2) < 40).mean()
     assert near > 0.1
     assert mpimg.imread(tmp_path / "s.png").shape[:2] == (90, 120)
+
+
+@pytest.mark.parametrize(
+    ("quat", "deg"),
+    [
+        ((1, 0, 0, 0), 0.0),
+        ((0, 1, 0, 0), 180.0),
+        ((np.cos(np.pi / 4), 0, np.sin(np.pi / 4), 0), 90.0),
+        ((np.cos(np.radians(82.5)), 0, np.sin(np.radians(82.5)), 0), 165.0),  # the Go2's radar
+    ],
+)
+def test_the_title_gives_the_sensors_tilt(quat, deg) -> None:
+    assert tilt_deg(quat) == pytest.approx(deg, abs=1e-9)
+
+
+def test_a_flat_view_is_stretched_to_be_read() -> None:
+    assert view_stretch((-2.0, 2.0), (0.0, 1.0)) == 1.0  # equal scales
+    # A ground from -3 to 32 m seen 0.25 m high: stretched to 4 times wider than high.
+    stretch = view_stretch((-3.0, 32.0), (0.0, 0.25))
+    assert stretch == pytest.approx(35.0 / 0.25 / 4.0)

@@ -47,6 +47,27 @@ def upside_down(sensor_quat: np.ndarray | Sequence[float] | None) -> bool:
     return bool(1.0 - 2.0 * (x * x + y * y) / n < 0.0)
 
 
+def tilt_deg(sensor_quat: np.ndarray | Sequence[float]) -> float:
+    """Angle [deg] between a sensor's z axis (orientation ``sensor_quat``, w, x, y, z, in
+    the world frame) and the world's up."""
+    w, x, y, z = np.asarray(sensor_quat, dtype=np.float64).reshape(4)
+    n = w * w + x * x + y * y + z * z
+    cos = float(np.clip(1.0 - 2.0 * (x * x + y * y) / n, -1.0, 1.0))
+    return float(np.degrees(np.arccos(cos)))
+
+
+#: Widest a view is drawn at equal scales (width / height); a flatter one is stretched.
+MAX_VIEW_RATIO = 4.0
+
+
+def view_stretch(xlim: tuple[float, float], ylim: tuple[float, float]) -> float:
+    """How much a view's vertical scale is stretched: 1 (equal scales) unless the view
+    is more than :data:`MAX_VIEW_RATIO` times wider than high (a ground seen from 0.3 m
+    out to 30 m: a strip no one can read at equal scales); then to that ratio."""
+    flat = (xlim[1] - xlim[0]) / (ylim[1] - ylim[0])
+    return max(1.0, flat / MAX_VIEW_RATIO)
+
+
 def _limits(values: np.ndarray, extra: float | None) -> tuple[float, float]:
     """Axis range covering ``values`` (and ``extra``) with a 4 % margin."""
     lo, hi = float(values.min()), float(values.max())
@@ -73,7 +94,9 @@ def plot_scan(
     view, and a side view of a slice through the sensor (walls in front of and behind
     the furniture would otherwise cover it).
 
-    Both views are cropped to the drawn hits (and the sensor), with equal scales.
+    Both views are cropped to the drawn hits (and the sensor), with equal scales, except
+    that a view wider than :data:`MAX_VIEW_RATIO` times its height has its height
+    stretched (said in its title).
 
     Args:
         points: ``(N, 3)`` points; rows with NaN (misses) are skipped.
@@ -87,8 +110,9 @@ def plot_scan(
             counts always cover every point.
         class_keywords: class name -> keywords that define it (the sensor's
             ``semantic_class_mapping``): the legend says ``valuable: sofa, table, ...``.
-        sensor_quat: sensor orientation (w, x, y, z) in the world frame; a sensor
-            mounted upside down is named in the title.
+        sensor_quat: sensor orientation (w, x, y, z) in the world frame; a sensor whose
+            z axis points below the horizon has its tilt said in the title (the
+            pattern's elevations are measured in the sensor's frame).
         side_slice: the side view shows points with ``|y - y_sensor|`` at most this
             [m] (y of the origin without ``sensor_pos``); ``None`` shows every point.
     """
@@ -128,15 +152,21 @@ def plot_scan(
             ax.scatter(points[sel, i], points[sel, j], s=1.5, c=class_color(cls_id), linewidths=0)
         if sensor_pos is not None:
             ax.plot(sensor_pos[i], sensor_pos[j], "kx", markersize=10, mew=2)
+        stretch = 1.0
         if len(shown):
             extra_i = None if sensor_pos is None else float(sensor_pos[i])
             extra_j = None if sensor_pos is None else float(sensor_pos[j])
-            ax.set_xlim(*_limits(shown[:, i], extra_i))
-            ax.set_ylim(*_limits(shown[:, j], extra_j))
-        ax.set_title(f"{name} ({len(shown)} points)")
+            xlim, ylim = _limits(shown[:, i], extra_i), _limits(shown[:, j], extra_j)
+            ax.set_xlim(*xlim)
+            ax.set_ylim(*ylim)
+            stretch = view_stretch(xlim, ylim)
+        ax.set_title(
+            f"{name} ({len(shown)} points"
+            + (f"; {yl[0]} stretched x{stretch:.3g})" if stretch > 1.0 else ")")
+        )
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
-        ax.set_aspect("equal", adjustable="box")
+        ax.set_aspect(stretch, adjustable="box")
         ax.grid(True, alpha=0.3)
 
     # Legend markers drawn at a readable size (the scatter dots themselves are tiny).
@@ -167,7 +197,10 @@ def plot_scan(
     )
     heading = title or f"LiDAR scan: {len(points)} points"
     if upside_down(sensor_quat):
-        heading += "\nnote: the sensor is mounted upside down (its z axis points down)"
+        heading += (
+            f"\nthe sensor's z axis is tilted {tilt_deg(sensor_quat):.0f} deg from up: the "
+            "pattern's elevations are measured in the sensor's frame"
+        )
     fig.suptitle(heading)
     # The views get what the legend leaves: its height measured once drawn.
     fig.canvas.draw()
