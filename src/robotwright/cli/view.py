@@ -158,10 +158,21 @@ def _run(args: argparse.Namespace) -> int:
             # sleep of this one, and its handler runs only when this one wakes.
             time.sleep(_SIGNAL_POLL_S)
     except KeyboardInterrupt:
+        _ignore_signals()  # a second Ctrl-C while the server stops does not cut it short
         print("stopped", flush=True)
     finally:
         viewer.stop()
     return 0
+
+
+def _ignore_signals() -> None:
+    """SIGINT and SIGTERM ignored from here on (the viewer is stopping: exit 0)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
 
 
 def note_lines(notes: list[str], skipped: list[str], verbose: bool) -> list[str]:
