@@ -111,8 +111,34 @@ def test_update_period_holds_the_scan_between_updates(clutter_model):
         published.append(now)
     assert dues == [0, 0, 1, 0, 1, 0]  # every 0.05 s of 0.02 s steps (timer keeps the rest)
     s.reset(torch.tensor([2]))
+    held = s.data.distances.numpy().copy()
     _step(env, 0.02)
     assert s.data.scan_due.numpy().tolist() == [0, 0, 1]  # a reset env is published at once
+    # Only the due environment is cast: the others' rays are sent away from the world
+    # (no hit), and their held scans stay as they were.
+    cast = s._ray_dist.numpy()
+    assert (cast[:2] == -1.0).all() and (cast[2] > 0).any()
+    np.testing.assert_array_equal(s.data.distances.numpy()[:2], held[:2])
+
+
+def test_a_held_scan_is_binned_with_its_own_window(clutter_model):
+    """The range image of a held scan is the image of that scan when it was published:
+    its window (``window_start``) is held with it while the live window moves on."""
+    env = _make(clutter_model, _cfg(pattern=LivoxPatternCfg(num_rays=2000), update_period=0.05))
+    s = env.sensor
+    _step(env, 0.0)
+    image = rw_mjlab.lidar_range_image(env, "lidar", 32, 8, scanned=True)
+    start = s.data.window_start.numpy().copy()
+    for _ in range(2):  # 0.02 and 0.04 s: held
+        _step(env, 0.02)
+        assert (s.data.scan_due.numpy() == 0).all()
+        np.testing.assert_array_equal(s.data.window_start.numpy(), start)
+        assert torch.equal(rw_mjlab.lidar_range_image(env, "lidar", 32, 8, scanned=True), image)
+    _step(env, 0.02)  # 0.06 s: a new scan, in a window 0.06 s of firing further on
+    assert (s.data.scan_due.numpy() == 1).all()
+    moved = s.data.window_start.numpy()
+    rows = s.table.directions.shape[0]
+    assert (np.abs(moved - (start + round(0.06 * RATE)) % rows) <= 1).all()
 
 
 def test_random_scan_phase_is_per_env_seeded_and_untimed_patterns_move_by_frames(clutter_model):

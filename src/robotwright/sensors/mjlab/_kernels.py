@@ -33,6 +33,7 @@ def advance_scan(
     carry: wp.array(dtype=wp.float64),
     timer: wp.array(dtype=wp.float64),
     due: wp.array(dtype=wp.int32),
+    published: wp.array(dtype=wp.int32),
 ):
     """Move each environment's window by the simulated time ``elapsed[0]`` [s] since the
     last sense, and decide whether its scan is published this step (``due``).
@@ -42,6 +43,7 @@ def advance_scan(
     untimed one moves one frame (``rays`` rows) per published scan. With ``period > 0``
     a scan is published once ``period`` seconds have passed since the last (Isaac
     Lab's ``update_period``); a fresh environment (just reset) is published at once.
+    ``published`` keeps the window start of the scan each environment's data hold.
     """
     e = wp.tid()
     dt = elapsed[0]
@@ -49,6 +51,7 @@ def advance_scan(
         fresh[e] = 0
         timer[e] = wp.float64(0.0)
         due[e] = 1
+        published[e] = start[e]
         return
     if rays_per_second > wp.float64(0.0):
         c = carry[e] + dt * rays_per_second
@@ -63,9 +66,14 @@ def advance_scan(
         if period > wp.float64(0.0):
             t = t - period * wp.floor((t + wp.float64(1.0e-9)) / period)
         timer[e] = wp.max(t, wp.float64(0.0))
+        published[e] = start[e]
     else:
         due[e] = 0
         timer[e] = t
+
+
+#: Height [m] rays of a held scan start from, pointing up: above any world a model holds.
+AWAY_Z = wp.constant(wp.float32(1.0e7))
 
 
 @wp.kernel
@@ -81,14 +89,24 @@ def world_rays_windowed(
     jitter_std: wp.float32,
     env_seed: wp.array(dtype=wp.int32),
     frame: wp.array(dtype=wp.int32),
+    hold: wp.int32,
+    due: wp.array(dtype=wp.int32),
     pnt: wp.array2d(dtype=wp.vec3),
     vec: wp.array2d(dtype=wp.vec3),
 ):
     """World rays of environment ``e``: table rows ``start[e] + i`` (wrapping), rotated
     and moved to the sensor, origins shifted by the environment's ``drift`` [m] and
     directions tilted by Gaussian angular jitter of ``jitter_std`` [rad] per axis.
-    ``pnt``/``vec`` may be a column slice of the rays starting at ``ray_offset``."""
+    ``pnt``/``vec`` may be a column slice of the rays starting at ``ray_offset``.
+
+    With ``hold`` (scans held between updates), an environment whose scan is not
+    ``due`` gets rays that start far above the world and point up: the BVH's root
+    box turns them away at once, so its held scan costs next to no cast."""
     e, i = wp.tid()
+    if hold != 0 and due[e] == 0:
+        pnt[e, i] = wp.vec3(0.0, 0.0, AWAY_Z)
+        vec[e, i] = wp.vec3(0.0, 0.0, 1.0)
+        return
     k = (start[e] + ray_offset + i) % rows
     r = ray_rot[e]
     d = r @ table_d[k]

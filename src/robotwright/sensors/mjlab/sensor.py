@@ -121,8 +121,9 @@ class MjlabSemanticLidarData(RayCastData):
         sensor_pos_w: ``(E, 3)`` the LiDAR's position (``offset_pos`` applied) [m];
             sensor_quat_w: ``(E, 4)`` its orientation (w, x, y, z).
         frame: ``(1,)`` int32 count of scans cast since the start, less one.
-        window_start: ``(E,)`` int32 first row of each environment's window in the
-            pattern table (its rays are rows ``window_start + i``, wrapping).
+        window_start: ``(E,)`` int32 first row, in the pattern table, of the window of
+            the scan the data hold (its rays are rows ``window_start + i``, wrapping;
+            a held scan keeps its own window while the live one moves on).
         scan_due: ``(E,)`` int32, 1 where this step published a new scan (always, with
             ``update_period`` 0), 0 where the data hold an earlier one.
     """
@@ -261,6 +262,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 "timer": wp.zeros(e, dtype=wp.float64),
                 "fresh": wp.ones(e, dtype=wp.int32),
                 "due": wp.ones(e, dtype=wp.int32),
+                "published": wp.zeros(e, dtype=wp.int32),
                 "mount_pos": wp.array(
                     np.tile(np.asarray(res.offset_pos, np.float32), (e, 1)), dtype=wp.vec3
                 ),
@@ -336,7 +338,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             sensor_pos_w=t(b["pos_w"]),
             sensor_quat_w=t(b["quat_w"]),
             frame=t(b["frame"]),
-            window_start=t(b["start"]),
+            window_start=t(b["published"]),
             scan_due=t(b["due"]),
         )
         self._sensor_mat = t(b["sensor_mat"])
@@ -504,7 +506,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 float(res.update_period),
                 b["fresh"],
             ],
-            outputs=[b["start"], b["carry"], b["timer"], b["due"]],
+            outputs=[b["start"], b["carry"], b["timer"], b["due"], b["published"]],
             device=dev,
         )
         align = _ALIGN[cfg.ray_alignment]
@@ -576,6 +578,8 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 float(res.angular_jitter_std),
                 b["env_seed"],
                 b["frame"],
+                int(self._hold),
+                b["due"],
             ],
             outputs=[pnt, vec],
             device=dev,
