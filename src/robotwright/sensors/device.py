@@ -280,11 +280,13 @@ class WarpLidarPipeline:
         pnt, vec = cols(self.ray_origins), cols(self.ray_directions)
         raw_dist, raw_geom = cols(self._raw_dist), cols(self._raw_geom)
         with wp.ScopedDevice(self.device):
-            wp.launch(
+            k.launch_per_ray(
                 k.world_rays,
-                dim=(e, b - a),
-                inputs=[self.table_o, self.table_d, self.window, a, self.pos_w, self.ray_rot],
-                outputs=[pnt, vec],
+                k.world_rays_rows,
+                (e, b - a),
+                [self.table_o, self.table_d, self.window, a, self.pos_w, self.ray_rot],
+                [pnt, vec],
+                pnt.device,
             )
             mjw.rays(
                 self._m,
@@ -299,10 +301,11 @@ class WarpLidarPipeline:
                 cols(self._normal),
                 self._rc,
             )
-            wp.launch(
+            k.launch_per_ray(
                 k.finish_rays,
-                dim=(e, b - a),
-                inputs=[
+                k.finish_rays_rows,
+                (e, b - a),
+                [
                     raw_dist,
                     raw_geom,
                     pnt,
@@ -322,11 +325,12 @@ class WarpLidarPipeline:
                     self.label_lut,
                     a,
                 ],
-                outputs=[
+                [
                     cols(self.distances),
                     cols(self.hit_mask),
                     cols(self.geom_ids),
                     cols(self.labels),
                     cols(self.points),
                 ],
+                pnt.device,
             )

@@ -309,6 +309,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         self._work, self._out = work, out
         b |= {k: out[k] for k in ("distances", "hit_mask", "geom_ids", "labels", "points")}
         self._table_rows = rows
+        self._origins = int(bool(np.any(self.table.origins)))
         rot = np.empty(9)
         mujoco.mju_quat2Mat(rot, np.asarray(res.offset_rot, dtype=np.float64))
         self._offset_pos = wp.vec3(*np.asarray(res.offset_pos, dtype=np.float32))
@@ -554,7 +555,7 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         """World rays, mjlab's cast and finishing of the rays ``[a, b_)`` of every env."""
         b, cfg = self._buffers, self.cfg
         d = self._data.struct
-        e, dev = int(d.nworld), self._wp_device
+        e = int(d.nworld)
         whole = (a, b_) == (0, int(self.table.rays_per_frame))
 
         def cols(array: Any) -> Any:
@@ -563,10 +564,11 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         pnt, vec = cols(self._ray_pnt), cols(self._ray_vec)
         dist, geomid = cols(self._ray_dist), cols(self._ray_geomid)
         res, work, out = self.resolved, self._work, self._out
-        wp.launch(
+        self._per_ray(
             mjlab_kernels.world_rays_windowed,
-            dim=(e, b_ - a),
-            inputs=[
+            mjlab_kernels.world_rays_windowed_rows,
+            (e, b_ - a),
+            [
                 b["table_o"],
                 b["table_d"],
                 b["start"],
@@ -580,9 +582,9 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 b["frame"],
                 int(self._hold),
                 b["due"],
+                self._origins,
             ],
-            outputs=[pnt, vec],
-            device=dev,
+            [pnt, vec],
         )
         # mjlab's own call (RayCastSensor.raycast_kernel): its BVH, geom groups and
         # parent-body exclusion, on this block of columns.
@@ -599,51 +601,51 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             normal=cols(self._ray_normal),
             rc=rc,
         )
-        wp.launch(
+        range_model = [
+            dist,
+            geomid,
+            pnt,
+            vec,
+            d.geom_xpos,
+            d.geom_xmat,
+            b["geom_type"],
+            b["geom_size"],
+            int(cfg.refine_curved_hits),
+            float(cfg.min_distance),
+            float(cfg.max_distance),
+            float(cfg.range_noise_std),
+            float(cfg.dropout_prob),
+        ]
+        labelled = [cols(work[k]) for k in ("distances", "hit_mask", "geom_ids", "labels")]
+        if not (self._hold or res.range_noise_per_meter or any(res.class_dropout)):
+            # The plain case: one pass writes the published arrays with mjlab's misses.
+            self._per_ray(
+                mjlab_kernels.finish_rays_mjlab,
+                mjlab_kernels.finish_rays_mjlab_rows,
+                (e, b_ - a),
+                [*range_model, b["env_seed"], b["frame"], b["lut"], a],
+                [*labelled, cols(work["points"]), cols(self._ray_normal)],
+            )
+            return
+        self._per_ray(
             kernels.finish_rays,
-            dim=(e, b_ - a),
-            inputs=[
-                dist,
-                geomid,
-                pnt,
-                vec,
-                d.geom_xpos,
-                d.geom_xmat,
-                b["geom_type"],
-                b["geom_size"],
-                int(cfg.refine_curved_hits),
-                float(cfg.min_distance),
-                float(cfg.max_distance),
-                float(cfg.range_noise_std),
-                float(cfg.dropout_prob),
+            kernels.finish_rays_rows,
+            (e, b_ - a),
+            [
+                *range_model,
                 -1.0,  # mjlab's miss value; get_distances() applies miss_distance
                 b["env_seed"],
                 b["frame"],
                 b["lut"],
                 a,
             ],
-            outputs=[
-                cols(work["distances"]),
-                cols(work["hit_mask"]),
-                cols(work["geom_ids"]),
-                cols(work["labels"]),
-                cols(work["points"]),
-            ],
-            device=dev,
+            [*labelled, cols(work["points"])],
         )
-        if not (self._hold or res.range_noise_per_meter or any(res.class_dropout)):
-            wp.launch(
-                mjlab_kernels.mjlab_misses,
-                dim=(e, b_ - a),
-                inputs=[cols(work["hit_mask"]), pnt],
-                outputs=[cols(work["points"]), cols(self._ray_normal)],
-                device=dev,
-            )
-            return
-        wp.launch(
+        self._per_ray(
             mjlab_kernels.mjlab_finish,
-            dim=(e, b_ - a),
-            inputs=[
+            mjlab_kernels.mjlab_finish_rows,
+            (e, b_ - a),
+            [
                 cols(work["distances"]),
                 cols(work["hit_mask"]),
                 cols(work["geom_ids"]),
@@ -662,9 +664,13 @@ class MjlabSemanticLidarSensor(RayCastSensor):
                 int(self._hold),
                 b["due"],
             ],
-            outputs=[cols(out[k]) for k in _PUBLISHED],
-            device=dev,
+            [cols(out[k]) for k in _PUBLISHED],
         )
+
+    def _per_ray(
+        self, grid: Any, rows: Any, dim: tuple[int, int], inputs: list, outputs: list
+    ) -> None:
+        kernels.launch_per_ray(grid, rows, dim, inputs, outputs, self._wp_device)
 
     def postprocess_rays(self) -> None:
         """Fresh results: drop data cached before this step's cast (nothing per ray),
