@@ -5,6 +5,8 @@ from __future__ import annotations
 import importlib.metadata
 import os
 import platform
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 
 def versions(packages: tuple[str, ...]) -> dict[str, str]:
@@ -18,10 +20,23 @@ def versions(packages: tuple[str, ...]) -> dict[str, str]:
     return out
 
 
+def cpu_model() -> str:
+    """The CPU's model name (Linux's /proc/cpuinfo; the platform's processor elsewhere)."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
 def machine(packages: tuple[str, ...] = ()) -> dict[str, object]:
     """CPU cores, 1-minute load average, GPU (torch's view) and package versions."""
     info: dict[str, object] = {
         "python": platform.python_version(),
+        "cpu": cpu_model(),
         "cpu_cores": os.cpu_count(),
         "load_average": round(os.getloadavg()[0], 2),
     }
@@ -38,7 +53,19 @@ def machine(packages: tuple[str, ...] = ()) -> dict[str, object]:
 def print_machine(info: dict[str, object]) -> None:
     """One line for the machine, one for the versions."""
     print(
-        f"Python {info['python']}, {info['cpu_cores']} CPU cores, load {info['load_average']}, "
-        f"GPU: {info['gpu'] or 'none'}"
+        f"Python {info['python']}, {info.get('cpu', 'unknown CPU')}, {info['cpu_cores']} CPU "
+        f"cores, load {info['load_average']}, GPU: {info['gpu'] or 'none'}"
     )
     print("versions: " + ", ".join(f"{k} {v}" for k, v in info["versions"].items()))
+
+
+@contextmanager
+def measured(packages: tuple[str, ...] = ()) -> Iterator[None]:
+    """Print the machine, the load and the versions (MuJoCo's and numpy's, and
+    ``packages``) before the block (a benchmark's figures), and the load after it: a
+    figure is read with the load it ran under."""
+    print_machine(machine(("mujoco", "numpy", *packages)))
+    try:
+        yield
+    finally:
+        print(f"load average after: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} CPU cores")

@@ -19,6 +19,8 @@ import time
 import warnings
 from pathlib import Path
 
+from _machine import measured
+
 from robotwright._paths import trusted_asset_roots
 from robotwright.parsers.convert import convert
 
@@ -66,4 +68,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with measured(("trimesh",)):
+        main()

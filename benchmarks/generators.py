@@ -28,6 +28,8 @@ import warnings
 from collections.abc import Callable
 from pathlib import Path
 
+from _machine import measured
+
 HERE = Path(__file__).resolve().parent
 #: The hurodes-written G1 that tools/fetch_test_data.py makes.
 DEFAULT_ROBOT = HERE.parent / ".testdata" / "hurodes-fixtures" / "g1_29"
@@ -299,4 +301,5 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with measured(("hurodes",)):
+        sys.exit(main())

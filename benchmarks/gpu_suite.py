@@ -213,6 +213,8 @@ def main(argv: list[str] | None = None) -> int:
         else:
             summary[section] = {"error": (done.stderr or done.stdout)[-1500:]}
             print(f"{section}: failed (exit {done.returncode})", flush=True)
+    summary["load_average_after"] = machine()["load_average"]
+    print(f"load average after: {summary['load_average_after']}")
     args.out.write_text(json.dumps(summary, indent=1))
     print(f"wrote {args.out}")
     return 0 if all("error" not in v for k, v in summary.items() if k in SECTIONS) else 1

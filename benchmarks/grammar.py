@@ -21,6 +21,8 @@ import warnings
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
 
+from _machine import measured
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import mujoco  # noqa: E402
@@ -173,4 +175,5 @@ def compare_search(g, max_links: int, budget: int = 300) -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with measured(("cma", "ray")):
+        sys.exit(main())

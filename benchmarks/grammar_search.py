@@ -23,6 +23,8 @@ import time
 import warnings
 from concurrent.futures import Executor, ProcessPoolExecutor
 
+from _machine import measured
+
 from robotwright.grammar import default_grammar
 from robotwright.grammar.derive import Counter, sample
 from robotwright.grammar.executors import usable_cores
@@ -97,4 +99,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with measured(("ray",)):
+        sys.exit(main())

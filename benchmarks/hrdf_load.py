@@ -20,6 +20,8 @@ import uuid
 import warnings
 from pathlib import Path
 
+from _machine import measured
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _timing import median_seconds, report, run_peer  # noqa: E402
 
@@ -82,4 +84,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with measured(("hurodes",)):
+        sys.exit(main())

@@ -27,6 +27,8 @@ import argparse
 import statistics
 import time
 
+from _machine import measured
+
 
 def scene_cfg(num_envs: int):
     import isaaclab.sim as sim_utils
@@ -159,4 +161,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with measured(("isaaclab", "newton", "warp-lang", "torch")):
+        main()

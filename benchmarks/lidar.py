@@ -41,6 +41,7 @@ from typing import NamedTuple
 import mujoco
 import numpy as np
 import trimesh
+from _machine import measured
 
 from robotwright.sensors import (
     FilePatternCfg,
@@ -394,7 +395,6 @@ def main() -> None:
     ap.add_argument("--scenes", nargs="+", default=["plane", "hfield"], choices=["plane", "hfield"])
     args = ap.parse_args()
     print(f"mujoco {mujoco.__version__}, {os.cpu_count()} CPU cores, {NUM_RAYS} rays/frame/env")
-    print(f"load average before: {os.getloadavg()[0]:.2f}")
     for kind in args.scenes:
         for n in args.envs:
             print(f"\nscene={kind} envs={n}  (median frame time)")
@@ -406,8 +406,8 @@ def main() -> None:
                     f"  {label:48s} {t * 1e3:9.2f} ms/frame {mrays:7.2f} Mrays/s"
                     f"  x{base / t:6.2f} vs raw  hits {hit:6.1%}"
                 )
-    print(f"\nload average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
-    main()
+    with measured(("mujoco-warp", "warp-lang", "mjlab", "mujoco-lidar")):
+        main()

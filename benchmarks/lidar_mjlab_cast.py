@@ -24,7 +24,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from _machine import machine, print_machine
+from _machine import measured
 from lidar_mjlab_step import mjlab_same_rays
 
 from robotwright.sensors import LivoxPatternCfg
@@ -117,7 +117,6 @@ def main() -> None:
     ap.add_argument("--envs", type=int, default=16)
     ap.add_argument("--scenes", nargs="+", default=["go1", "seeker"], choices=["go1", "seeker"])
     args = ap.parse_args()
-    print_machine(machine(("mujoco", "mujoco-warp", "warp-lang", "mjlab", "torch")))
     for scene in args.scenes:
         times = bench(scene, args.envs)
         base = times["mjlab RayCastSensor"]
@@ -126,8 +125,8 @@ def main() -> None:
         )
         for label, t in times.items():
             print(f"  {label:24s} {t * 1e3:8.2f} ms  {t / base:5.2f}x mjlab's")
-    print_machine(machine())  # the load after
 
 
 if __name__ == "__main__":
-    main()
+    with measured(("mujoco-warp", "warp-lang", "mjlab", "torch")):
+        main()

@@ -30,6 +30,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from _machine import measured
 
 from robotwright.sensors import LivoxPatternCfg, SemanticLidarCfg, SemanticLidarSensor
 
@@ -98,7 +99,6 @@ def main() -> None:
     pattern = LivoxPatternCfg(num_rays=20_000)
     dirs = pattern.rays(0)[1]
     print(f"{TASK}, {args.envs} envs, device {args.device}, {os.cpu_count()} CPU cores")
-    print(f"load average before: {os.getloadavg()[0]:.2f}")
     results: dict[str, float] = {}
 
     env = make_env(args.envs, args.device, [])
@@ -151,8 +151,8 @@ def main() -> None:
         if label.startswith("+ robotwright"):
             line += f"  {100 * (t - mj) / mj:+6.1f}% vs the step with mjlab's cast"
         print(line)
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
-    main()
+    with measured(("mujoco-warp", "warp-lang", "mjlab", "torch")):
+        main()

@@ -20,6 +20,8 @@ import sysconfig
 import time
 from pathlib import Path
 
+from _machine import measured
+
 ROOT = Path(__file__).resolve().parents[1]
 G1_MJCF = ROOT / ".testdata/mjlab/mjlab/asset_zoo/robots/unitree_g1/xmls/g1.xml"
 G1_URDF = (
@@ -108,4 +110,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    with measured(("hurodes",)):
+        raise SystemExit(main())

@@ -17,6 +17,7 @@ import time
 import warnings
 
 import mujoco
+from _machine import measured
 
 from robotwright.errors import ConversionWarning
 from robotwright.render import RenderError, RenderOptions, load_model, render_model
@@ -65,4 +66,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with measured(()):
+        main()

@@ -20,6 +20,7 @@ import warnings
 from pathlib import Path
 
 import mujoco
+from _machine import measured
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "parsers"))
 from test_roundtrip_scale import tree_urdf  # noqa: E402
@@ -49,4 +50,5 @@ def main(sizes: list[int]) -> None:
 
 
 if __name__ == "__main__":
-    main([int(a) for a in sys.argv[1:]] or [500, 1000, 2500])
+    with measured(()):
+        main([int(a) for a in sys.argv[1:]] or [500, 1000, 2500])

@@ -36,6 +36,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict
 from pathlib import Path
 
+from _machine import measured
+
 VARIANTS = (("labels", True), ("no labels", False))
 #: ``--policy pointnet``: the labels read as a point cloud by PointNet (no twin without
 #: labels: the classes are what its points carry).
@@ -231,4 +233,5 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with measured(("mjlab", "torch", "rsl-rl-lib")):
+        sys.exit(main())

@@ -14,6 +14,7 @@ import statistics
 import time
 
 import mujoco
+from _machine import measured
 
 from robotwright.things import Body, Capsule, Gyro, Hinge, JointPos, Motor, Site, World
 
@@ -120,4 +121,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with measured(()):
+        main()

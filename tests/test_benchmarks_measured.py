@@ -1,0 +1,39 @@
+"""Every benchmark prints what it ran on with its figures: the CPU model, the cores, the
+load average before and after, and the versions (benchmarks/_machine.py)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+SCRIPTS = sorted(p for p in BENCHMARKS.glob("*.py") if not p.name.startswith("_"))
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
+def test_every_benchmark_says_where_it_ran(script: Path) -> None:
+    text = script.read_text(encoding="utf-8")
+    # measured() prints the machine before and the load after; the two JSON-writing
+    # suites print the machine into their record and the load after by hand.
+    assert "measured(" in text or ("print_machine(" in text and "load average after" in text), (
+        script.name
+    )
+
+
+def test_measured_prints_cpu_load_and_versions() -> None:
+    code = (
+        "import sys; sys.path.insert(0, sys.argv[1]);"
+        "from _machine import measured\n"
+        "with measured(('numpy',)):\n    print('figures')"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", code, str(BENCHMARKS)], capture_output=True, text=True
+    )
+    assert run.returncode == 0, run.stderr
+    first, versions, figures, after = run.stdout.splitlines()
+    assert "CPU cores, load" in first and first.startswith("Python ")
+    assert versions.startswith("versions: robotwright ") and "numpy" in versions
+    assert figures == "figures" and after.startswith("load average after: ")
