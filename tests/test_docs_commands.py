@@ -36,7 +36,10 @@ INTERACTIVE = {"view"}
 _TIMING = re.compile(r"\d s\b|/s\b")
 #: What a command prints on stderr only when a step runs long on this machine (progress
 #: lines, the announcement of long work): not counted in the one-line rule.
-_SLOW_WORK = re.compile(r"^  \d+/\d+ .+ \(\d.*\)$|\(estimated\); progress follows")
+#: Progress lines of slow work: ``  12/60 links read (4 s, ...)`` and ``  WHAT (4 s)``.
+_SLOW_WORK = re.compile(
+    r"^  \d+/\d+ .+ \(\d.*\)$|^  \S.* \(\d[^()]*\)$|\(estimated\); progress follows"
+)
 
 
 def commands(document: Path) -> list[tuple[str, list[str]]]:

@@ -127,3 +127,16 @@ def test_an_unknown_name_says_which_package_brings_more_robots(monkeypatch, caps
     assert "no robot named 'go2'" in err
     assert "pip install example-robot-data" in err
     assert "robotwright[menagerie]" in err
+
+
+def test_a_floating_robot_already_standing_is_written_as_it_is(tmp_path, capsys) -> None:
+    from robotwright.generators.standing import stand_on_floor
+    from robotwright.tasks import load_robot
+
+    humanoid = load_robot("mini_humanoid")  # a free base set above the floor by its file
+    assert humanoid.floating_base
+    assert stand_on_floor(humanoid) == (humanoid, [])
+    out = tmp_path / "mini.xml"
+    assert main(["export", "mini_humanoid", "-o", str(out)]) == 0
+    assert "keyframe" not in capsys.readouterr().err
+    assert mujoco.MjModel.from_xml_path(str(out)).nkey == 0

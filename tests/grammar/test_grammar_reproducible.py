@@ -100,7 +100,10 @@ def test_pool_workers_die_with_a_search_killed_by_sigkill(tmp_path: Path) -> Non
 
             def ready(parent):
                 die_with_parent(parent)
-                print(f"worker {os.getpid()} ready", flush=True)
+                # One write of the whole line: print() writes the text and its newline
+                # apart when output is unbuffered (pytest-xdist runs with -u), and two
+                # workers' lines then interleave.
+                os.write(1, f"worker {os.getpid()} ready\\n".encode())
             """
         )
     )

@@ -153,7 +153,8 @@ def stand_on_floor(
 ) -> tuple[HRDF, list[str]]:
     """The robot standing on the floor, for an MJCF file: a free base whose collision
     geometry reaches below z = 0 in its reference pose is raised until it touches it,
-    and, when the robot has no keyframe, a ``home`` keyframe holds the base at its
+    and then, or when ``joint_pos`` is given, a robot without keyframes gets a ``home``
+    keyframe that holds the base at its
     standing height [m] in the joint positions of ``joint_pos`` (see
     :func:`initial_state`; the reference pose, clamped into the ranges, without it) and
     the controls that hold it (a position servo's target is its joint's position).
@@ -187,6 +188,8 @@ def stand_on_floor(
                 f"robot {shown(hrdf.name)} has keyframes of its own: --joint-pos would "
                 "add a home keyframe beside them"
             )
+        return hrdf, changes
+    if not changes and not joint_pos:  # standing already, as its file says: kept as is
         return hrdf, changes
     home, joints, clamped = initial_state(model, joint_pos)
     qpos = model.qpos0.copy()
