@@ -55,7 +55,7 @@ def trans(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
 def mat2quat(R: np.ndarray) -> tuple[float, float, float, float]:
     """Quaternion (w >= 0, so equal rotations give equal text) of a rotation matrix, with
     float noise rounded away."""
-    return tuple(float(v) for v in _clean(np.array(mat_to_quat(R))))  # type: ignore[return-value]
+    return _clean_floats(mat_to_quat(R))  # type: ignore[return-value]
 
 
 def _clean(v: np.ndarray) -> np.ndarray:
@@ -63,12 +63,15 @@ def _clean(v: np.ndarray) -> np.ndarray:
     return np.where(np.abs(v) < 1e-12, 0.0, np.round(v, 12))
 
 
+def _clean_floats(v) -> tuple[float, ...]:  # noqa: ANN001 - any iterable of numbers
+    """:func:`_clean` on plain floats: numpy's round(x, 12) is rint(x * 1e12) / 1e12,
+    which Python's round() to an int (exact below 2**53) followed by the division
+    repeats, without numpy's cost on a few values (the search builds thousands)."""
+    return tuple(0.0 if abs(x) < 1e-12 else round(x * 1e12) / 1e12 for x in map(float, v))
+
+
 def _vec(v: np.ndarray) -> tuple[float, float, float]:
-    # _clean on plain floats: numpy's round(x, 12) is rint(x * 1e12) / 1e12, which
-    # Python's round() to an int (exact below 2**53) followed by the division repeats.
-    return tuple(  # type: ignore[return-value]
-        0.0 if abs(x) < 1e-12 else round(x * 1e12) / 1e12 for x in map(float, v)
-    )
+    return _clean_floats(v)  # type: ignore[return-value]
 
 
 def _rigid_inv(T: np.ndarray) -> np.ndarray:
@@ -272,7 +275,7 @@ class Limb:
                 {
                     "mass": float(model.body_mass[i]),
                     "inertial_pos": _vec(model.body_ipos[i]),
-                    "inertial_quat": tuple(float(v) for v in _clean(model.body_iquat[i])),
+                    "inertial_quat": _clean_floats(model.body_iquat[i]),
                     "diag_inertia": _vec(model.body_inertia[i]),
                 }
             )
