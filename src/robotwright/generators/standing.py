@@ -3,7 +3,8 @@ standing form of an HRDF for MJCF export, and which of its bodies say that it wa
 
 A free base read from a URDF sits at the world origin, so a legged robot's legs reach
 below the floor: :func:`stand_on_floor` raises the base until its lowest collision geom
-touches z = 0 and adds a ``home`` keyframe, the pose a simulator resets to.
+touches z = 0 and adds a ``home`` keyframe, the pose a simulator resets to. Only the
+MJCF export writes it so: the robot itself (its HRDF) is not changed.
 """
 
 from __future__ import annotations
@@ -58,8 +59,9 @@ def initial_state(
     whose fnmatch pattern matches its name (a user's standing pose, rad or m), else the
     MJCF's reference pose clamped into the joint's range (Isaac Lab checks ranges). A
     free base is raised so that its collision geometry, in that pose, stands on z = 0
-    (in the USD of :func:`~robotwright.generators.isaaclab_cfg.write_articulation_cfg` the root body sits at its prim's
-    origin, so this position is where the base spawns and where a reset puts it).
+    (in the USD of :func:`~robotwright.generators.isaaclab_cfg.write_articulation_cfg`
+    the root body sits at its prim's origin, so this position is where the base spawns
+    and where a reset puts it).
 
     Raises:
         GeneratorError: a pattern matches no joint, or a value lies outside the range of
@@ -154,12 +156,11 @@ def stand_on_floor(
     """The robot standing on the floor, for an MJCF file: a free base whose collision
     geometry reaches below z = 0 in its reference pose is raised until it touches it,
     and then, or when ``joint_pos`` is given, a robot without keyframes gets a ``home``
-    keyframe that holds the base at its
-    standing height [m] in the joint positions of ``joint_pos`` (see
-    :func:`initial_state`; the reference pose, clamped into the ranges, without it) and
-    the controls that hold it (a position servo's target is its joint's position).
-    A fixed base gets the keyframe only with ``joint_pos``. Returns the robot and
-    a line for each change made.
+    keyframe that holds the base at its standing height [m] in the joint positions of
+    ``joint_pos`` (see :func:`initial_state`; the reference pose, clamped into the
+    ranges, without it) and the controls that hold it (a position servo's target is its
+    joint's position). A fixed base gets the keyframe only with ``joint_pos``. Returns
+    the robot and a line for each change made.
 
     Raises:
         GeneratorError: as :func:`initial_state`.
@@ -172,9 +173,8 @@ def stand_on_floor(
     changes = []
     root = hrdf.root_body
     pos = initial_state(model)[0]
-    if (
-        hrdf.floating_base and pos[2] > root.pos[2] + 1e-9
-    ):  # only raised: a base set above the floor stays there
+    # Only raised: a base its file sets above the floor stays there.
+    if hrdf.floating_base and pos[2] > root.pos[2] + 1e-9:
         changes.append(
             f"robot {shown(hrdf.name)}: free base {shown(root.name)} raised from z = "
             f"{root.pos[2]:.4g} to {pos[2]:.4g} m, its lowest collision geom on the floor"
