@@ -6,10 +6,12 @@ graph (a CUDA graph on GPU). Inside that graph, per step, it launches robotwrigh
 kernels around mjlab's ray cast: ``advance_frame`` (the pattern window, counter on the
 device), ``sensor_pose`` (sensor and carrier frame poses), ``world_rays`` (the window of
 the pattern table), MuJoCo Warp ``rays`` (the call of mjlab's ``RayCastSensor`` with its
-arguments: BVH, parent-body exclusion, geom-group filter), ``finish_rays`` (float64
-refinement of curved hits, range model, labels, points) and ``mjlab_misses`` (mjlab's
-miss values); on warp's CPU device the last four run in column blocks on parallel
-threads. Nothing runs on the host per step and nothing is copied: mjlab's
+arguments: BVH, parent-body exclusion, geom-group filter) and ``finish_rays_mjlab``
+(float64 refinement of curved hits, range model, labels, points and mjlab's miss
+values in one pass; with realism options or held scans, ``finish_rays`` then
+``mjlab_finish``). On warp's CPU device the per-ray kernels run in column blocks on
+parallel threads, each a thread per environment looping over its rays (their row form:
+a 2-D launch's index costs more there than their work); on CUDA a thread a ray. Nothing runs on the host per step and nothing is copied: mjlab's
 ``prepare_rays`` (host, before the graph) is replaced by the in-graph kernels and
 ``postprocess_rays`` (host, after it) only marks the data fresh.
 
