@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -83,6 +84,10 @@ _NOTED_URDF = """<robot name="noted"><link name="base"><inertial><mass value="1"
 <limit lower="-1" upper="1" effort="10" velocity="2"/></joint></robot>"""
 
 
+#: A progress line of ``robotwright._progress.working``: ``  drawing noted.png (2 s)``.
+_PROGRESS = re.compile(r"^  drawing \S+ \(\d[^()]*\)$")
+
+
 @pytest.mark.parametrize("verbose", [False, True])
 def test_reading_notes_are_shown_with_v_only(tmp_path: Path, verbose) -> None:
     """A drawing writes no conversion: what reading the robot noted (here its effort and
@@ -101,5 +106,5 @@ def test_reading_notes_are_shown_with_v_only(tmp_path: Path, verbose) -> None:
     assert run.returncode == 0, run.stderr
     assert out.is_file()
     assert ("effort/velocity limits" in run.stderr) is verbose
-    if not verbose:
-        assert run.stderr == ""
+    if not verbose:  # nothing but the progress of a slow drawing (a busy machine)
+        assert [ln for ln in run.stderr.splitlines() if not _PROGRESS.match(ln)] == []
