@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -36,7 +37,6 @@ def test_bundled_robots_render_with_no_notes(robot: str, tmp_path: Path, capsys)
 def _closed_reader(argv: list[str]) -> subprocess.CompletedProcess:
     """Run ``robotwright ARGV`` with stdout a pipe whose reader is already gone."""
     import os
-import re
 
     read, write = os.pipe()
     os.close(read)
