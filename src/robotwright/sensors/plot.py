@@ -205,7 +205,7 @@ def plot_scan(
     # The views get what the legend leaves: its height measured once drawn.
     fig.canvas.draw()
     below = legend.get_window_extent().height / fig.bbox.height
-    fig.tight_layout(rect=(0, min(below + 0.02, 0.6), 1, 0.97))
+    fig.tight_layout(rect=(0, min(below + 0.05, 0.6), 1, 0.97))
     path = Path(path)
     try:
         with atomic_open(path, "wb") as fh:
