@@ -88,7 +88,8 @@ def _compile_source(
             **compiler,
         )
         fuse = options.get("fixed_joints", "keep") == "merge"
-        return compile_urdf(text, options.get("density"), fuse_static=fuse), None
+        floating = bool(options.get("floating_base"))
+        return compile_urdf(text, options.get("density"), fuse_static=fuse, floating=floating), None
     except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
         return None
 

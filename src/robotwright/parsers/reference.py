@@ -208,7 +208,7 @@ def urdf_for_mujoco(
 
 
 def compile_urdf(
-    text: str, density: float | None = None, *, fuse_static: bool = False
+    text: str, density: float | None = None, *, fuse_static: bool = False, floating: bool = False
 ) -> mujoco.MjModel:
     """MuJoCo's import of a URDF text (as :func:`urdf_for_mujoco` writes it), compiled.
 
@@ -219,6 +219,10 @@ def compile_urdf(
 
     ``density``: kg/m^3 given to the collision geoms (MuJoCo's import gives them its
     default, 1000; a URDF cannot say otherwise), for the links without ``<inertial>``.
+
+    ``floating``: the root body gets a free joint named as the URDF reader names it
+    (``floating_base``, ``_`` appended while a joint holds the name): the reference of
+    ``floating_base=True``, so that the free base the user asked for is not a difference.
 
     On MuJoCo 4.x this is ``MjModel.from_xml_string(text)``. Where the installed MuJoCo
     gets a URDF wrong (3.11; each found by a probe), the import is completed so that the
@@ -237,6 +241,7 @@ def compile_urdf(
         and mujoco_urdf_keeps_mesh_files_apart()
         and density is None
         and not fuse_static
+        and not floating
     ):
         return mujoco.MjModel.from_xml_string(text)
     root = DET.fromstring(text)
@@ -246,6 +251,12 @@ def compile_urdf(
         if assets:
             text = ET.tostring(root, encoding="unicode")
     spec = mujoco.MjSpec.from_string(text, assets=assets or None)
+    if floating:
+        taken = {j.name for j in spec.joints}
+        name = "floating_base"
+        while name in taken:
+            name += "_"
+        spec.worldbody.first_body().add_freejoint(name=name)
     if fuse_static:
         spec.compiler.fusestatic = True
         # A body a sensor refers to is not fused: the root stays the robot's base. (A
