@@ -67,7 +67,7 @@ def _clean_floats(v) -> tuple[float, ...]:  # noqa: ANN001 - any iterable of num
     """:func:`_clean` on plain floats: numpy's round(x, 12) is rint(x * 1e12) / 1e12,
     which Python's round() to an int (exact below 2**53) followed by the division
     repeats, without numpy's cost on a few values (the search builds thousands)."""
-    return tuple(0.0 if abs(x) < 1e-12 else round(x * 1e12) / 1e12 for x in map(float, v))
+    return tuple([0.0 if abs(x) < 1e-12 else round(x * 1e12) / 1e12 for x in map(float, v)])
 
 
 def _vec(v: np.ndarray) -> tuple[float, float, float]:
