@@ -136,8 +136,10 @@ def test_the_benchmark_trains_both_variants_and_prints_the_comparison(tmp_path) 
         timeout=600,
     )
     assert done.returncode == 0, done.stderr[-3000:]
-    last = done.stdout.strip().splitlines()[-1]
+    # The comparison is the last figure; the load after the run follows it.
+    *_, last, after = done.stdout.strip().splitlines()
     assert last.startswith("at target: labels ")
+    assert after.startswith("load average after: ")
     values = [float(v.split()[-1]) for v in last.split(":", 1)[1].split(",")]
     assert len(values) == 2 and all(0.0 <= v <= 1.0 and not math.isnan(v) for v in values)
     assert (tmp_path / "seeker_runs.json").is_file()
