@@ -128,29 +128,6 @@ def sensor_pose_per_env(
     )
 
 
-@wp.func
-def _world_ray(
-    table_o: wp.array(dtype=wp.vec3),
-    table_d: wp.array(dtype=wp.vec3),
-    window: wp.array(dtype=wp.int32),
-    ray_offset: wp.int32,
-    pos_w: wp.array(dtype=wp.vec3),
-    ray_rot: wp.array(dtype=wp.mat33),
-    pnt: wp.array2d(dtype=wp.vec3),
-    vec: wp.array2d(dtype=wp.vec3),
-    e: wp.int32,
-    i: wp.int32,
-):
-    """World rays of every environment: the frame's window of the table, rotated and moved.
-
-    ``pnt``/``vec`` may be a column slice of the frame's rays starting at ``ray_offset``.
-    """
-    k = window[0] + ray_offset + i
-    r = ray_rot[e]
-    pnt[e, i] = pos_w[e] + r @ table_o[k]
-    vec[e, i] = r @ table_d[k]
-
-
 @wp.kernel
 def world_rays(
     table_o: wp.array(dtype=wp.vec3),
@@ -161,29 +138,24 @@ def world_rays(
     ray_rot: wp.array(dtype=wp.mat33),
     pnt: wp.array2d(dtype=wp.vec3),
     vec: wp.array2d(dtype=wp.vec3),
-):
-    """:func:`_world_ray` on a ``(E, N)`` grid (CUDA: a thread a ray)."""
-    e, i = wp.tid()
-    _world_ray(table_o, table_d, window, ray_offset, pos_w, ray_rot, pnt, vec, e, i)
-
-
-@wp.kernel
-def world_rays_rows(
-    table_o: wp.array(dtype=wp.vec3),
-    table_d: wp.array(dtype=wp.vec3),
-    window: wp.array(dtype=wp.int32),
-    ray_offset: wp.int32,
-    pos_w: wp.array(dtype=wp.vec3),
-    ray_rot: wp.array(dtype=wp.mat33),
-    pnt: wp.array2d(dtype=wp.vec3),
-    vec: wp.array2d(dtype=wp.vec3),
     count: wp.int32,
+    step: wp.int32,
 ):
-    """:func:`_world_ray` a row at a time (warp's CPU device: a loop over the ``count``
-    rays of environment ``e`` costs less than a 2-D launch's index per ray)."""
-    e = wp.tid()
-    for i in range(count):
-        _world_ray(table_o, table_d, window, ray_offset, pos_w, ray_rot, pnt, vec, e, i)
+    """World rays of every environment: the frame's window of the table, rotated and moved.
+
+    ``pnt``/``vec`` may be a column slice of the frame's rays starting at ``ray_offset``.
+
+    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
+    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
+    warp's CPU device a thread per environment looping over its rays, where a 2-D
+    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    e, c = wp.tid()
+    first = c * step
+    for i in range(first, wp.min(first + step, count)):
+        k = window[0] + ray_offset + i
+        r = ray_rot[e]
+        pnt[e, i] = pos_w[e] + r @ table_o[k]
+        vec[e, i] = r @ table_d[k]
 
 
 @wp.func
@@ -387,76 +359,6 @@ def ranged_hit(
     return hit, d
 
 
-@wp.func
-def _finish_ray(
-    raw_dist: wp.array2d(dtype=wp.float32),
-    raw_geom: wp.array2d(dtype=wp.int32),
-    pnt: wp.array2d(dtype=wp.vec3),
-    vec: wp.array2d(dtype=wp.vec3),
-    geom_xpos: wp.array2d(dtype=wp.vec3),
-    geom_xmat: wp.array2d(dtype=wp.mat33),
-    geom_type: wp.array(dtype=wp.int32),
-    geom_size: wp.array(dtype=wp.vec3d),
-    refine: wp.int32,
-    min_distance: wp.float32,
-    max_distance: wp.float32,
-    noise_std: wp.float32,
-    dropout_prob: wp.float32,
-    miss_distance: wp.float32,
-    env_seed: wp.array(dtype=wp.int32),
-    frame: wp.array(dtype=wp.int32),
-    label_lut: wp.array(dtype=wp.int32),
-    ray_offset: wp.int32,
-    distances: wp.array2d(dtype=wp.float32),
-    hit_mask: wp.array2d(dtype=wp.bool),
-    geom_ids: wp.array2d(dtype=wp.int32),
-    labels: wp.array2d(dtype=wp.int32),
-    points: wp.array2d(dtype=wp.vec3),
-    e: wp.int32,
-    i: wp.int32,
-):
-    """Range model, labels and points of every ray (see the module docstring).
-
-    A ray is a miss when it hits nothing, hits nearer than ``min_distance`` or further
-    than ``max_distance``, or is dropped; noise is added to hits only and clipped to
-    ``[min_distance, max_distance]``. Misses: distance ``miss_distance``, mask False,
-    geom id -1, label 0, point NaN. The arrays may be a column slice of the frame's rays
-    starting at ``ray_offset`` (the random stream of a ray depends on its index only).
-    """
-    g = raw_geom[e, i]
-    hit, d = ranged_hit(
-        raw_dist,
-        raw_geom,
-        pnt,
-        vec,
-        geom_xpos,
-        geom_xmat,
-        geom_type,
-        geom_size,
-        refine,
-        min_distance,
-        max_distance,
-        noise_std,
-        dropout_prob,
-        env_seed,
-        frame,
-        ray_offset,
-        e,
-        i,
-    )
-    hit_mask[e, i] = hit
-    if hit:
-        distances[e, i] = d
-        geom_ids[e, i] = g
-        labels[e, i] = label_lut[g]
-        points[e, i] = pnt[e, i] + d * vec[e, i]
-    else:
-        distances[e, i] = miss_distance
-        geom_ids[e, i] = -1
-        labels[e, i] = 0
-        points[e, i] = wp.vec3(wp.nan, wp.nan, wp.nan)
-
-
 @wp.kernel
 def finish_rays(
     raw_dist: wp.array2d(dtype=wp.float32),
@@ -482,70 +384,26 @@ def finish_rays(
     geom_ids: wp.array2d(dtype=wp.int32),
     labels: wp.array2d(dtype=wp.int32),
     points: wp.array2d(dtype=wp.vec3),
-):
-    """:func:`_finish_ray` on a ``(E, N)`` grid (CUDA: a thread a ray)."""
-    e, i = wp.tid()
-    _finish_ray(
-        raw_dist,
-        raw_geom,
-        pnt,
-        vec,
-        geom_xpos,
-        geom_xmat,
-        geom_type,
-        geom_size,
-        refine,
-        min_distance,
-        max_distance,
-        noise_std,
-        dropout_prob,
-        miss_distance,
-        env_seed,
-        frame,
-        label_lut,
-        ray_offset,
-        distances,
-        hit_mask,
-        geom_ids,
-        labels,
-        points,
-        e,
-        i,
-    )
-
-
-@wp.kernel
-def finish_rays_rows(
-    raw_dist: wp.array2d(dtype=wp.float32),
-    raw_geom: wp.array2d(dtype=wp.int32),
-    pnt: wp.array2d(dtype=wp.vec3),
-    vec: wp.array2d(dtype=wp.vec3),
-    geom_xpos: wp.array2d(dtype=wp.vec3),
-    geom_xmat: wp.array2d(dtype=wp.mat33),
-    geom_type: wp.array(dtype=wp.int32),
-    geom_size: wp.array(dtype=wp.vec3d),
-    refine: wp.int32,
-    min_distance: wp.float32,
-    max_distance: wp.float32,
-    noise_std: wp.float32,
-    dropout_prob: wp.float32,
-    miss_distance: wp.float32,
-    env_seed: wp.array(dtype=wp.int32),
-    frame: wp.array(dtype=wp.int32),
-    label_lut: wp.array(dtype=wp.int32),
-    ray_offset: wp.int32,
-    distances: wp.array2d(dtype=wp.float32),
-    hit_mask: wp.array2d(dtype=wp.bool),
-    geom_ids: wp.array2d(dtype=wp.int32),
-    labels: wp.array2d(dtype=wp.int32),
-    points: wp.array2d(dtype=wp.vec3),
     count: wp.int32,
+    step: wp.int32,
 ):
-    """:func:`_finish_ray` a row at a time (warp's CPU device: a loop over the ``count``
-    rays of environment ``e`` costs less than a 2-D launch's index per ray)."""
-    e = wp.tid()
-    for i in range(count):
-        _finish_ray(
+    """Range model, labels and points of every ray (see the module docstring).
+
+    A ray is a miss when it hits nothing, hits nearer than ``min_distance`` or further
+    than ``max_distance``, or is dropped; noise is added to hits only and clipped to
+    ``[min_distance, max_distance]``. Misses: distance ``miss_distance``, mask False,
+    geom id -1, label 0, point NaN. The arrays may be a column slice of the frame's rays
+    starting at ``ray_offset`` (the random stream of a ray depends on its index only).
+
+    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
+    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
+    warp's CPU device a thread per environment looping over its rays, where a 2-D
+    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    e, c = wp.tid()
+    first = c * step
+    for i in range(first, wp.min(first + step, count)):
+        g = raw_geom[e, i]
+        hit, d = ranged_hit(
             raw_dist,
             raw_geom,
             pnt,
@@ -559,29 +417,33 @@ def finish_rays_rows(
             max_distance,
             noise_std,
             dropout_prob,
-            miss_distance,
             env_seed,
             frame,
-            label_lut,
             ray_offset,
-            distances,
-            hit_mask,
-            geom_ids,
-            labels,
-            points,
             e,
             i,
         )
+        hit_mask[e, i] = hit
+        if hit:
+            distances[e, i] = d
+            geom_ids[e, i] = g
+            labels[e, i] = label_lut[g]
+            points[e, i] = pnt[e, i] + d * vec[e, i]
+        else:
+            distances[e, i] = miss_distance
+            geom_ids[e, i] = -1
+            labels[e, i] = 0
+            points[e, i] = wp.vec3(wp.nan, wp.nan, wp.nan)
 
 
 def launch_per_ray(
-    grid: Any, rows: Any, dim: tuple[int, int], inputs: list, outputs: list, device: Any
+    kernel: Any, dim: tuple[int, int], inputs: list, outputs: list, device: Any
 ) -> None:
-    """Launch a per-ray kernel over ``dim`` = (environments, rays): on CUDA its ``(E, N)``
-    grid, on warp's CPU device its row form (a thread per environment looping over its
-    rays: there a 2-D launch's index costs more per ray than a light kernel's work;
-    measured 2.4x faster on 320,000 rays)."""
-    if device.is_cuda:
-        wp.launch(grid, dim=dim, inputs=inputs, outputs=outputs, device=device)
-    else:
-        wp.launch(rows, dim=dim[0], inputs=[*inputs, *outputs, dim[1]], device=device)
+    """Launch a per-ray kernel (its last parameters ``count, step``) over ``dim`` =
+    (environments, rays): on CUDA a thread a ray (``(E, N)`` threads, ``step`` 1), on
+    warp's CPU device a thread per environment looping over its rays (``(E, 1)``,
+    ``step`` N): there a 2-D launch's index costs more per ray than a light kernel's
+    work (measured 2.4x faster on 320,000 rays)."""
+    e, n = dim
+    grid, step = ((e, n), 1) if device.is_cuda else ((e, 1), n)
+    wp.launch(kernel, dim=grid, inputs=[*inputs, *outputs, n, step], device=device)

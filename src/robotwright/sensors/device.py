@@ -282,7 +282,6 @@ class WarpLidarPipeline:
         with wp.ScopedDevice(self.device):
             k.launch_per_ray(
                 k.world_rays,
-                k.world_rays_rows,
                 (e, b - a),
                 [self.table_o, self.table_d, self.window, a, self.pos_w, self.ray_rot],
                 [pnt, vec],
@@ -303,7 +302,6 @@ class WarpLidarPipeline:
             )
             k.launch_per_ray(
                 k.finish_rays,
-                k.finish_rays_rows,
                 (e, b - a),
                 [
                     raw_dist,

@@ -10,8 +10,9 @@ arguments: BVH, parent-body exclusion, geom-group filter) and ``finish_rays_mjla
 (float64 refinement of curved hits, range model, labels, points and mjlab's miss
 values in one pass; with realism options or held scans, ``finish_rays`` then
 ``mjlab_finish``). On warp's CPU device the per-ray kernels run in column blocks on
-parallel threads, each a thread per environment looping over its rays (their row form:
-a 2-D launch's index costs more there than their work); on CUDA a thread a ray. Nothing runs on the host per step and nothing is copied: mjlab's
+parallel threads, each a thread per environment looping over its rays (a 2-D launch's
+index costs more there than their work); on CUDA a thread a ray. Nothing runs on the
+host per step and nothing is copied: mjlab's
 ``prepare_rays`` (host, before the graph) is replaced by the in-graph kernels and
 ``postprocess_rays`` (host, after it) only marks the data fresh.
 
@@ -568,7 +569,6 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         res, work, out = self.resolved, self._work, self._out
         self._per_ray(
             mjlab_kernels.world_rays_windowed,
-            mjlab_kernels.world_rays_windowed_rows,
             (e, b_ - a),
             [
                 b["table_o"],
@@ -623,7 +623,6 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             # The plain case: one pass writes the published arrays with mjlab's misses.
             self._per_ray(
                 mjlab_kernels.finish_rays_mjlab,
-                mjlab_kernels.finish_rays_mjlab_rows,
                 (e, b_ - a),
                 [*range_model, b["env_seed"], b["frame"], b["lut"], a],
                 [*labelled, cols(work["points"]), cols(self._ray_normal)],
@@ -631,7 +630,6 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             return
         self._per_ray(
             kernels.finish_rays,
-            kernels.finish_rays_rows,
             (e, b_ - a),
             [
                 *range_model,
@@ -645,7 +643,6 @@ class MjlabSemanticLidarSensor(RayCastSensor):
         )
         self._per_ray(
             mjlab_kernels.mjlab_finish,
-            mjlab_kernels.mjlab_finish_rows,
             (e, b_ - a),
             [
                 cols(work["distances"]),
@@ -669,10 +666,8 @@ class MjlabSemanticLidarSensor(RayCastSensor):
             [cols(out[k]) for k in _PUBLISHED],
         )
 
-    def _per_ray(
-        self, grid: Any, rows: Any, dim: tuple[int, int], inputs: list, outputs: list
-    ) -> None:
-        kernels.launch_per_ray(grid, rows, dim, inputs, outputs, self._wp_device)
+    def _per_ray(self, kernel: Any, dim: tuple[int, int], inputs: list, outputs: list) -> None:
+        kernels.launch_per_ray(kernel, dim, inputs, outputs, self._wp_device)
 
     def postprocess_rays(self) -> None:
         """Fresh results: drop data cached before this step's cast (nothing per ray),
