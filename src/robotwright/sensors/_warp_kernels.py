@@ -145,10 +145,8 @@ def world_rays(
 
     ``pnt``/``vec`` may be a column slice of the frame's rays starting at ``ray_offset``.
 
-    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
-    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
-    warp's CPU device a thread per environment looping over its rays, where a 2-D
-    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    Thread ``(e, c)``: rays ``[c * step, (c + 1) * step)`` of environment ``e``, as
+    :func:`launch_per_ray` launches it."""
     e, c = wp.tid()
     first = c * step
     for i in range(first, wp.min(first + step, count)):
@@ -395,10 +393,8 @@ def finish_rays(
     geom id -1, label 0, point NaN. The arrays may be a column slice of the frame's rays
     starting at ``ray_offset`` (the random stream of a ray depends on its index only).
 
-    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
-    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
-    warp's CPU device a thread per environment looping over its rays, where a 2-D
-    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    Thread ``(e, c)``: rays ``[c * step, (c + 1) * step)`` of environment ``e``, as
+    :func:`launch_per_ray` launches it."""
     e, c = wp.tid()
     first = c * step
     for i in range(first, wp.min(first + step, count)):

@@ -108,10 +108,8 @@ def world_rays_windowed(
     ``due`` gets rays that start far above the world and point up: the BVH's root
     box turns them away at once, so its held scan costs next to no cast.
 
-    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
-    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
-    warp's CPU device a thread per environment looping over its rays, where a 2-D
-    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    Thread ``(e, c)``: rays ``[c * step, (c + 1) * step)`` of environment ``e``, as
+    :func:`~robotwright.sensors._warp_kernels.launch_per_ray` launches it."""
     e, c = wp.tid()
     first = c * step
     for i in range(first, wp.min(first + step, count)):
@@ -168,10 +166,8 @@ def finish_rays_mjlab(
     of this adapter, scans published every step), where :func:`mjlab_finish` has
     nothing else to do.
 
-    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
-    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
-    warp's CPU device a thread per environment looping over its rays, where a 2-D
-    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    Thread ``(e, c)``: rays ``[c * step, (c + 1) * step)`` of environment ``e``, as
+    :func:`~robotwright.sensors._warp_kernels.launch_per_ray` launches it."""
     e, c = wp.tid()
     first = c * step
     for i in range(first, wp.min(first + step, count)):
@@ -247,10 +243,8 @@ def mjlab_finish(
     ``hold`` is 0 (they may be the arrays read), else only where the environment's scan
     is ``due`` (the others keep their last published scan).
 
-    Thread ``(e, c)`` handles rays ``[c * step, (c + 1) * step)`` of environment
-    ``e`` (fewer at the end of ``count``): on CUDA ``step`` 1, a thread a ray; on
-    warp's CPU device a thread per environment looping over its rays, where a 2-D
-    launch's index costs more per ray than the work (see :func:`launch_per_ray`)."""
+    Thread ``(e, c)``: rays ``[c * step, (c + 1) * step)`` of environment ``e``, as
+    :func:`~robotwright.sensors._warp_kernels.launch_per_ray` launches it."""
     e, c = wp.tid()
     first = c * step
     for i in range(first, wp.min(first + step, count)):
