@@ -1,7 +1,7 @@
 """Cost of the proof of a conversion: ``convert`` with and without it, on one robot.
 
 The proof compiles the source and the output with MuJoCo and compares every per-object
-array (see :mod:`robotwright.parsers.proof`); issue 20 keeps ``convert`` within 1.5x of
+array (see :mod:`robotwright.proof.compare`); issue 20 keeps ``convert`` within 1.5x of
 its time without it. Prints the median of each over ``--repeat`` runs (each in a fresh
 temporary folder, after one warm-up of each) and their ratio.
 
@@ -22,7 +22,7 @@ from pathlib import Path
 from _machine import measured
 
 from robotwright._paths import trusted_asset_roots
-from robotwright.parsers.convert import convert
+from robotwright.proof.convert import convert
 
 ROOT = Path(__file__).resolve().parents[1]
 G1 = ROOT / ".testdata" / "hurodes-fixtures" / "sources" / "g1_29.xml"

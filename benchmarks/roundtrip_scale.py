@@ -25,7 +25,7 @@ from _machine import measured
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "parsers"))
 from test_roundtrip_scale import tree_urdf  # noqa: E402
 
-from robotwright.parsers.roundtrip import roundtrip  # noqa: E402
+from robotwright.proof.roundtrip.run import roundtrip  # noqa: E402
 
 
 def main(sizes: list[int]) -> None:

@@ -44,7 +44,7 @@ def go2_usd(folder: Path) -> Path:
     import mujoco_usd_converter
 
     from robotwright.catalog import find_entry
-    from robotwright.parsers.convert import convert
+    from robotwright.proof.convert import convert
 
     entry = find_entry("go2")
     if entry is None:

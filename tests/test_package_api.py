@@ -58,3 +58,41 @@ def test_unknown_attribute_is_an_attribute_error() -> None:
     with pytest.raises(AttributeError):
         robotwright.no_such_part  # noqa: B018
     assert hasattr(robotwright, "view") and "view" in dir(robotwright)
+
+
+def test_the_readers_face_keeps_the_proofs_old_names_without_importing_them() -> None:
+    """``robotwright.parsers.convert``, ``.prove`` and ``.roundtrip`` (names of the proof
+    layer since it left the readers) are the proof's own functions; importing the
+    readers' package imports neither the proof nor a writer."""
+    done = _run(
+        "import sys\n"
+        "import robotwright.parsers as readers\n"
+        "before = sorted(m for m in sys.modules if m.startswith(('robotwright.proof',"
+        " 'robotwright.generators')))\n"
+        "import robotwright.proof as proof\n"
+        "same = [getattr(readers, n) is getattr(proof, n) and callable(getattr(proof, n))"
+        " for n in ('convert', 'prove', 'roundtrip')]\n"
+        "print(before, same)"
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[] [True, True, True]"
+
+
+@pytest.mark.parametrize(
+    ("module", "names"),
+    [
+        ("robotwright.parsers.mjcf", ("MJCFOptions", "parse_mjcf", "parse_mjcf_spec")),
+        ("robotwright.parsers.urdf", ("URDFOptions", "parse_urdf")),
+        ("robotwright.parsers.xacro", ("expand_xacro", "is_xacro", "xacro_as_urdf")),
+        ("robotwright.parsers.usd", ("USDOptions", "parse_usd", "prepare_confined_read")),
+        ("robotwright.proof.roundtrip", ("RoundTripReport", "our_mjcf_model", "roundtrip")),
+    ],
+)
+def test_each_format_package_names_its_entry_points(module: str, names: tuple) -> None:
+    """``from robotwright.parsers.mjcf import parse_mjcf`` (the import path of the
+    modules these packages replaced) works through each package's face."""
+    import importlib
+
+    package = importlib.import_module(module)
+    assert set(names) <= set(package.__all__)
+    assert all(callable(getattr(package, n)) for n in names)

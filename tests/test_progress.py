@@ -91,7 +91,7 @@ def test_animation_frames_show_progress(tmp_path: Path, slow_clock: None, capsys
 def test_the_library_prints_no_progress(tmp_path: Path, slow_clock: None, capsys) -> None:
     """A program calling the library gets no lines on its stderr: progress is the
     command line's."""
-    from robotwright.parsers.convert import convert
+    from robotwright.proof.convert import convert
 
     urdf = tmp_path / "chain.urdf"
     urdf.write_text(_chain_urdf(12))

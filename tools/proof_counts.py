@@ -3,7 +3,7 @@
 Each ``.xml`` (MJCF) and ``.urdf`` file of the corpora ``tools/fetch_test_data.py``
 unpacks (and example-robot-data, the ``test`` extra) that MuJoCo compiles on its own (a
 URDF through MuJoCo's URDF import) is converted to an HRDF folder with the proof on (see
-``robotwright.parsers.proof``); a world with several top-level bodies is converted with
+``robotwright.proof.compare``); a world with several top-level bodies is converted with
 the largest as the robot. Prints per corpus the counts (exact, with proof notes, refused
 by the converter, not compiled by MuJoCo) and the first proof note of each file that has
 one.
@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from robotwright.errors import RobotwrightError
-from robotwright.parsers import proof
-from robotwright.parsers.convert import convert
+from robotwright.proof import compare as proof
+from robotwright.proof.convert import convert
 
 T = Path(__file__).resolve().parents[1] / ".testdata"
 ERD = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data/robots"

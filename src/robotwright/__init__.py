@@ -33,6 +33,7 @@ _SUBMODULES = frozenset(
         "grammar",
         "hrdf",
         "parsers",
+        "proof",
         "render",
         "scene",
         "sensors",

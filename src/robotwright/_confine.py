@@ -36,12 +36,12 @@ import sys
 import sysconfig
 import threading
 import warnings
-from collections.abc import Callable, Iterable, Iterator
-from contextvars import ContextVar
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, TypeVar
 
 from robotwright._landlock import LandlockError, abi_version, restrict_self
+from robotwright._reader_budget import _BUDGET, reader_budget, reader_memory_bytes  # noqa: F401
 from robotwright._temporaries import die_with_parent, prefix
 from robotwright.errors import RobotwrightError
 
@@ -108,47 +108,6 @@ def adoption_holder(path: str | os.PathLike[str]) -> object:
     if staging is None or not Path(path).resolve().is_relative_to(staging.path.resolve()):
         raise ConfinementError(f"{path}: not a temporary folder of a confined reader")
     return staging
-
-
-#: Memory a confined reader may allocate beyond what the process held when it was
-#: copied (bytes; ``--max-reader-mb``), and the CPU time it may use (s). MuJoCo allocates
-#: what a file declares (``<size nuserdata>``, keyframes, replicated bodies) as it
-#: reads: past the budget the reader stops with one error, not the machine.
-READER_MEMORY_BYTES = 2_000 * 10**6
-READER_CPU_S = 120
-_BUDGET: ContextVar[tuple[int, int]] = ContextVar(
-    "robotwright_reader_budget", default=(READER_MEMORY_BYTES, READER_CPU_S)
-)
-
-
-@contextlib.contextmanager
-def reader_budget(memory_mb: float | None = None, cpu_s: int | None = None) -> Iterator[None]:
-    """Within the block, confined readers may allocate ``memory_mb`` MB (10**6 bytes)
-    and use ``cpu_s`` seconds of CPU (``None``: the default, :data:`READER_MEMORY_BYTES`
-    and :data:`READER_CPU_S`).
-
-    Raises:
-        ValueError: a value that is not positive.
-    """
-    memory, cpu = _BUDGET.get()
-    if memory_mb is not None:
-        if not 0 < memory_mb < float("inf"):
-            raise ValueError(f"max_reader_mb must be a positive number of MB, got {memory_mb}")
-        memory = round(memory_mb * 10**6)
-    if cpu_s is not None:
-        if cpu_s <= 0:
-            raise ValueError(f"reader CPU time must be positive, got {cpu_s}")
-        cpu = int(cpu_s)
-    token = _BUDGET.set((memory, cpu))
-    try:
-        yield
-    finally:
-        _BUDGET.reset(token)
-
-
-def reader_memory_bytes() -> int:
-    """The memory a confined reader may allocate now (bytes; see :func:`reader_budget`)."""
-    return _BUDGET.get()[0]
 
 
 def _mapped_bytes() -> int:

@@ -90,10 +90,9 @@ def is_ours(w: warnings.WarningMessage) -> bool:
 
 def _always_shown(w: warnings.WarningMessage) -> bool:
     """A warning the command line prints as it is, never folded into the notes' count
-    (:class:`~robotwright.errors.RobotSetupWarning`: what the user must act on)."""
-    from robotwright.errors import RobotSetupWarning
-
-    return issubclass(w.category, RobotSetupWarning)
+    (its class says ``always_shown``, as :class:`~robotwright.errors.RobotSetupWarning`
+    does: what the user must act on)."""
+    return bool(getattr(w.category, "always_shown", False))
 
 
 def _unique(items: Iterable[Note]) -> list[Note]:

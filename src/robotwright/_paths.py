@@ -365,7 +365,7 @@ def check_declared_counts(el: Any, source: str) -> None:
     Raises:
         InputFileError: naming ``source``, the element, the count and the override.
     """
-    from robotwright._confine import reader_memory_bytes
+    from robotwright._reader_budget import reader_memory_bytes
 
     budget = reader_memory_bytes()
     hint = "(--max-reader-mb raises the reader's memory budget)"

@@ -149,6 +149,10 @@ class RobotSetupWarning(UserWarning):
     drives, a fixed base on a legged robot, a drive without damping): shown always,
     naming the robot and what to give."""
 
+    #: read by :func:`robotwright._notes.collect_notes`: printed as it is, never folded
+    #: into a count of conversion notes
+    always_shown = True
+
 
 class ConversionWarning(UserWarning):
     """An element was dropped or approximated during a conversion (named in the message).

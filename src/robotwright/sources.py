@@ -264,7 +264,7 @@ def load_robot_with_notes(
     returns it and the readers' notes (values or elements not kept), one line each.
 
     ``options`` are those of :class:`~robotwright.parsers.URDFOptions` or
-    :class:`~robotwright.parsers.mjcf.MJCFOptions` (over the command line's, see
+    :class:`~robotwright.parsers.mjcf.reader.MJCFOptions` (over the command line's, see
     :func:`given_source_options`).
 
     Raises:
@@ -284,7 +284,7 @@ def load_robot_with_notes(
 
     prepare_read()
     if resolved.kind == "usd":
-        from robotwright.parsers.usd import prepare_confined_read
+        from robotwright.parsers.usd.reader import prepare_confined_read
 
         prepare_confined_read()
     return run_confined(

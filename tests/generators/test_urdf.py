@@ -319,7 +319,7 @@ def test_bundled_hrdf_urdf_hrdf_round_trip_is_exact(name, tmp_path):
     contact bits, friction and colour, drawn where it was drawn. A capsule comes back as
     the cylinder and two end spheres URDF holds it as (the same solid; reported)."""
     from robotwright.parsers.reference import view_from_model
-    from robotwright.parsers.roundtrip import compare_views, our_mjcf_model
+    from robotwright.proof.roundtrip.run import compare_views, our_mjcf_model
 
     hrdf = HRDF.from_robot_name(name)
     back = _urdf_roundtrip(hrdf, tmp_path, name)

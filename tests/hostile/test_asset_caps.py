@@ -415,8 +415,8 @@ def test_the_default_cap_refuses_a_600_mb_sparse_mesh(arm: Path, tmp_path: Path,
 def _python_readers(tmp_path: Path, arm: Path) -> list[tuple[str, object, Path]]:
     from robotwright._paths import checked_mjcf_spec
     from robotwright.hrdf import HRDF
-    from robotwright.parsers.mjcf import parse_mjcf
-    from robotwright.parsers.urdf import parse_urdf
+    from robotwright.parsers.mjcf.reader import parse_mjcf
+    from robotwright.parsers.urdf.reader import parse_urdf
     from robotwright.render import load_model
     from robotwright.things import World
 

@@ -74,7 +74,7 @@ def test_the_stager_refuses_what_the_check_would(layout) -> None:
     import mujoco
 
     from robotwright.errors import UnsafePathError
-    from robotwright.parsers.mjcf_geoms import _mesh_source
+    from robotwright.parsers.mjcf.geoms import _mesh_source
 
     robot, secret = layout
     spec = mujoco.MjSpec.from_string(MJCF.format(strip="false", file=str(secret)))

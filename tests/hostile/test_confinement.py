@@ -25,7 +25,7 @@ import pytest
 import trimesh
 
 import robotwright._paths as paths
-import robotwright.parsers.mjcf as mjcf_parser
+import robotwright.parsers.mjcf.reader as mjcf_parser
 import robotwright.scene.load as view_scene
 from robotwright._confine import ConfinementError, confinement, run_confined
 from robotwright.cli import main
@@ -141,7 +141,7 @@ def checks_off(monkeypatch):
     def accept(file, *, base, root, trusted=None, what="", hint=""):
         return (Path(base) / file).resolve()
 
-    from robotwright.parsers import mjcf_geoms
+    from robotwright.parsers.mjcf import geoms as mjcf_geoms
 
     # The checks and the mesh stager resolve through the same function (the stager
     # imports it by name).

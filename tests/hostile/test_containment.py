@@ -30,7 +30,7 @@ from robotwright.cli import main
 from robotwright.errors import RobotwrightError
 from robotwright.parsers import urdf_to_hrdf
 from robotwright.parsers.packages import robot_root
-from robotwright.parsers.roundtrip import roundtrip
+from robotwright.proof.roundtrip.run import roundtrip
 from robotwright.render import load_model
 
 URDF = """<robot name="r">
@@ -359,7 +359,7 @@ def test_roundtrip_reference_api_keeps_the_rule(shared: Path) -> None:
     outside mesh is refused, not handed to MuJoCo as written."""
     from robotwright.errors import UnsafePathError
     from robotwright.parsers.reference import urdf_for_mujoco
-    from robotwright.parsers.roundtrip import reference_view
+    from robotwright.proof.roundtrip.run import reference_view
 
     path = _urdf(shared / "robot", "../private/secret.stl")
     with pytest.raises(UnsafePathError):

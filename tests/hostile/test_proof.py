@@ -10,7 +10,7 @@ import random
 import mujoco
 import pytest
 
-from robotwright.parsers import proof
+from robotwright.proof import compare as proof
 
 SEEDS = range(24)
 
@@ -144,7 +144,7 @@ URDF_SEEDS = range(12)
 @pytest.mark.parametrize("seed", URDF_SEEDS)
 @pytest.mark.parametrize("out", ["folder", "out.xml", "out.urdf"])
 def test_random_urdf_converts_with_no_false_alarm(tmp_path, seed: int, out: str) -> None:
-    from robotwright.parsers.convert import convert
+    from robotwright.proof.convert import convert
 
     src = tmp_path / "r.urdf"
     src.write_text(_urdf(seed))
@@ -158,7 +158,7 @@ def test_random_urdf_changed_mass_is_found(tmp_path, monkeypatch, seed: int) -> 
     import dataclasses
 
     from robotwright.hrdf.model import HRDF
-    from robotwright.parsers.convert import convert
+    from robotwright.proof.convert import convert
 
     target = f"l{random.Random(seed * 3).randrange(random.Random(seed).randint(2, 9))}"
     real = HRDF.save

@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from robotwright.hrdf.model import HRDF
-from robotwright.parsers.convert import convert
-from robotwright.parsers.roundtrip import our_mjcf_model, roundtrip
+from robotwright.proof.convert import convert
+from robotwright.proof.roundtrip.run import our_mjcf_model, roundtrip
 
 
 @pytest.fixture(autouse=True)

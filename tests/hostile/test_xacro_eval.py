@@ -25,7 +25,7 @@ pytest.importorskip("xacro", reason="the xacro extra (pip install 'robotwright[x
 
 from robotwright.cli import main  # noqa: E402
 from robotwright.errors import ConversionError  # noqa: E402
-from robotwright.parsers.xacro import _expand_here  # noqa: E402
+from robotwright.parsers.xacro.expand import _expand_here  # noqa: E402
 
 MARK = "PWNED_MARKER"
 RUN = f"__import__('os').system('touch {MARK}')"

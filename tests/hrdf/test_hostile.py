@@ -192,7 +192,7 @@ def test_trusted_asset_root_is_an_explicit_opt_in(robot, outside, tmp_path, caps
     assert HRDF.from_dir(saved).meshes[0].file == "meshes/secret.stl"
     with trusted_asset_roots([outside]):
         assert HRDF.from_dir(robot).meshes[0].file == str(outside / "secret.stl")
-    from robotwright.parsers.convert import convert
+    from robotwright.proof.convert import convert
 
     convert(robot, tmp_path / "api.xml", asset_roots=[outside])
     assert (tmp_path / "meshes").is_dir()

@@ -29,7 +29,7 @@ from usd_robots import ROBOTS, robot  # noqa: E402
 from robotwright.generators.mjcf import MJCFHumanoidGenerator  # noqa: E402
 from robotwright.generators.usd import to_usd  # noqa: E402
 from robotwright.parsers.api import usd_to_hrdf_with_warnings  # noqa: E402
-from robotwright.parsers.proof import compare_models  # noqa: E402
+from robotwright.proof.compare import compare_models  # noqa: E402
 
 _NUMBER = re.compile(r"-?\d+(?:\.\d*)?(?:e[-+]?\d+)?")
 

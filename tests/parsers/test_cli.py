@@ -8,7 +8,7 @@ import mujoco
 import pytest
 
 from robotwright.cli import main
-from robotwright.parsers.convert import convert
+from robotwright.proof.convert import convert
 
 
 def test_convert_mjcf_to_hrdf_to_urdf_and_mjcf(probe: Path, tmp_path: Path, capsys) -> None:
@@ -157,7 +157,7 @@ def test_roundtrip_rows_that_compare_nothing_are_not_passes(tmp_path: Path, caps
 
 def test_roundtrip_names_sites_carried_as_urdf_links(tmp_path: Path, capsys) -> None:
     from robotwright.generators import MJCFHumanoidGenerator
-    from robotwright.parsers.roundtrip import roundtrip
+    from robotwright.proof.roundtrip.run import roundtrip
 
     xml = tmp_path / "arm6.xml"
     with pytest.warns(UserWarning):

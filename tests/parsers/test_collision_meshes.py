@@ -17,7 +17,7 @@ from robotwright.errors import ConversionError
 from robotwright.hrdf.model import HRDF, Body, Joint, MeshGeom
 from robotwright.parsers import urdf_to_hrdf
 from robotwright.parsers.collision import CollisionMeshConfig, repair_collision_meshes
-from robotwright.parsers.roundtrip import our_mjcf_model
+from robotwright.proof.roundtrip.run import our_mjcf_model
 
 ERD = Path(
     __import__("sysconfig").get_paths()["purelib"],

@@ -6,11 +6,11 @@ Corpora (unpacked as data by tools/fetch_test_data.py): robosuite-models and rob
 gymnasium's MuJoCo assets, and pybullet_data (URDFs and old MJCFs, without its 1,000
 generated ``random_urdfs``). Each file is compiled by MuJoCo first: a file MuJoCo itself
 refuses is out of scope and skipped with MuJoCo's reason. The rest goes through
-:func:`robotwright.parsers.roundtrip.roundtrip` (our MJCF to 1e-9: masses, inertias,
+:func:`robotwright.proof.roundtrip.run.roundtrip` (our MJCF to 1e-9: masses, inertias,
 joints, 20 random configurations, actuators with gear/ctrlrange, tendons, equalities,
 sensors, keyframes; our URDF to 1e-6) plus a check of every body's mass, centre of mass
 and inertia tensor, massless bodies included, and the proof ``robotwright convert`` runs
-(:func:`robotwright.parsers.proof.prove`: no compiled field differs unless a note says
+(:func:`robotwright.proof.compare.prove`: no compiled field differs unless a note says
 so), all on one parse of the file. A world holding several top-level bodies
 (an arm and its target) is converted with the largest one as the robot.
 
@@ -25,9 +25,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from robotwright.parsers.proof import prove
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
-from robotwright.parsers.roundtrip import roundtrip
+from robotwright.proof.compare import prove
+from robotwright.proof.roundtrip.run import roundtrip
 
 pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
 

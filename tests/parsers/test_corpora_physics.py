@@ -10,13 +10,13 @@ MuJoCo's reason. The rest must:
 
 - convert: the parse succeeds, or raises the refusal listed for it in
   :data:`EXPECTED_REFUSALS` (checked: the reason's words are in the error);
-- be physics-complete: :func:`robotwright.parsers.roundtrip.roundtrip` passes against
+- be physics-complete: :func:`robotwright.proof.roundtrip.run.roundtrip` passes against
   MuJoCo (masses, inertias, joints, forward kinematics in random configurations,
   actuators, sensors, tendons, equalities, keyframes; our URDF too), and every body's
   mass, centre of mass and inertia tensor equals the source's (1e-9), massless ones
   included;
 - lose nothing silently: for an MJCF source, the proof
-  (:func:`robotwright.parsers.proof.prove`) of writing it as an HRDF folder finds no
+  (:func:`robotwright.proof.compare.prove`) of writing it as an HRDF folder finds no
   difference in any compared ``MjModel`` field that no conversion note reports.
 
 A world holding several top-level bodies (a robot and its table, objects, a floor) is
@@ -38,7 +38,7 @@ import pytest
 from robotwright._paths import trusted_asset_roots
 from robotwright.errors import ConversionError, UnsafePathError
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
-from robotwright.parsers.roundtrip import roundtrip
+from robotwright.proof.roundtrip.run import roundtrip
 
 pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
 
@@ -134,8 +134,8 @@ def check_file(
 ) -> tuple[str, str]:
     """(outcome, detail) of one file: ``"not compilable"`` (MuJoCo's reason),
     ``"refused"`` (our error), ``"exact"``, or ``"differs"`` (what differs)."""
-    from robotwright.parsers.proof import prove
-    from robotwright.parsers.xacro import is_xacro, xacro_as_urdf
+    from robotwright.parsers.xacro.expand import is_xacro, xacro_as_urdf
+    from robotwright.proof.compare import prove
 
     root, _, corpus_options = CORPORA[corpus]
     path = root / rel

@@ -23,7 +23,7 @@ from robotwright.hrdf.model import HRDF, Body, Joint
 from robotwright.hrdf.validate import check_model as validate
 from robotwright.parsers.api import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
 from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco, view_from_model
-from robotwright.parsers.roundtrip import compare_extras, our_mjcf_model, roundtrip
+from robotwright.proof.roundtrip.run import compare_extras, our_mjcf_model, roundtrip
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
 
@@ -174,7 +174,7 @@ def test_unreadable_visual_mesh_rewritten_pybullet_table_square() -> None:
     """table.obj has out-of-range normal indices: MuJoCo 4 cannot decode it (its URDF
     import discards visuals; MuJoCo 3.11 reads it); ours keeps the geometry, rewritten by
     trimesh where MuJoCo refuses it (reported), and the robot compiles with it."""
-    from robotwright.parsers.visuals import _mesh_error
+    from robotwright.parsers.urdf.visuals import _mesh_error
 
     path = _need(PB / "table_square" / "table_square.urdf")
     result = urdf_to_hrdf_with_warnings(path)

@@ -11,7 +11,7 @@ import trimesh
 
 from robotwright.parsers import urdf_to_hrdf
 from robotwright.parsers.reference import urdf_mujoco_view, view_from_model
-from robotwright.parsers.roundtrip import compare_views, our_mjcf_model, roundtrip
+from robotwright.proof.roundtrip.run import compare_views, our_mjcf_model, roundtrip
 
 INERTIAL = (
     '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '

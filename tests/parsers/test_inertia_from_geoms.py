@@ -22,7 +22,7 @@ from robotwright.errors import ConversionError
 from robotwright.parsers import URDFOptions
 from robotwright.parsers.api import urdf_to_hrdf_with_warnings
 from robotwright.parsers.reference import mujoco_diagonalises_inertia_exactly
-from robotwright.parsers.roundtrip import our_mjcf_model, roundtrip
+from robotwright.proof.roundtrip.run import our_mjcf_model, roundtrip
 
 CUBE = np.array(
     [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],

@@ -11,8 +11,8 @@ import trimesh
 
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers import mjcf_to_hrdf
-from robotwright.parsers.convert import convert
-from robotwright.parsers.proof import compare_models
+from robotwright.proof.compare import compare_models
+from robotwright.proof.convert import convert
 
 REF = """<mujoco model="ref">
   <asset>

@@ -12,7 +12,7 @@ import trimesh
 from robotwright.errors import ConversionError
 from robotwright.parsers import mjcf_to_hrdf_with_warnings, urdf_to_hrdf_with_warnings
 from robotwright.parsers.meshes import obj_object_faces
-from robotwright.parsers.roundtrip import our_mjcf_model
+from robotwright.proof.roundtrip.run import our_mjcf_model
 
 TET_V = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\n"
 # One closed, outward-wound tetrahedron whose first face sits in its own object, as

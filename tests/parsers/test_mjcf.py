@@ -12,7 +12,7 @@ import pytest
 from robotwright.errors import ConversionError
 from robotwright.parsers import mjcf_to_hrdf, mjcf_to_hrdf_with_warnings
 from robotwright.parsers.reference import view_from_model
-from robotwright.parsers.roundtrip import compare_views, our_mjcf_model
+from robotwright.proof.roundtrip.run import compare_views, our_mjcf_model
 
 
 def test_records_hold_resolved_values(probe: Path) -> None:

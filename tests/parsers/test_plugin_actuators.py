@@ -11,8 +11,8 @@ import pytest
 from robotwright.generators import MJCFHumanoidGenerator
 from robotwright.hrdf.model import HRDF
 from robotwright.parsers import mjcf_to_hrdf
-from robotwright.parsers.convert import convert
-from robotwright.parsers.proof import compare_models
+from robotwright.proof.compare import compare_models
+from robotwright.proof.convert import convert
 
 PID = """<mujoco model="pid">
   <extension>

@@ -14,9 +14,9 @@ import pytest
 from robotwright.cli import main
 from robotwright.errors import ConversionError
 from robotwright.hrdf.model import HRDF
-from robotwright.parsers import proof
-from robotwright.parsers.convert import convert
 from robotwright.parsers.reference import mujoco_diagonalises_inertia_exactly
+from robotwright.proof import compare as proof
+from robotwright.proof.convert import convert
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
 
@@ -274,7 +274,7 @@ def test_actuatorfrc_of_a_carried_actuator_moves_with_it(tmp_path: Path) -> None
     messages = convert(_write(tmp_path, CARRIED), tmp_path / "out")
     assert not [m for m in messages if "proof:" in m], messages
     out = HRDF.from_dir(tmp_path / "out")
-    from robotwright.parsers.roundtrip import our_mjcf_model
+    from robotwright.proof.roundtrip.run import our_mjcf_model
 
     model = our_mjcf_model(out)
     # Every sensor kept, in order, reading the same objects (the proof compared them).
@@ -319,7 +319,7 @@ def test_range_of_an_unlimited_joint_is_noted(tmp_path: Path) -> None:
     assert len(noted) == 1 and '"shoulder"' in noted[0] and "-1.5" in noted[0], messages
     assert not [m for m in messages if "proof:" in m], messages
     # What MuJoCo simulates is the same: the joint is unlimited on both sides.
-    from robotwright.parsers.roundtrip import our_mjcf_model
+    from robotwright.proof.roundtrip.run import our_mjcf_model
 
     out = our_mjcf_model(HRDF.from_dir(tmp_path / "out"))
     assert not out.jnt_limited[out.joint("shoulder").id]
@@ -393,7 +393,7 @@ def test_urdf_source_matches_mujocos_import(tmp_path: Path, out: str) -> None:
     src = _write(tmp_path, URDF, "u.urdf")
     reference = proof.source_model(src, "urdf", {})
     assert reference is not None
-    from robotwright.parsers.convert import load_any
+    from robotwright.proof.convert import load_any
 
     hrdf, _ = load_any(src)
     ours, _ = proof.result_model(hrdf, "mjcf", None, discard_visual=True)
@@ -475,7 +475,7 @@ def test_urdf_output_silent_loss_becomes_a_note(tmp_path: Path, monkeypatch) -> 
 
 
 def test_urdf_form_names_each_changed_value() -> None:
-    from robotwright.parsers.proof_urdf import compare_urdf_form
+    from robotwright.proof.urdf_output import compare_urdf_form
 
     a = _model(PLAIN)
     assert compare_urdf_form(a, a) == []
@@ -533,7 +533,7 @@ def test_dropped_massless_root_link_is_one_reported_absence(tmp_path: Path) -> N
 
 
 def test_source_compile_reused_only_for_the_same_file(tmp_path: Path) -> None:
-    from robotwright.parsers.mjcf import parse_mjcf
+    from robotwright.parsers.mjcf.reader import parse_mjcf
 
     src = _write(tmp_path, PLAIN)
     parse_mjcf(src)

@@ -8,7 +8,7 @@ import mujoco
 import pytest
 import trimesh
 
-from robotwright.parsers.proof import compare_models
+from robotwright.proof.compare import compare_models
 
 MODEL = """<mujoco model="families">
   <asset><mesh name="m" file="{mesh}"/></asset>

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from robotwright.parsers.roundtrip import roundtrip
+from robotwright.proof.roundtrip.run import roundtrip
 
 pytestmark = [pytest.mark.realdata, pytest.mark.usefixtures("quiet_parsers")]
 
@@ -199,9 +199,9 @@ def test_g1_full_circle_mjcf_urdf_mjcf(tmp_path: Path) -> None:
     source (body masses, inertias, FK; the URDF carries sites as links, merged back)."""
     import mujoco
 
-    from robotwright.parsers.convert import convert
     from robotwright.parsers.reference import view_from_model
-    from robotwright.parsers.roundtrip import compare_views
+    from robotwright.proof.convert import convert
+    from robotwright.proof.roundtrip.run import compare_views
 
     path = TESTDATA / "unitree_g1/xmls/g1.xml"
     if not path.is_file():

@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 from robotwright.cli import main
-from robotwright.parsers import roundtrip as rt
-from robotwright.parsers.roundtrip_compare import _rel
+from robotwright.proof.roundtrip import run as rt
+from robotwright.proof.roundtrip.compare import _rel
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
 

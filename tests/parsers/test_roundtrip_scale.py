@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from robotwright.parsers.reference import quat_angle, view_from_model
-from robotwright.parsers.roundtrip import compare_geoms, compare_views, rotation_angles, roundtrip
+from robotwright.proof.roundtrip.run import compare_geoms, compare_views, rotation_angles, roundtrip
 
 
 def tree_urdf(n: int, *, branching: int = 4) -> str:
@@ -63,7 +63,7 @@ def test_a_chain_too_deep_for_mjcf_is_answered_before_the_reference(tmp_path: Pa
 def test_the_round_trip_legs_agree_with_one_at_a_time(tmp_path: Path) -> None:
     """The three MuJoCo imports run at once; each leg's table equals the one computed
     alone (the source's view, our MJCF's, our URDF's)."""
-    from robotwright.parsers.roundtrip import (
+    from robotwright.proof.roundtrip.run import (
         TOL_URDF,
         our_mjcf_model,
         our_urdf_view,
@@ -199,7 +199,7 @@ def test_every_body_inertia_is_compared_on_both_legs(full: bool) -> None:
 def test_actuators_made_for_a_urdf_are_checked_against_its_joints(tmp_path: Path) -> None:
     """MuJoCo's URDF import has no actuators; those ``actuators="motor"`` makes are not a
     failure, but each must drive a moving joint of the source, once."""
-    from robotwright.parsers.roundtrip_compare import _made_actuators_row
+    from robotwright.proof.roundtrip.compare import _made_actuators_row
 
     path = tmp_path / "tree.urdf"
     path.write_text(tree_urdf(6))

@@ -20,8 +20,8 @@ import pytest
 
 from robotwright.generators import URDFHumanoidGenerator
 from robotwright.hrdf.model import HRDF
-from robotwright.parsers.convert import convert
-from robotwright.parsers.roundtrip import our_mjcf_model, our_urdf, roundtrip, xyz_angles
+from robotwright.proof.convert import convert
+from robotwright.proof.roundtrip.run import our_mjcf_model, our_urdf, roundtrip, xyz_angles
 
 pytestmark = pytest.mark.usefixtures("quiet_parsers")
 

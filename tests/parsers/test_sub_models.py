@@ -7,8 +7,8 @@ from __future__ import annotations
 import mujoco
 import trimesh
 
-from robotwright.parsers.convert import convert
-from robotwright.parsers.proof import compare_models
+from robotwright.proof.compare import compare_models
+from robotwright.proof.convert import convert
 
 ARM = """<mujoco model="arm">
   <compiler meshdir="assets"/>

@@ -13,7 +13,7 @@ import trimesh
 from robotwright.errors import ConversionError
 from robotwright.parsers import urdf_to_hrdf, urdf_to_hrdf_with_warnings
 from robotwright.parsers.reference import urdf_mujoco_view, view_from_model
-from robotwright.parsers.roundtrip import compare_views, our_mjcf_model
+from robotwright.proof.roundtrip.run import compare_views, our_mjcf_model
 
 BOX_STL = (
     "solid b\n"

@@ -15,8 +15,8 @@ import pytest
 from robotwright.cli import main
 from robotwright.errors import ConversionError
 from robotwright.parsers import urdf_to_hrdf, urdf_to_hrdf_with_warnings
-from robotwright.parsers.roundtrip import our_mjcf_model
-from robotwright.parsers.urdf import URDFOptions
+from robotwright.parsers.urdf.reader import URDFOptions
+from robotwright.proof.roundtrip.run import our_mjcf_model
 
 PYBULLET = Path(__file__).resolve().parents[2] / ".testdata/pybullet/pybullet_data"
 

@@ -19,7 +19,7 @@ import pytest
 from robotwright.cli import main
 from robotwright.errors import ConversionError
 from robotwright.parsers import urdf_to_hrdf
-from robotwright.parsers.roundtrip import our_mjcf_model, roundtrip
+from robotwright.proof.roundtrip.run import our_mjcf_model, roundtrip
 
 pytest.importorskip("xacro", reason="the xacro extra (pip install 'robotwright[xacro]') is absent")
 
@@ -280,7 +280,7 @@ MACRO_BOMB = "".join(
     ids=["macro-explosion", "huge-expression"],
 )
 def test_expansion_bombs_stop_at_the_limits(robot_dir: Path, body: str, monkeypatch) -> None:
-    import robotwright.parsers.xacro as X
+    import robotwright.parsers.xacro.expand as X
 
     monkeypatch.setattr(X, "XACRO_CPU_S", 2)
     monkeypatch.setattr(X, "XACRO_MEMORY_BYTES", 1 << 30)
@@ -382,7 +382,7 @@ class _AgainstPython:
         self.mismatches: list[tuple[str, str, str]] = []
 
     def __call__(self, xacro, substitution_args):  # noqa: ANN001, ANN204 - xacro's modules
-        from robotwright.parsers.xacro_eval import installed
+        from robotwright.parsers.xacro.expressions import installed
 
         hook = installed(xacro, substitution_args)
         ours = hook.safe_eval
@@ -404,7 +404,7 @@ class _AgainstPython:
 
 
 def _expand(path: Path, installer) -> str:  # noqa: ANN001
-    import robotwright.parsers.xacro as X
+    import robotwright.parsers.xacro.expand as X
 
     saved = X.installed
     X.installed = installer
@@ -500,7 +500,7 @@ BENIGN = (
 
 @pytest.mark.parametrize("expr", BENIGN)
 def test_benign_expressions_equal_pythons(expr: str) -> None:
-    from robotwright.parsers.xacro_eval import Evaluator, default_names
+    from robotwright.parsers.xacro.expressions import Evaluator, default_names
 
     ours = Evaluator(lambda name: PROPS[name], default_names()).evaluate(expr)
     # Python's eval over the same names, with xacro's symbols (the real builtins).

@@ -54,7 +54,7 @@ def _options(args: argparse.Namespace) -> dict:
 
 def _density(text: str) -> float:
     """``--density``: a finite number > 0 (kg/m^3)."""
-    from robotwright.parsers.inertia_from_geoms import check_density
+    from robotwright.parsers.urdf.inertia_from_geoms import check_density
 
     try:
         return check_density(text)
@@ -259,7 +259,7 @@ def _quiet_parser_log(func: Callable[[argparse.Namespace], int]) -> Callable:
 
 @_quiet_parser_log
 def _convert(args: argparse.Namespace) -> int:
-    from robotwright.parsers.convert import convert, file_kind
+    from robotwright.proof.convert import convert, file_kind
 
     # What cannot be written at all is said before whether it may be overwritten.
     file_kind(Path(args.output), existing=False)
@@ -291,7 +291,7 @@ def _convert(args: argparse.Namespace) -> int:
 
 @_quiet_parser_log
 def _roundtrip(args: argparse.Namespace) -> int:
-    from robotwright.parsers.roundtrip import roundtrip
+    from robotwright.proof.roundtrip.run import roundtrip
     from robotwright.sources import resolve_source
 
     source = Path(args.source)

@@ -83,7 +83,7 @@ def step_export(out: Path, ctx: dict[str, Any]) -> str:
 
 
 def step_roundtrip(out: Path, ctx: dict[str, Any]) -> str:
-    from robotwright.parsers.roundtrip import roundtrip
+    from robotwright.proof.roundtrip.run import roundtrip
 
     lines = []
     log = logging.getLogger("robotwright.parsers")

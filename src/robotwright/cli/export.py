@@ -350,12 +350,12 @@ def _mjlab_cfg(args: argparse.Namespace) -> int:
 
 def _prove_urdf(hrdf, out: Path, strict: bool) -> None:
     """The proof of a URDF output: MuJoCo's import of it against our MJCF of the robot
-    (:mod:`robotwright.parsers.proof_urdf`); each difference the writer does not report
+    (:mod:`robotwright.proof.urdf_output`); each difference the writer does not report
     is a warning, under ``strict`` an error before anything is written."""
     import warnings
 
     from robotwright.errors import ConversionError, ConversionWarning
-    from robotwright.parsers.proof_urdf import prove_urdf_output
+    from robotwright.proof.urdf_output import prove_urdf_output
 
     found = prove_urdf_output(hrdf, str(out))
     if strict and found:

@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
 from robotwright.errors import GeneratorError, Problem
+from robotwright.generators.mixin import HRDFMixin
 from robotwright.generators.mjcf import imu_sites
 from robotwright.generators.placement import qmul
 from robotwright.generators.urdf_base import (
@@ -32,9 +32,6 @@ from robotwright.hrdf.model import (
     MeshGeom,
     SimpleGeom,
 )
-
-if TYPE_CHECKING:
-    from robotwright.generators.urdf import URDFHumanoidGenerator
 
 #: Mass (kg) and inertia (kg m^2) of the links that split a multi-joint body: MuJoCo
 #: rejects massless moving bodies and SDFormat (Gazebo) drops massless links with their
@@ -73,18 +70,18 @@ class _RobotWriter:
 
     def __init__(
         self,
-        gen: URDFHumanoidGenerator | URDFGeneratorBase,
+        gen: URDFGeneratorBase,
         hrdf: HRDF,
         prefix: str | None,
         relative: bool,
         losses: list[Problem],
-        robot_gen: URDFHumanoidGenerator | None = None,
+        robot_gen: HRDFMixin | None = None,
     ) -> None:
         self.gen, self.hrdf, self.prefix = gen, hrdf, prefix
         owner = robot_gen if robot_gen is not None else gen
-        from robotwright.generators.urdf import URDFHumanoidGenerator  # the module imports this one
-
-        assert isinstance(owner, URDFHumanoidGenerator)
+        # the generator that holds the robot (``gen`` itself, or one robot's generator
+        # of a composite) knows where its meshes are
+        assert isinstance(owner, HRDFMixin)
         self.mesh_path = owner.mesh_abspath
         self.relative, self.losses = relative, losses
         self.materials: dict[tuple[float, ...], str] = {}

@@ -23,7 +23,7 @@ def urdf_to_hrdf_with_warnings(
     path: str | os.PathLike, *, strict: bool = False, **options: Any
 ) -> ParseResult:
     """Parse a URDF; ``options`` are the fields of :class:`~robotwright.parsers.URDFOptions`."""
-    from robotwright.parsers.urdf import URDFOptions, parse_urdf
+    from robotwright.parsers.urdf.reader import URDFOptions, parse_urdf
 
     return _confined(parse_urdf, path, URDFOptions(**options), strict, "urdf", options)
 
@@ -36,8 +36,8 @@ def urdf_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: An
 def mjcf_to_hrdf_with_warnings(
     path: str | os.PathLike, *, strict: bool = False, **options: Any
 ) -> ParseResult:
-    """Parse an MJCF; ``options`` are the fields of :class:`~robotwright.parsers.mjcf.MJCFOptions`."""
-    from robotwright.parsers.mjcf import MJCFOptions, parse_mjcf
+    """Parse an MJCF; ``options`` are the fields of :class:`~robotwright.parsers.mjcf.reader.MJCFOptions`."""
+    from robotwright.parsers.mjcf.reader import MJCFOptions, parse_mjcf
 
     return _confined(parse_mjcf, path, MJCFOptions(**options), strict, "mjcf", options)
 
@@ -51,8 +51,8 @@ def usd_to_hrdf_with_warnings(
     path: str | os.PathLike, *, strict: bool = False, **options: Any
 ) -> ParseResult:
     """Read an OpenUSD robot (``.usd``, ``.usda``, ``.usdc``) with Newton's USD importer;
-    ``options`` are the fields of :class:`~robotwright.parsers.usd.USDOptions`."""
-    from robotwright.parsers.usd import USDOptions, parse_usd
+    ``options`` are the fields of :class:`~robotwright.parsers.usd.reader.USDOptions`."""
+    from robotwright.parsers.usd.reader import USDOptions, parse_usd
 
     return _confined(parse_usd, path, USDOptions(**options), strict, "usd", options)
 
@@ -63,8 +63,8 @@ def usd_to_hrdf(path: str | os.PathLike, *, strict: bool = False, **options: Any
 
 
 #: Modules of the readers' packages that are not read in a confined copy (USD's reader
-#: needs Newton and prepares itself: :func:`robotwright.parsers.usd.prepare_confined_read`).
-_NOT_PREPARED = frozenset({"usd"})
+#: needs Newton and prepares itself: :func:`robotwright.parsers.usd.reader.prepare_confined_read`).
+_NOT_PREPARED = ("robotwright.parsers.usd",)
 _prepared = False
 
 
@@ -88,9 +88,9 @@ def prepare_read() -> None:
     from robotwright.parsers import mujoco_probes
 
     for package in (robotwright.hrdf, robotwright.parsers):
-        for info in pkgutil.iter_modules(package.__path__):
-            if info.name not in _NOT_PREPARED:
-                importlib.import_module(f"{package.__name__}.{info.name}")
+        for info in pkgutil.walk_packages(package.__path__, f"{package.__name__}."):
+            if not info.name.startswith(_NOT_PREPARED):
+                importlib.import_module(info.name)
     for name in dir(mujoco_probes):
         if name.startswith("mujoco_"):
             getattr(mujoco_probes, name)()
@@ -110,7 +110,7 @@ def _confined(
     work = options.get("work_dir")
     prepare_read()
     if kind == "usd":
-        from robotwright.parsers.usd import prepare_confined_read
+        from robotwright.parsers.usd.reader import prepare_confined_read
 
         prepare_confined_read()
     with reading_root(roots[0]):

@@ -1,5 +1,5 @@
 """Convert between MJCF, URDF and HRDF folders (type by extension, or folder = HRDF); a
-USD file (``.usd``, ``.usda``, ``.usdc``) is read too (:mod:`robotwright.parsers.usd`),
+USD file (``.usd``, ``.usda``, ``.usdc``) is read too (:mod:`robotwright.parsers.usd.reader`),
 and written by ``robotwright export`` (:func:`robotwright.generators.to_usd`).
 
 Outputs are written atomically by the writers (HRDF folder: all or nothing; MJCF/URDF:
@@ -69,9 +69,9 @@ def _check_options(path: Path, kind: str, options: dict[str, Any]) -> None:
     for an MJCF) instead of failing inside the options dataclass with a TypeError."""
     import dataclasses
 
-    from robotwright.parsers.mjcf import MJCFOptions
-    from robotwright.parsers.urdf import URDFOptions
-    from robotwright.parsers.usd import USDOptions
+    from robotwright.parsers.mjcf.reader import MJCFOptions
+    from robotwright.parsers.urdf.reader import URDFOptions
+    from robotwright.parsers.usd.reader import USDOptions
 
     cls = {"urdf": URDFOptions, "usd": USDOptions}.get(kind, MJCFOptions)
     known = {f.name for f in dataclasses.fields(cls)}
@@ -99,7 +99,7 @@ def convert(
     and a sky (one note names them: they are not the source's).
 
     With ``proof`` (the default), an MJCF or URDF source that MuJoCo compiles is compared
-    with the output, compiled, field by field (:mod:`robotwright.parsers.proof`): each
+    with the output, compiled, field by field (:mod:`robotwright.proof.compare`): each
     difference no warning reports becomes one; under ``strict`` any fails the conversion
     before anything is written.
 
@@ -146,7 +146,7 @@ def _convert(
 
     prepare_read()
     if file_kind(src_p, existing=True) == "usd":
-        from robotwright.parsers.usd import prepare_confined_read
+        from robotwright.parsers.usd.reader import prepare_confined_read
 
         prepare_confined_read()
     hrdf, messages, proved = run_confined(
@@ -240,17 +240,17 @@ def _proof(
     strict: bool,
     options: dict[str, Any],
 ) -> list[str]:
-    """The proof's notes (see :func:`robotwright.parsers.proof.prove`); under ``strict``
+    """The proof's notes (see :func:`robotwright.proof.compare.prove`); under ``strict``
     any of them is a ConversionError, raised before the output is written."""
-    from robotwright.parsers.proof import prove
-    from robotwright.parsers.xacro import is_xacro, xacro_as_urdf
+    from robotwright.parsers.xacro.expand import is_xacro, xacro_as_urdf
+    from robotwright.proof.compare import prove
 
     kind = file_kind(src_p, existing=True)
     if kind == "hrdf":
         if out_kind != "urdf":
             return []  # the output is the folder's own export: nothing else to compare with
         # A URDF holds less than the folder: MuJoCo's import of it against its MJCF.
-        from robotwright.parsers.proof_urdf import prove_urdf_output
+        from robotwright.proof.urdf_output import prove_urdf_output
 
         found = prove_urdf_output(hrdf, str(src_p), notes)
     elif kind == "usd":
@@ -276,7 +276,7 @@ def _usd_proof(src_p: Path, hrdf: HRDF, out_kind: str, options: dict[str, Any]) 
     """A USD source's proof: Newton's reading of the file against MuJoCo's compile of the
     output (:func:`robotwright.generators.usd_proof.prove_usd`)."""
     from robotwright.generators.usd_proof import prove_usd
-    from robotwright.parsers.proof_models import result_model
+    from robotwright.proof.models import result_model
 
     work = options.get("work_dir")
     model, _ = result_model(hrdf, out_kind, Path(work) if work else None)

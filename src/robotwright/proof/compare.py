@@ -39,7 +39,7 @@ import mujoco
 import numpy as np
 
 from robotwright.errors import Problem
-from robotwright.parsers.proof_families import (
+from robotwright.proof.families import (
     _contacts,
     _geom_order,
     _massless,
@@ -49,7 +49,7 @@ from robotwright.parsers.proof_families import (
     _tendon_paths,
     _tensors,
 )
-from robotwright.parsers.proof_match import (
+from robotwright.proof.match import (
     _act_map,
     _dof_map,
     _match,
@@ -58,18 +58,17 @@ from robotwright.parsers.proof_match import (
     _robot_bodies,
     _used_sizes,
 )
-from robotwright.parsers.proof_models import (
-    remember_parsed,  # noqa: F401
+from robotwright.proof.models import (
     result_model,
     source_model,
 )
-from robotwright.parsers.proof_notes import (
+from robotwright.proof.notes import (
     _stem,
     as_problems,
     covered,  # noqa: F401
     uncovered,
 )
-from robotwright.parsers.proof_objects import (  # noqa: F401
+from robotwright.proof.objects import (  # noqa: F401
     _EQ_FAMILY,
     _ID_FIELDS,
     _KEY_COLUMNS,
@@ -287,7 +286,7 @@ def prove(
     geoms discarded as that import does; the output compiled the same way). A URDF
     output is proved in two steps: the source against our MJCF of ``hrdf`` (what the
     robot holds), and MuJoCo's import of our URDF against that MJCF
-    (:func:`robotwright.parsers.proof_urdf.prove_urdf_output`: what a URDF holds)."""
+    (:func:`robotwright.proof.urdf_output.prove_urdf_output`: what a URDF holds)."""
     options = dict(options or {})
     from robotwright.generators.compiles import too_deep_for_mjcf
 
@@ -300,7 +299,7 @@ def prove(
     if out_kind == "urdf":
         # The URDF form against our MJCF of the same robot (what a URDF can hold), and
         # that MJCF against the source (what the robot holds) below.
-        from robotwright.parsers.proof_urdf import prove_urdf_output
+        from robotwright.proof.urdf_output import prove_urdf_output
 
         found = prove_urdf_output(hrdf, str(source), notes)
         out_kind = "mjcf"

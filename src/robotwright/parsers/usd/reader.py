@@ -607,7 +607,7 @@ def parse_usd(
         InputFileError: a layer or asset path outside the file's folder.
     """
     from robotwright._paths import trusted_roots
-    from robotwright.parsers.mjcf import MJCFOptions, parse_mjcf_spec
+    from robotwright.parsers.mjcf.reader import MJCFOptions, parse_mjcf_spec
 
     path = Path(path)
     opt = options or USDOptions()

@@ -9,7 +9,7 @@ Visual geoms go to group 2 without contacts (contype = conaffinity = 0), collisi
 to group 3 with contype = conaffinity = 1, so the two stay apart. A visual and a
 collision of the same geometry and origin are one geom that is drawn and collides
 (group 0, contype = conaffinity = 1, the visual's colour; see
-:mod:`robotwright.parsers.geom_pairs`), as MuJoCo's own geoms are by default.
+:mod:`robotwright.parsers.urdf.geom_pairs`), as MuJoCo's own geoms are by default.
 """
 
 from __future__ import annotations
@@ -35,12 +35,12 @@ from robotwright.hrdf.model import (
     SimpleGeom,
     Site,
 )
-from robotwright.parsers import urdf_actuators as acts
 from robotwright.parsers.meshes import (
     rewrite_staged,
 )
 from robotwright.parsers.report import ParseResult, Reporter, warn_massless_moving
-from robotwright.parsers.urdf_common import (  # noqa: F401
+from robotwright.parsers.urdf import actuators as acts
+from robotwright.parsers.urdf.common import (  # noqa: F401
     COLLISION_GROUP,
     DRAWN_COLLISION_GROUP,
     VISUAL_GROUP,
@@ -49,10 +49,10 @@ from robotwright.parsers.urdf_common import (  # noqa: F401
     _Pose,
     _t,
 )
-from robotwright.parsers.urdf_joints import _body_record, _joint_record, _mimic_extra, _read_tree
-from robotwright.parsers.urdf_links import _make_geom, _URDFReader
-from robotwright.parsers.visuals import drop_unbuildable_visuals
-from robotwright.parsers.xacro import read_robot_xml
+from robotwright.parsers.urdf.joints import _body_record, _joint_record, _mimic_extra, _read_tree
+from robotwright.parsers.urdf.links import _make_geom, _URDFReader
+from robotwright.parsers.urdf.visuals import drop_unbuildable_visuals
+from robotwright.parsers.xacro.expand import read_robot_xml
 
 #: Joints from a root link named "world" that stay on its child when the root is dropped.
 _WORLD_CHILD_JOINTS = ("revolute", "continuous", "prismatic")
@@ -97,7 +97,7 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
     # A robot of many links with large meshes takes a while: progress past 2 s.
     data = {n: reader.link_data(links[n]) for n in steps(order, len(order), "links read")}
     if reader.unresolved:
-        from robotwright.parsers.unresolved import group_unresolved
+        from robotwright.parsers.urdf.unresolved import group_unresolved
 
         raise ConversionError(
             group_unresolved(reader.unresolved),

@@ -18,9 +18,9 @@ from robotwright.hrdf.model import (
     Joint,
 )
 from robotwright.parsers import inertia as inr
-from robotwright.parsers import urdf_actuators as acts
 from robotwright.parsers.report import Reporter
-from robotwright.parsers.urdf_common import _JOINT_TYPES, URDFOptions, _floats, _num, _t
+from robotwright.parsers.urdf import actuators as acts
+from robotwright.parsers.urdf.common import _JOINT_TYPES, URDFOptions, _floats, _num, _t
 
 
 @dataclass

@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from robotwright._names import shown
-from robotwright.parsers.xacro_names import (
+from robotwright.parsers.xacro.names import (
     _CONTAINERS,
     _SCALARS,
     MAX_INT_BITS,

@@ -55,8 +55,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from robotwright.parsers.xacro_evaluator import Evaluator
-from robotwright.parsers.xacro_names import (
+from robotwright.parsers.xacro.evaluator import Evaluator
+from robotwright.parsers.xacro.names import (
     _UNSET,
     MAX_STEPS,  # noqa: F401
     ExpressionError,

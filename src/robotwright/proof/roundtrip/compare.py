@@ -11,13 +11,13 @@ from robotwright.parsers import inertia as inr
 from robotwright.parsers.reference import (
     RobotView,
 )
-from robotwright.parsers.roundtrip_geoms import (
+from robotwright.proof.roundtrip.geoms import (
     _in_frame,
     compare_extras,
     compare_geoms,
     rotation_angles,
 )
-from robotwright.parsers.roundtrip_report import FLOOR, TOL_EXACT, Row
+from robotwright.proof.roundtrip.report import FLOOR, TOL_EXACT, Row
 
 
 def random_configs(

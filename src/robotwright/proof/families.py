@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from robotwright.parsers.proof_objects import (
+from robotwright.proof.objects import (
     Difference,
     _diff,
     _fmt,

@@ -10,7 +10,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import mujoco
-import numpy as np
+
+from robotwright.parsers.mjcf.compiled import _cacheable_mesh_files, _take_parsed
 
 if TYPE_CHECKING:
     from robotwright.hrdf.model import HRDF
@@ -109,17 +110,6 @@ def _file_key(path: str | Path) -> tuple[int, str] | None:
 _SOURCE_MESHES: dict[int, tuple[str, str, dict[tuple[int, str], str]]] = {}
 
 
-def _cacheable_mesh_files(spec: mujoco.MjSpec) -> list[str]:
-    """The mesh files of ``spec`` the result may read by the same name (MuJoCo's cache):
-    not one read with a ``refpos``/``refquat``, which MuJoCo 3.11 keeps in the cached
-    mesh (the result holds that frame in its geoms' poses instead)."""
-    return [
-        m.file
-        for m in spec.meshes
-        if not (np.any(m.refpos != 0) or np.any(np.asarray(m.refquat) != [1, 0, 0, 0]))
-    ]
-
-
 def _mesh_files(
     folder: str, meshdir: str, files: Iterable[str]
 ) -> tuple[str, str, dict[tuple[int, str], str]]:
@@ -135,35 +125,6 @@ def _mesh_files(
             if key is not None:
                 names.setdefault(key, file)
     return folder, meshdir, names
-
-
-#: the last MJCF the parser compiled: (resolved path, size and mtime) -> its model, model
-#: folder, mesh folder and mesh file names; taken by :func:`source_model` (one compile
-#: of the source saved). At most one is kept.
-_PARSED: dict[tuple[str, int, int], tuple[mujoco.MjModel, str, str, list[str]]] = {}
-
-
-def _stat_key(path: str | Path) -> tuple[str, int, int] | None:
-    try:
-        st = Path(path).stat()
-        return str(Path(path).resolve()), st.st_size, st.st_mtime_ns
-    except OSError:
-        return None
-
-
-def remember_parsed(path: str | Path, spec: mujoco.MjSpec, model: mujoco.MjModel) -> None:
-    """Keep ``model``, the parser's compile of the MJCF file ``path`` from ``spec``
-    (compiled, not changed since), for the proof of the conversion that follows."""
-    _PARSED.clear()
-    key = _stat_key(path)
-    if key is not None:
-        files = _cacheable_mesh_files(spec)
-        _PARSED[key] = (model, spec.modelfiledir or "", spec.compiler.meshdir or "", files)
-
-
-def _take_parsed(path: str | Path) -> tuple[mujoco.MjModel, str, str, list[str]] | None:
-    key = _stat_key(path)
-    return _PARSED.pop(key, None) if key is not None else None
 
 
 def _mesh_sources(hrdf: HRDF) -> list[Path]:
@@ -245,7 +206,7 @@ def result_model(
     import tempfile
     import warnings
 
-    from robotwright.parsers.roundtrip import our_mjcf_text, our_urdf_model
+    from robotwright.proof.roundtrip.run import our_mjcf_text, our_urdf_model
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -30,13 +30,14 @@ from robotwright.parsers.reference import (
     mimic_map,
     view_from_model,
 )
-from robotwright.parsers.roundtrip_compare import (
+from robotwright.parsers.xacro.expand import is_xacro, xacro_as_urdf
+from robotwright.proof.roundtrip.compare import (
     compare_views,
     random_configs,  # noqa: F401
 )
-from robotwright.parsers.roundtrip_geoms import compare_extras, compare_geoms, rotation_angles  # noqa: F401
-from robotwright.parsers.roundtrip_report import FLOOR, TOL_EXACT, TOL_URDF, RoundTripReport, Row  # noqa: F401
-from robotwright.parsers.roundtrip_sides import (  # noqa: F401
+from robotwright.proof.roundtrip.geoms import compare_extras, compare_geoms, rotation_angles  # noqa: F401
+from robotwright.proof.roundtrip.report import FLOOR, TOL_EXACT, TOL_URDF, RoundTripReport, Row  # noqa: F401
+from robotwright.proof.roundtrip.sides import (  # noqa: F401
     OurURDF,
     our_mjcf_model,
     our_mjcf_text,
@@ -49,7 +50,6 @@ from robotwright.parsers.roundtrip_sides import (  # noqa: F401
     source_kind,
     xyz_angles,
 )
-from robotwright.parsers.xacro import is_xacro, xacro_as_urdf
 
 
 def roundtrip(

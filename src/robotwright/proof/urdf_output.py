@@ -17,8 +17,8 @@ So the two models are compared where those terms agree, at their reference pose
   ``solmix``), which URDF cannot hold.
 
 Tolerance: :data:`RTOL` relative (the URDF text writes rotations as roll-pitch-yaw),
-:data:`robotwright.parsers.proof.ATOL` absolute. Each difference that no note of the
-URDF writer reports becomes a note (:func:`robotwright.parsers.proof.as_problems`).
+:data:`robotwright.proof.objects.ATOL` absolute. Each difference that no note of the
+URDF writer reports becomes a note (:func:`robotwright.proof.notes.as_problems`).
 """
 
 from __future__ import annotations
@@ -28,7 +28,8 @@ from collections.abc import Iterable
 import mujoco
 import numpy as np
 
-from robotwright.parsers.proof import ATOL, Difference, _fmt, _used_sizes
+from robotwright.proof.match import _used_sizes
+from robotwright.proof.objects import ATOL, Difference, _fmt
 
 #: relative tolerance of the URDF form (as the round trip's URDF rows).
 RTOL = 1e-6
@@ -189,10 +190,10 @@ def prove_urdf_output(hrdf, file: str, notes: Iterable[str] = ()) -> list:
 
     from robotwright.errors import Problem
     from robotwright.generators import URDFHumanoidGenerator
-    from robotwright.parsers.proof_models import _compile_with_same_files, _mesh_sources
-    from robotwright.parsers.proof_notes import as_problems, uncovered
     from robotwright.parsers.reference import compile_urdf, urdf_for_mujoco
-    from robotwright.parsers.roundtrip import our_mjcf_text
+    from robotwright.proof.models import _compile_with_same_files, _mesh_sources
+    from robotwright.proof.notes import as_problems, uncovered
+    from robotwright.proof.roundtrip.sides import our_mjcf_text
 
     gen = URDFHumanoidGenerator.from_hrdf(hrdf)
     with warnings.catch_warnings(record=True) as caught:

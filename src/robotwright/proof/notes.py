@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from robotwright.errors import Problem
-from robotwright.parsers.proof_objects import Difference
+from robotwright.proof.objects import Difference
 
 if TYPE_CHECKING:
     pass

@@ -11,7 +11,7 @@ The macros are expanded by the ``xacro`` package from PyPI (install the ``xacro`
 - ``$(env VAR)`` is refused and ``$(optenv VAR default)`` gives its default: the
   environment is not read, so a file cannot copy it into its output;
 - ``${...}`` and ``$(eval ...)`` expressions are evaluated by
-  :mod:`robotwright.parsers.xacro_eval` (an allow-list over the syntax tree), never by
+  :mod:`robotwright.parsers.xacro.expressions` (an allow-list over the syntax tree), never by
   Python's ``eval``.
 
 The files xacro reads (the source, ``<xacro:include>``, ``xacro.load_yaml``) must lie
@@ -52,7 +52,7 @@ from robotwright.parsers.packages import (
     robot_root,
 )
 from robotwright.parsers.report import Reporter
-from robotwright.parsers.xacro_eval import ExpressionError, installed
+from robotwright.parsers.xacro.expressions import ExpressionError, installed
 
 #: xacro keeps its state in module globals: one expansion at a time.
 _LOCK = threading.Lock()
@@ -66,7 +66,7 @@ def is_xacro(path: str | os.PathLike[str]) -> bool:
 def read_robot_xml(path: Path, options: Any, rep: Reporter) -> ET.Element:
     """Root element of a URDF file, or of the URDF a xacro file expands to.
 
-    ``options`` is the :class:`~robotwright.parsers.urdf.URDFOptions` (its
+    ``options`` is the :class:`~robotwright.parsers.urdf.reader.URDFOptions` (its
     ``package_map``, ``xacro_args`` and ``asset_roots`` are used); xacro's own warnings
     are reported on ``rep``.
     """
@@ -133,7 +133,7 @@ def expand_xacro(
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     try:
         done = subprocess.run(
-            isolated_python_command("robotwright.parsers.xacro", "_worker"),
+            isolated_python_command("robotwright.parsers.xacro.expand", "_worker"),
             input=json.dumps(request),
             capture_output=True,
             text=True,
@@ -180,7 +180,7 @@ def isolated_python_command(module: str, function: str) -> list[str]:
 
 
 def _worker() -> None:
-    """``python -m robotwright.parsers.xacro``: one expansion, request on stdin, reply
+    """``python -m robotwright.parsers.xacro.expand``: one expansion, request on stdin, reply
     (JSON) on stdout, under CPU and memory limits."""
     import json
     import sys

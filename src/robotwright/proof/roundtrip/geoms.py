@@ -11,7 +11,7 @@ from robotwright.parsers.reference import (
     RobotView,
     body_name,
 )
-from robotwright.parsers.roundtrip_report import Row
+from robotwright.proof.roundtrip.report import Row
 
 
 def _in_frame(

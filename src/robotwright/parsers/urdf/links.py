@@ -18,8 +18,6 @@ from robotwright.hrdf.model import (
     MeshGeom,
     SimpleGeom,
 )
-from robotwright.parsers import inertia_from_geoms as geom_inertia
-from robotwright.parsers.geom_pairs import BOTH, merge_visual_collision
 from robotwright.parsers.meshes import (
     MeshConversionError,
     conversion_is_cosmetic,
@@ -28,7 +26,8 @@ from robotwright.parsers.meshes import (
 )
 from robotwright.parsers.packages import UnresolvedMesh, resolve_uri
 from robotwright.parsers.report import Reporter
-from robotwright.parsers.urdf_common import (
+from robotwright.parsers.urdf import inertia_from_geoms as geom_inertia
+from robotwright.parsers.urdf.common import (
     COLLISION_GROUP,
     DRAWN_COLLISION_GROUP,
     VISUAL_GROUP,
@@ -40,6 +39,7 @@ from robotwright.parsers.urdf_common import (
     _t,
     _why,
 )
+from robotwright.parsers.urdf.geom_pairs import BOTH, merge_visual_collision
 
 
 @dataclass

@@ -14,7 +14,7 @@ from robotwright._mjmodel import actuator_count
 from robotwright.hrdf.model import (
     Actuator,
 )
-from robotwright.parsers.mjcf_common import _fmt, _user
+from robotwright.parsers.mjcf.common import _fmt, _user
 from robotwright.parsers.reference import body_name, joint_name
 from robotwright.parsers.report import Reporter
 

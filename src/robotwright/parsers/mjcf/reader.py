@@ -30,14 +30,14 @@ from robotwright.hrdf.model import (
     SimulatorConfig,
 )
 from robotwright.hrdf.options import nuser_from_model, options_from_model
-from robotwright.parsers import mjcf_extra
 from robotwright.parsers.meshes import (
     mesh_store,
 )
-from robotwright.parsers.mjcf_actuators import _actuators, _carried_instances, _plugin_instances
-from robotwright.parsers.mjcf_common import MJCFOptions, _t3
-from robotwright.parsers.mjcf_geoms import _geoms
-from robotwright.parsers.mjcf_tree import (
+from robotwright.parsers.mjcf import extra as mjcf_extra
+from robotwright.parsers.mjcf.actuators import _actuators, _carried_instances, _plugin_instances
+from robotwright.parsers.mjcf.common import MJCFOptions, _t3
+from robotwright.parsers.mjcf.geoms import _geoms
+from robotwright.parsers.mjcf.tree import (
     _bodies,
     _frames_as_sites,
     _joints,
@@ -106,7 +106,7 @@ def parse_mjcf(
             raise InputFileError(path, too_many)
         model = spec.compile()
         # The proof of the conversion compares with this compile (one compile saved).
-        from robotwright.parsers.proof_models import remember_parsed
+        from robotwright.parsers.mjcf.compiled import remember_parsed
 
         remember_parsed(path, spec, model)
     except UnsafePathError as exc:

@@ -18,10 +18,10 @@ import numpy as np
 from robotwright._names import shown
 from robotwright.errors import ConversionError, Problem
 from robotwright.parsers import inertia as inr
-from robotwright.parsers import inertia_from_geoms as geom_inertia
-from robotwright.parsers import urdf_actuators as acts
-from robotwright.parsers.fixed import FIXED_POLICIES, FixedPolicy
 from robotwright.parsers.report import Reporter
+from robotwright.parsers.urdf import actuators as acts
+from robotwright.parsers.urdf import inertia_from_geoms as geom_inertia
+from robotwright.parsers.urdf.fixed import FIXED_POLICIES, FixedPolicy
 
 VISUAL_GROUP = 2
 
@@ -52,7 +52,7 @@ class URDFOptions:
             peak_velocity = velocity, ctrl_range = +-effort); ``"position"`` (PD servos),
             ``"velocity"`` or ``"auto"`` (the type each joint's ``<transmission>`` /
             ros2_control ``<command_interface>`` declares): see
-            :mod:`robotwright.parsers.urdf_actuators`.
+            :mod:`robotwright.parsers.urdf.actuators`.
         actuator_gains: ``{"joint name pattern": (kp, kv)}`` for position/velocity
             servos (first matching ``fnmatch`` pattern wins).
         balance_inertia: repair A + B < C principal moments as MuJoCo's
@@ -69,12 +69,12 @@ class URDFOptions:
         asset_roots: folders outside the robot folder that relative and ``file://``
             mesh paths may point into (trusted explicitly; see :mod:`robotwright._paths`).
         xacro_args: ``{"name": "value"}`` for the ``$(arg name)`` of a ``.xacro`` source
-            (see :mod:`robotwright.parsers.xacro`).
+            (see :mod:`robotwright.parsers.xacro.expand`).
         inertia_from_geoms: a link without ``<inertial>`` gets the mass and inertia of
             its collision geoms at ``density``, computed by MuJoCo, as MuJoCo's URDF
             import does (``"auto"``, default; one note per link with the values), or
             none (``"never"``: mass 0, so a moving such link is refused). See
-            :mod:`robotwright.parsers.inertia_from_geoms`.
+            :mod:`robotwright.parsers.urdf.inertia_from_geoms`.
         density: kg/m^3 of the collision geoms of such links (MuJoCo's default 1000).
     """
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from robotwright.parsers.proof_objects import _FALLBACK, _bad_rows, _Side
+from robotwright.proof.objects import _FALLBACK, _bad_rows, _Side
 
 if TYPE_CHECKING:
     pass

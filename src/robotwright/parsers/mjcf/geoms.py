@@ -23,7 +23,7 @@ from robotwright.parsers.meshes import (
     conversion_is_cosmetic,
     conversion_note,
 )
-from robotwright.parsers.mjcf_common import _differs, _five, _pair, _reparent, _t3, _t4, _user
+from robotwright.parsers.mjcf.common import _differs, _five, _pair, _reparent, _t3, _t4, _user
 from robotwright.parsers.reference import body_name
 from robotwright.parsers.report import Reporter
 

@@ -20,7 +20,7 @@ from robotwright.hrdf.model import (
     Site,
 )
 from robotwright.parsers import inertia as inr
-from robotwright.parsers.mjcf_common import (
+from robotwright.parsers.mjcf.common import (
     MJCFOptions,
     _differs,
     _five,
