@@ -205,8 +205,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         metavar="N",
         help="then search the best design's continuous parameters (link lengths, strokes, "
-        "joint limits ...) anywhere within their ranges by CMA-ES for N evaluations, "
-        "keeping its structure (pip install 'robotwright[cma]'; not with --pareto)",
+        "joint limits ...) anywhere within their ranges by CMA-ES over N designs, "
+        "keeping its structure; logged to --log and taken from --resume as the search's "
+        "(pip install 'robotwright[cma]'; not with --pareto)",
     )
     q.add_argument(
         "--task",
@@ -640,6 +641,7 @@ def _refine(args: argparse.Namespace, g, res, objectives, constraints, executor)
     from robotwright.grammar.refine import refine
 
     before = res.best
+    searched = {e.design.hash(): e for e in res.evaluations}
     out = refine(
         g,
         before.design,
@@ -649,16 +651,26 @@ def _refine(args: argparse.Namespace, g, res, objectives, constraints, executor)
         seed=args.seed,
         executor=executor,
         workers=args.workers,
+        force_workers=args.force_workers,
+        # the search's log, appended to: a resumed run takes the refine's evaluations too
+        log=args.log or args.resume,
+        resume=args.resume,
+        known=searched,
+        progress=_search_progress(args.refine, objectives[0].name),
     )
-    res.evaluations.extend(out.evaluations[1:])
+    res.evaluations.extend(e for e in out.evaluations if e.design.hash() not in searched)
     if out.best.rank_key > before.rank_key:
         res.best = out.best
     first = objectives[0]
+    restarts = f", {out.restarts} restart(s) after all-infeasible generations" * bool(
+        out.restarts
+    )
     return (
         f"refined {len(out.parameters)} continuous parameter(s) of design "
-        f"{before.design.hash()} over {len(out.evaluations)} evaluations (CMA-ES): "
+        f"{before.design.hash()} over {len(out.evaluations)} designs (CMA-ES): "
         f"{_value_text(first, before.values[first.name])} -> "
-        f"{_value_text(first, res.best.values[first.name])}"
+        f"{_value_text(first, res.best.values[first.name])}\n"
+        f"refine stopped: {out.stopped}{restarts}"
     )
 
 

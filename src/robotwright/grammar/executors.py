@@ -21,6 +21,7 @@ from typing import Any
 from robotwright._temporaries import die_with_parent
 
 __all__ = [
+    "InProcessExecutor",
     "RayExecutor",
     "check_ray_address",
     "die_with_parent",
@@ -71,6 +72,21 @@ def check_ray_address(address: str) -> str:
             f"Ray address {address!r}: expected 'auto', 'ray://HOST:PORT' or 'HOST:PORT'"
         )
     return address
+
+
+class InProcessExecutor(Executor):
+    """Runs each call in this process when it is submitted: evaluations without a pool
+    (a refine's default), through the same ``map`` as the pools."""
+
+    workers = 1
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        done: Future = Future()
+        try:
+            done.set_result(fn(*args, **kwargs))
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller by the future
+            done.set_exception(exc)
+        return done
 
 
 def _run_batch(fn: Callable[[Any], Any], items: list[Any]) -> list[Any]:

@@ -103,12 +103,17 @@ class _Evaluator:
         log: str | os.PathLike[str] | None = None,
         resume: str | os.PathLike[str] | None = None,
         header: Mapping[str, Any] | None = None,
+        known: Mapping[str, Evaluation] | None = None,
+        append: bool = False,
     ) -> None:
+        """``known``: evaluations by design hash taken instead of evaluated (beside the
+        resumed log's); ``append``: add to the log (a later stage of the same run)."""
         if executor is None:  # the pool started here has ``workers`` processes
             check_workers(workers, force_workers)
         self.progress = progress
         objectives, constraints = tuple(objectives), tuple(constraints)
         self.fn = bind(evaluate, grammar, objectives=objectives, constraints=constraints)
+        self.grammar = grammar
         self.budget = budget
         self.cache: dict[str, Evaluation] = {}
         self.order: list[Evaluation] = []
@@ -119,12 +124,15 @@ class _Evaluator:
         self.known: dict[str, Evaluation] = (
             read_log(resume, grammar.name, objectives, constraints, header) if resume else {}
         )
+        self.known.update(known or {})
         same = resume is not None and (log is None or _same_file(log, resume))
         # Appending to the resumed log: its own evaluations are in it already.
         self._log_known = not same
         path = resume if same else log
         self.log = (
-            SearchLog(path, grammar.name, objectives, constraints, append=same, **(header or {}))
+            SearchLog(
+                path, grammar.name, objectives, constraints, append=same or append, **(header or {})
+            )
             if path is not None
             else None
         )

@@ -11,6 +11,10 @@ Format (``robotwright-search-log/1``), one JSON object per line:
      "objectives": [{"name": "reach", "maximize": true, "settings": "Reach(...)"}],
      "constraints": [{"name": "no-self-collision", "settings": "NoSelfCollision()"}]}
 
+  A refine of the search's best design (``--refine``, CMA-ES) appends a ``search`` line
+  of its own (``"method": "refine"``, its ``seed``, ``budget`` and initial step
+  ``sigma``), then its evaluations, its start design first.
+
 - an ``evaluation`` line per design, in evaluation order::
 
     {"kind": "evaluation", "seed": 0, "iteration": 7, "hash": "3f...",
@@ -58,6 +62,7 @@ _SEARCH_KEYS = {
     "budget",
     "max_links",
     "batch",
+    "sigma",
     "objectives",
     "constraints",
 }
