@@ -40,6 +40,7 @@ import numpy as np
 
 from robotwright.errors import Problem
 from robotwright.proof.families import (
+    _collision_hulls,
     _contacts,
     _geom_order,
     _massless,
@@ -201,6 +202,7 @@ def compare_models(
         diffs += _tendon_paths(src, res, maps)
     if "geom" in wanted:
         diffs += _mesh_data(src, res, maps["geom"])
+        diffs += _collision_hulls(src, res, maps["geom"])
     primary = [d for d in diffs if not _stem(d.field).endswith(_DERIVED)]
     # A derived value (a subtree mass, an inverse weight) differs because an input did:
     # that input is the difference to report; derived ones alone are reported as such.

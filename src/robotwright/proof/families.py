@@ -159,6 +159,77 @@ def _mesh_data(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[Differe
     return out
 
 
+def _hull(model: mujoco.MjModel, g: int) -> tuple[int, np.ndarray] | None:
+    """The convex hull MuJoCo collides a mesh geom with: its face count and its vertices
+    in the geom's body frame (so that two models that place the same hull through
+    different mesh frames agree); None when MuJoCo made no hull."""
+    k = int(model.geom_dataid[g])
+    adr = int(model.mesh_graphadr[k])
+    if adr < 0:
+        return None
+    nvert, nface = int(model.mesh_graph[adr]), int(model.mesh_graph[adr + 1])
+    ids = model.mesh_graph[adr + 2 + nvert : adr + 2 + 2 * nvert]
+    vert = model.mesh_vert[int(model.mesh_vertadr[k]) + ids].astype(float)
+    rot = np.empty(9)
+    mujoco.mju_quat2Mat(rot, model.geom_quat[g])
+    return nface, vert @ rot.reshape(3, 3).T + model.geom_pos[g]
+
+
+def _farthest(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest distance from a point of either set to the other set (m)."""
+    d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
+    return float(max(d.min(axis=1).max(initial=0.0), d.min(axis=0).max(initial=0.0)))
+
+
+def _collision_hulls(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[Difference]:
+    """For each matched mesh geom that collides: the convex hull MuJoCo computed for it
+    (what its contacts are made with), compared by vertex and face count and by the
+    farthest any hull vertex lies from the other hull's vertices, in the body frame. A
+    mirrored copy of a mesh or a dropped ``maxhullvert`` changes the hull while every
+    other array may agree."""
+    s, r = src.m, res.m
+    out: list[Difference] = []
+    mesh = int(mujoco.mjtGeom.mjGEOM_MESH)
+    for g, h in geom_map.items():
+        if h < 0 or int(s.geom_type[g]) != mesh or int(r.geom_type[h]) != mesh:
+            continue
+        if not (s.geom_contype[g] or s.geom_conaffinity[g]):
+            continue  # drawn only: no contact is made with its hull
+        a, b = _hull(s, g), _hull(r, h)
+        if a is None or b is None:
+            if (a is None) != (b is None):
+                shown = ("no hull" if a is None else "a hull", "no hull" if b is None else "a hull")
+                out.append(_diff(src, "geom", "collision hull", g, *shown))
+            continue
+        (fa, va), (fb, vb) = a, b
+        if (len(va), fa) != (len(vb), fb):
+            out.append(
+                _diff(
+                    src,
+                    "geom",
+                    "collision hull",
+                    g,
+                    f"{len(va)} vertices, {fa} faces",
+                    f"{len(vb)} vertices, {fb} faces",
+                )  # fmt: skip
+            )
+            continue
+        size = float(np.ptp(va, axis=0).max(initial=0.0))
+        far = _farthest(va, vb)
+        if far > 1e-9 * max(size, 1.0):
+            out.append(
+                _diff(
+                    src,
+                    "geom",
+                    "collision hull",
+                    g,
+                    "the source's hull",
+                    f"a hull with a vertex {far:.3g} m from it",
+                )  # fmt: skip
+            )
+    return out
+
+
 def _geom_order(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[Difference]:
     """One difference per body whose geoms the result holds in another order (MuJoCo
     finds and solves contacts in geom order: a reordered body's contacts differ)."""

@@ -1,0 +1,71 @@
+"""The proof compares the convex hull MuJoCo collides each mesh geom with: a conversion
+that keeps every array but changes a hull (a dropped ``maxhullvert``, a moved vertex)
+changes the contacts, and the proof says so, naming the geom."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+import trimesh
+
+from robotwright.proof.compare import compare_models
+from robotwright.proof.convert import convert
+
+
+def _robot(folder: Path, name: str, mesh_attrs: str = "", contype: int = 1) -> Path:
+    """One free body with one collision mesh (an uneven ellipsoid of 642 vertices)."""
+    if not (folder / "part.stl").exists():
+        m = trimesh.creation.icosphere(subdivisions=3, radius=0.05)
+        m.vertices *= [1.0, 0.6, 0.4]
+        m.vertices += np.random.default_rng(0).normal(0, 0.002, m.vertices.shape)
+        m.export(folder / "part.stl")
+    path = folder / f"{name}.xml"
+    path.write_text(
+        f'<mujoco model="{name}"><asset><mesh name="part" file="part.stl"{mesh_attrs}/></asset>'
+        '<worldbody><body name="b" pos="0 0 0.3"><freejoint name="root"/>'
+        f'<geom name="shell" type="mesh" mesh="part" mass="1" contype="{contype}"/>'
+        "</body></worldbody></mujoco>"
+    )
+    return path
+
+
+def _hull_notes(messages: list[str]) -> list[str]:
+    return [m for m in messages if "collision hull" in m]
+
+
+def test_a_dropped_maxhullvert_is_a_hull_difference(tmp_path) -> None:
+    src = _robot(tmp_path, "capped", ' maxhullvert="12"')
+    notes = _hull_notes(convert(src, tmp_path / "out.xml"))
+    assert len(notes) == 1 and "'shell'" in notes[0]
+    assert "12 vertices" in notes[0]  # the source's hull; the output's has more
+
+
+def test_a_kept_hull_is_no_difference(tmp_path) -> None:
+    assert _hull_notes(convert(_robot(tmp_path, "plain"), tmp_path / "plain_out.xml")) == []
+    # a mirrored mesh (negative scale) is written as a mirrored copy: the same hull
+    mirrored = _robot(tmp_path, "mirrored", ' scale="1 -1 1"')
+    assert _hull_notes(convert(mirrored, tmp_path / "mirrored_out.xml")) == []
+
+
+def test_a_moved_hull_is_reported_with_its_distance(tmp_path) -> None:
+    source = mujoco.MjModel.from_xml_path(str(_robot(tmp_path, "a")))
+    mesh = trimesh.load(tmp_path / "part.stl")
+    mesh.vertices *= 1.01  # every vertex 1 % farther out: the same hull, larger
+    (tmp_path / "moved").mkdir()
+    mesh.export(tmp_path / "moved" / "part.stl")
+    moved = mujoco.MjModel.from_xml_path(str(_robot(tmp_path / "moved", "a")))
+    found = [d for d in compare_models(source, moved) if d.field == "collision hull"]
+    assert len(found) == 1 and "shell" in found[0].obj
+    distance = float(found[0].result.split(" m from it")[0].split()[-1])
+    farthest_out = 0.01 * float(np.linalg.norm(mesh.vertices / 1.01, axis=1).max())
+    assert distance == pytest.approx(farthest_out, rel=0.01)
+
+
+def test_a_geom_that_never_collides_has_no_hull_compared(tmp_path) -> None:
+    src = _robot(tmp_path, "drawn", ' maxhullvert="12"', contype=0)
+    text = src.read_text().replace('contype="0"', 'contype="0" conaffinity="0"')
+    src.write_text(text)
+    assert _hull_notes(convert(src, tmp_path / "drawn_out.xml")) == []
