@@ -168,6 +168,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="MJCF output: add a floor, a light and a sky (default: the robot alone, as read)",
     )
+    p.add_argument(
+        "--simulate",
+        action="store_true",
+        help="the proof also steps source and output side by side for 200 steps (zero and "
+        "a fixed pseudo-random control, contacts on, the robot alone) and reports a "
+        "divergence the source's own sensitivity does not explain (MJCF sources)",
+    )
     add_overwrite_flag(p)
     _repair_args(p)
     p.add_argument(
@@ -280,6 +287,7 @@ def _convert(args: argparse.Namespace) -> int:
         strict=args.strict,
         overwrite=overwrite,
         scene=args.scene,
+        simulate=args.simulate,
         **_options(args),
     )
     # Reported like every command's losses: one summary line, each with -v.

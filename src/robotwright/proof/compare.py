@@ -278,6 +278,7 @@ def prove(
     *,
     options: dict | None = None,
     work_dir: Path | None = None,
+    simulate: bool = False,
 ) -> list[Problem]:
     """The proof of converting ``source`` (``kind``: ``"mjcf"`` or ``"urdf"``) into
     ``hrdf`` and writing it as ``out_kind`` (``"hrdf"``, ``"mjcf"``, ``"urdf"``): one
@@ -288,7 +289,10 @@ def prove(
     geoms discarded as that import does; the output compiled the same way). A URDF
     output is proved in two steps: the source against our MJCF of ``hrdf`` (what the
     robot holds), and MuJoCo's import of our URDF against that MJCF
-    (:func:`robotwright.proof.urdf_output.prove_urdf_output`: what a URDF holds)."""
+    (:func:`robotwright.proof.urdf_output.prove_urdf_output`: what a URDF holds).
+
+    ``simulate``: an MJCF source and the output are also stepped side by side
+    (:mod:`robotwright.proof.rollout`; not with ``root_body``)."""
     options = dict(options or {})
     from robotwright.generators.compiles import too_deep_for_mjcf
 
@@ -329,4 +333,17 @@ def prove(
         options=families is None,
         geom_order=kind != "urdf",
     )
+    if simulate and kind == "mjcf" and root is None:
+        diffs += _rollouts(src, res)
     return found + as_problems(str(source), uncovered(diffs, [*notes, *written]))
+
+
+def _rollouts(source: mujoco.MjModel, result: mujoco.MjModel) -> list[Difference]:
+    """The two models simulated side by side (:mod:`robotwright.proof.rollout`)."""
+    from robotwright.proof.rollout import rollout_differences
+
+    src, res = _Side(source, _robot_bodies(source, None)), _Side(result, None)
+    bodies = _match_bodies(src, res)
+    joints = _match(src, res, "jnt", bodies)
+    actuators = _match(src, res, "actuator", bodies)
+    return rollout_differences(source, result, _qpos_map(src, res, joints), actuators)

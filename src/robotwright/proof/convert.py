@@ -91,6 +91,7 @@ def convert(
     overwrite: bool = False,
     proof: bool = True,
     scene: bool = False,
+    simulate: bool = False,
     **options: Any,
 ) -> list[str]:
     """Convert ``src`` to ``dst``; returns every warning (parser and writer) as text.
@@ -101,7 +102,9 @@ def convert(
     With ``proof`` (the default), an MJCF or URDF source that MuJoCo compiles is compared
     with the output, compiled, field by field (:mod:`robotwright.proof.compare`): each
     difference no warning reports becomes one; under ``strict`` any fails the conversion
-    before anything is written.
+    before anything is written. ``simulate``: the proof also steps the source and the
+    output side by side (:mod:`robotwright.proof.rollout`; MJCF sources) and reports a
+    divergence the source's own sensitivity does not explain.
 
     ``options`` go to the parser (see ``URDFOptions`` / ``MJCFOptions``), except
     ``collision_max_faces`` and ``convex_decomposition``, which repair the collision
@@ -114,11 +117,19 @@ def convert(
     if scene and out_kind != "mjcf":
         raise ConversionError([Problem(str(dst_p), "scene=True / --scene applies to MJCF output")])
     if "work_dir" in options or file_kind(src_p, existing=True) == "hrdf":
-        return _convert(src_p, dst_p, out_kind, strict, overwrite, options, proof, scene)
+        return _convert(src_p, dst_p, out_kind, strict, overwrite, options, proof, scene, simulate)
     # The output gets its own copies of the meshes: staging lives only for the call.
     with tempfile.TemporaryDirectory(prefix=prefix("convert")) as tmp:
         return _convert(
-            src_p, dst_p, out_kind, strict, overwrite, {**options, "work_dir": tmp}, proof, scene
+            src_p,
+            dst_p,
+            out_kind,
+            strict,
+            overwrite,
+            {**options, "work_dir": tmp},
+            proof,
+            scene,
+            simulate,
         )
 
 
@@ -131,6 +142,7 @@ def _convert(
     options: dict[str, Any],
     proof: bool = True,
     scene: bool = False,
+    simulate: bool = False,
 ) -> list[str]:
     from robotwright._confine import run_confined
     from robotwright.generators.compiles import require_compiles
@@ -157,6 +169,7 @@ def _convert(
         options,
         repairs,
         proof,
+        simulate,
         roots=source_read_roots(src_p, file_kind(src_p, existing=True), options),
         writable=[work] if work else [],
         what=str(src_p),
@@ -168,7 +181,7 @@ def _convert(
             require_compiles(hrdf, f"cannot write {dst_p}")
             if proof:
                 if proved is None:  # the reader could not prove it: say why here
-                    proved = _proof(src_p, hrdf, out_kind, messages, strict, options)
+                    proved = _proof(src_p, hrdf, out_kind, messages, strict, options, simulate)
                 messages += proved
             if out_kind == "hrdf":
                 hrdf.save(dst_p, overwrite=overwrite)
@@ -211,6 +224,7 @@ def _read_and_prove(
     options: dict[str, Any],
     repairs: Any,
     proof: bool,
+    simulate: bool = False,
 ) -> tuple[HRDF, list[str], list[str] | None]:
     """Read the source, repair its collision meshes and prove the conversion (run in a
     confined reader): the robot, the notes, and the proof's notes (None: not proved
@@ -224,7 +238,7 @@ def _read_and_prove(
     proved = None
     if proof:
         try:
-            proved = _proof(src_p, hrdf, out_kind, messages, strict, options)
+            proved = _proof(src_p, hrdf, out_kind, messages, strict, options, simulate)
         except ConversionError:
             raise  # a strict proof's refusal is the conversion's answer
         except Exception:  # noqa: BLE001 - the output's own check gives the reason
@@ -239,6 +253,7 @@ def _proof(
     notes: list[str],
     strict: bool,
     options: dict[str, Any],
+    simulate: bool = False,
 ) -> list[str]:
     """The proof's notes (see :func:`robotwright.proof.compare.prove`); under ``strict``
     any of them is a ConversionError, raised before the output is written."""
@@ -261,7 +276,14 @@ def _proof(
             path, opts = xacro_as_urdf(src_p, options)
         work = opts.get("work_dir")
         found = prove(
-            path, kind, hrdf, out_kind, notes, options=opts, work_dir=Path(work) if work else None
+            path,
+            kind,
+            hrdf,
+            out_kind,
+            notes,
+            options=opts,
+            work_dir=Path(work) if work else None,
+            simulate=simulate,
         )
     if strict and found:
         raise ConversionError(

@@ -1,0 +1,135 @@
+"""The proof simulates: the source and the result, compiled, are stepped side by side
+from their reference pose with contacts on, once with zero control and once with a
+fixed pseudo-random control sequence, and their joint positions compared at every step.
+The robot is simulated as the conversion writes it: alone, so geoms of the source's
+world body (a floor, a table: scene, which the output does not hold) make no contact in
+either model.
+
+The per-object arrays can agree while the simulation does not: a collision mesh whose
+convex hull changed, a contact parameter MuJoCo derives, an order that decides which
+contact is solved first. But contacts make many robots chaotic: values that agree to
+1e-15 (a mesh centre rounded) grow into visibly different motions within 200 steps.
+So the source is also rolled out from a start moved by :data:`PERTURBATION` (rad or m)
+in every coordinate, and the result's divergence counts only where it is above
+:data:`ROLLOUT_TOL` and above :data:`CHAOS_MARGIN` times the source's own divergence
+from that start: one difference naming the control, the step it first exceeded the
+tolerance, the largest difference, the joint it is largest at and the source's own.
+
+Run only where every joint position and actuator of the source has its counterpart in
+the result (and the result has no others), and for models up to :data:`MAX_ROLLOUT_DOFS`
+degrees of freedom: a longer chain is a test of the writer, not a robot to simulate.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import mujoco
+import numpy as np
+
+from robotwright.proof.objects import Difference
+
+__all__ = [
+    "CHAOS_MARGIN",
+    "MAX_ROLLOUT_DOFS",
+    "PERTURBATION",
+    "ROLLOUT_STEPS",
+    "ROLLOUT_TOL",
+    "rollout_differences",
+]
+
+#: Steps of each rollout (at the model's own timestep).
+ROLLOUT_STEPS = 200
+#: Largest joint position difference (m or rad) that is not a difference.
+ROLLOUT_TOL = 1e-6
+#: The source's own start moved by this much in every joint position (rad or m).
+PERTURBATION = 1e-12
+#: How many times the source's own divergence the result's must exceed to count.
+CHAOS_MARGIN = 100.0
+#: Degrees of freedom above which no rollout is made.
+MAX_ROLLOUT_DOFS = 300
+#: Steps each value of the pseudo-random control is held for.
+_HOLD = 10
+
+
+def _controls(model: mujoco.MjModel, steps: int) -> np.ndarray:
+    """A fixed pseudo-random control sequence: per actuator a value drawn inside its
+    control range (``[-1, 1]`` without one), held :data:`_HOLD` steps."""
+    rng = np.random.default_rng(0)
+    lo = np.where(model.actuator_ctrllimited, model.actuator_ctrlrange[:, 0], -1.0)
+    hi = np.where(model.actuator_ctrllimited, model.actuator_ctrlrange[:, 1], 1.0)
+    held = rng.uniform(lo, hi, size=(steps // _HOLD + 1, model.nu))
+    return np.repeat(held, _HOLD, axis=0)[:steps]
+
+
+def _robot_alone(model: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of ``model`` whose world body's geoms collide with nothing."""
+    alone = copy.copy(model)  # MuJoCo's copy of every array
+    world = alone.geom_bodyid == 0
+    alone.geom_contype[world] = 0
+    alone.geom_conaffinity[world] = 0
+    return alone
+
+
+def _joint_at(model: mujoco.MjModel, qpos_index: int) -> str:
+    j = int(np.searchsorted(model.jnt_qposadr, qpos_index, side="right")) - 1
+    return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint #{j}"
+
+
+def rollout_differences(
+    source: mujoco.MjModel,
+    result: mujoco.MjModel,
+    qpos_map: dict[int, int],
+    actuator_map: dict[int, int],
+    steps: int = ROLLOUT_STEPS,
+) -> list[Difference]:
+    """The rollouts of ``source`` and ``result`` compared (see the module docstring).
+    ``qpos_map``: source joint position index -> the result's; ``actuator_map``: source
+    actuator -> the result's. Empty when they agree or cannot be compared."""
+    if not (
+        source.nq == result.nq == len(qpos_map)
+        and source.nu == result.nu == len(actuator_map)
+        and source.nv <= MAX_ROLLOUT_DOFS
+        and all(r >= 0 for r in actuator_map.values())
+    ):
+        return []
+    src_q = np.fromiter(qpos_map.keys(), dtype=int)
+    res_q = np.fromiter(qpos_map.values(), dtype=int)
+    src_u = np.fromiter(actuator_map.keys(), dtype=int)
+    res_u = np.fromiter(actuator_map.values(), dtype=int)
+    out = []
+    source, result = _robot_alone(source), _robot_alone(result)
+    zero = np.zeros((steps, source.nu))
+    out = []
+    for what, ctrl in (("zero control", zero), ("pseudo-random control", _controls(source, steps))):
+        a, b, c = mujoco.MjData(source), mujoco.MjData(result), mujoco.MjData(source)
+        c.qpos[:] += PERTURBATION
+        mujoco.mj_normalizeQuat(source, c.qpos)
+        worst, where, first, own = 0.0, 0, -1, 0.0
+        for t in range(steps):
+            a.ctrl[src_u] = ctrl[t, src_u]
+            c.ctrl[src_u] = ctrl[t, src_u]
+            b.ctrl[res_u] = ctrl[t, src_u]
+            for model, data in ((source, a), (result, b), (source, c)):
+                mujoco.mj_step(model, data)
+            gap = np.abs(a.qpos[src_q] - b.qpos[res_q])
+            own = max(own, float(np.abs(a.qpos - c.qpos).max(initial=0.0)))
+            k = int(gap.argmax()) if len(gap) else 0
+            if len(gap) and gap[k] > worst:
+                worst, where = float(gap[k]), int(src_q[k])
+            if first < 0 and worst > ROLLOUT_TOL:
+                first = t + 1
+        if worst > ROLLOUT_TOL and worst > CHAOS_MARGIN * own:
+            out.append(
+                Difference(
+                    f"simulation, {what}, {steps} steps",
+                    "model",
+                    "the robot",
+                    "the source's joint positions",
+                    f"joint positions differing from step {first} on, by up to {worst:.3g} "
+                    f"(joint '{_joint_at(source, where)}'; the source itself moves by "
+                    f"{own:.3g} from a start {PERTURBATION:g} away)",
+                    (),
+                )
+            )
+    return out
