@@ -41,7 +41,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from robotwright._landlock import LandlockError, abi_version, restrict_self
-from robotwright._reader_budget import _BUDGET, reader_budget, reader_memory_bytes  # noqa: F401
+from robotwright._reader_budget import _BUDGET
 from robotwright._temporaries import die_with_parent, prefix
 from robotwright.errors import RobotwrightError
 
@@ -49,7 +49,6 @@ __all__ = [
     "ConfinementError",
     "confinement",
     "readable_roots",
-    "reader_budget",
     "run_confined",
     "start_confined",
 ]

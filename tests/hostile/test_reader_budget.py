@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from robotwright._confine import confinement, reader_budget
+from robotwright._confine import confinement
+from robotwright._reader_budget import reader_budget
 from robotwright.cli import main
 from robotwright.errors import RobotwrightError
 from robotwright.parsers import mjcf_to_hrdf

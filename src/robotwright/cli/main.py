@@ -18,7 +18,6 @@ from typing import Any
 
 from robotwright import __version__
 from robotwright._atomic import mesh_size_limit
-from robotwright._confine import reader_budget
 from robotwright._limits import keyframe_limit
 from robotwright._names import PrintableStream
 from robotwright._notes import CaughtNotes, Note, collect_notes, summary_line
@@ -26,6 +25,7 @@ from robotwright._npz import npz_limit
 from robotwright._outputs import copies_replace
 from robotwright._paths import trusted_asset_roots
 from robotwright._progress import shown as progress_shown
+from robotwright._reader_budget import reader_budget
 from robotwright._suggest import did_you_mean
 from robotwright._temporaries import Terminated, sweep_stale, terminate_like_interrupt
 from robotwright.cli.options import source_options
