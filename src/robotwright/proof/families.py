@@ -175,10 +175,28 @@ def _hull(model: mujoco.MjModel, g: int) -> tuple[int, np.ndarray] | None:
     return nface, vert @ rot.reshape(3, 3).T + model.geom_pos[g]
 
 
-def _farthest(a: np.ndarray, b: np.ndarray) -> float:
-    """The largest distance from a point of either set to the other set (m)."""
-    d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
-    return float(max(d.min(axis=1).max(initial=0.0), d.min(axis=0).max(initial=0.0)))
+#: Points of one set compared with the whole other set at a time: a hull of thousands of
+#: vertices stays a few MB of distances, also in a confined reader's memory budget.
+_CHUNK = 256
+
+
+def _farthest(a: np.ndarray, b: np.ndarray, tol: float) -> float:
+    """The largest distance from a point of either set to the other set (m). When the
+    sets agree point by point within ``tol`` (a hull compiled from the same vertices
+    comes out in the same order) that bound is the answer, without the search."""
+    if a.shape == b.shape:
+        paired = float(np.linalg.norm(a - b, axis=1).max(initial=0.0))
+        if paired <= tol:
+            return paired
+
+    def one_way(p: np.ndarray, q: np.ndarray) -> float:
+        far = 0.0
+        for k in range(0, len(p), _CHUNK):
+            d = np.linalg.norm(p[k : k + _CHUNK, None, :] - q[None, :, :], axis=2)
+            far = max(far, float(d.min(axis=1).max(initial=0.0)))
+        return far
+
+    return max(one_way(a, b), one_way(b, a))
 
 
 def _collision_hulls(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[Difference]:
@@ -214,9 +232,9 @@ def _collision_hulls(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[D
                 )  # fmt: skip
             )
             continue
-        size = float(np.ptp(va, axis=0).max(initial=0.0))
-        far = _farthest(va, vb)
-        if far > 1e-9 * max(size, 1.0):
+        tol = 1e-9 * max(float(np.ptp(va, axis=0).max(initial=0.0)), 1.0)
+        far = _farthest(va, vb, tol)
+        if far > tol:
             out.append(
                 _diff(
                     src,
