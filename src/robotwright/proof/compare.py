@@ -109,20 +109,8 @@ def compare_models(
     (default all of :data:`FAMILIES`); ``options``: compare ``model.opt`` too;
     ``geom_order``: compare the order of each body's geoms (contacts come in that order).
     """
-    src = _Side(source, _robot_bodies(source, root_body))
-    res = _Side(result, None)
+    src, res, maps, cols = _matched(source, result, root_body)
     wanted = list(FAMILIES) if families is None else list(families)
-    maps: dict[str, dict[int, int]] = {"body": _match_bodies(src, res)}
-    for fam in ("jnt", "geom", "site", "actuator", "sensor", "tendon", "eq", "key"):
-        maps[fam] = _match(src, res, fam, maps["body"])
-    maps["dof"] = _dof_map(src, res, maps["jnt"])
-    maps["cam"] = {}
-    cols = {
-        "qpos": _qpos_map(src, res, maps["jnt"]),
-        "dof": maps["dof"],
-        "actuator": maps["actuator"],
-        "act": _act_map(src, res, maps["actuator"]),
-    }
     diffs: list[Difference] = []
     if options:
         diffs += _compare_options(source, result)
@@ -207,6 +195,28 @@ def compare_models(
     # A derived value (a subtree mass, an inverse weight) differs because an input did:
     # that input is the difference to report; derived ones alone are reported as such.
     return primary if primary else diffs
+
+
+def _matched(
+    source: mujoco.MjModel, result: mujoco.MjModel, root_body: str | None
+) -> tuple[_Side, _Side, dict[str, dict[int, int]], dict[str, dict[int, int]]]:
+    """The two sides, the source's objects matched to the result's by family
+    (``maps``), and the keyframe columns matched (``cols``: joint positions, degrees of
+    freedom, actuators, activations)."""
+    src = _Side(source, _robot_bodies(source, root_body))
+    res = _Side(result, None)
+    maps: dict[str, dict[int, int]] = {"body": _match_bodies(src, res)}
+    for fam in ("jnt", "geom", "site", "actuator", "sensor", "tendon", "eq", "key"):
+        maps[fam] = _match(src, res, fam, maps["body"])
+    maps["dof"] = _dof_map(src, res, maps["jnt"])
+    maps["cam"] = {}
+    cols = {
+        "qpos": _qpos_map(src, res, maps["jnt"]),
+        "dof": maps["dof"],
+        "actuator": maps["actuator"],
+        "act": _act_map(src, res, maps["actuator"]),
+    }
+    return src, res, maps, cols
 
 
 #: principal moments -> the rotation of their axes: compared as the one tensor they make
@@ -342,8 +352,5 @@ def _rollouts(source: mujoco.MjModel, result: mujoco.MjModel) -> list[Difference
     """The two models simulated side by side (:mod:`robotwright.proof.rollout`)."""
     from robotwright.proof.rollout import rollout_differences
 
-    src, res = _Side(source, _robot_bodies(source, None)), _Side(result, None)
-    bodies = _match_bodies(src, res)
-    joints = _match(src, res, "jnt", bodies)
-    actuators = _match(src, res, "actuator", bodies)
-    return rollout_differences(source, result, _qpos_map(src, res, joints), actuators)
+    _, _, maps, cols = _matched(source, result, None)
+    return rollout_differences(source, result, cols["qpos"], maps["actuator"])
