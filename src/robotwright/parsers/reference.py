@@ -207,6 +207,16 @@ def urdf_for_mujoco(
     return ET.tostring(root, encoding="unicode")
 
 
+def free_joint_name(taken: set[str]) -> str:
+    """The name a URDF robot's requested free base gets (``floating_base``, ``_``
+    appended while one of the ``taken`` joint names holds it), in the URDF reader and in
+    the proof's reference of ``floating_base=True`` alike."""
+    name = "floating_base"
+    while name in taken:
+        name += "_"
+    return name
+
+
 def compile_urdf(
     text: str, density: float | None = None, *, fuse_static: bool = False, floating: bool = False
 ) -> mujoco.MjModel:
@@ -252,11 +262,9 @@ def compile_urdf(
             text = ET.tostring(root, encoding="unicode")
     spec = mujoco.MjSpec.from_string(text, assets=assets or None)
     if floating:
-        taken = {j.name for j in spec.joints}
-        name = "floating_base"
-        while name in taken:
-            name += "_"
-        spec.worldbody.first_body().add_freejoint(name=name)
+        spec.worldbody.first_body().add_freejoint(
+            name=free_joint_name({j.name for j in spec.joints})
+        )
     if fuse_static:
         spec.compiler.fusestatic = True
         # A body a sensor refers to is not fused: the root stays the robot's base. (A

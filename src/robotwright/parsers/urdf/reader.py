@@ -222,11 +222,10 @@ def _parse_urdf(path: Path, opt: URDFOptions, strict: bool) -> ParseResult:
         if j is None:
             if free_root:
                 if free_name is None:
+                    from robotwright.parsers.reference import free_joint_name
+
                     # The name our URDF generator gives it, so our MJCF names it alike.
-                    taken = {x.get("name") for x in joints}
-                    free_name = "floating_base"
-                    while free_name in taken:
-                        free_name += "_"
+                    free_name = free_joint_name({x.get("name") for x in joints})
                 hrdf_joints.append(Joint(name=free_name, body=name, type="free"))
             continue
         if jtype == "fixed":
