@@ -662,7 +662,9 @@ def _refine(args: argparse.Namespace, g, res, objectives, constraints, executor)
     if out.best.rank_key > before.rank_key:
         res.best = out.best
     first = objectives[0]
-    restarts = f", {out.restarts} restart(s) after all-infeasible generations" * bool(out.restarts)
+    restarts = (
+        f", {out.restarts} restart(s) after all-infeasible generations" if out.restarts else ""
+    )
     return (
         f"refined {len(out.parameters)} continuous parameter(s) of design "
         f"{before.design.hash()} over {len(out.evaluations)} designs (CMA-ES): "
