@@ -13,6 +13,7 @@ from robotwright._atomic import atomic_dir, check_output_path
 from robotwright._outputs import check_overwrite
 from robotwright._progress import STEP_REPORT_S, Progress, working
 from robotwright._progress import duration as _duration
+from robotwright.cli.grammar_results import refine_best, report_front, value_text
 from robotwright.cli.options import add_overwrite_flag
 from robotwright.errors import GrammarError, InputFileError, Problem
 
@@ -501,20 +502,6 @@ def _objectives(args: argparse.Namespace, task) -> tuple[list, list] | str:  # n
     return named, named
 
 
-def _value_text(objective: object, value: float) -> str:
-    """``name = value unit``, saying when the value is the objective's bound."""
-    from robotwright.grammar.winners import UNITS
-
-    name = getattr(objective, "name", "")
-    unit = UNITS.get(name, "")
-    text = f"{name} = {value:.6g} {unit}".rstrip()
-    limit = getattr(objective, "limit", None)
-    if limit is not None and value >= limit:
-        bound = f"{limit:g} {unit}".rstrip()
-        text += f" (the {bound} bound: the design holds at least this)"
-    return text
-
-
 def _search(args: argparse.Namespace) -> int:
     from robotwright.grammar.search import beam_search, check_workers, mcts_search, random_search
     from robotwright.grammar.task import DEFAULT_TASK, load_task
@@ -596,7 +583,15 @@ def _search(args: argparse.Namespace) -> int:
         refined = ""
         searched = res.n_evaluated
         if args.refine is not None and res.best is not None:
-            refined = _refine(args, g, res, objectives, constraints, executor)
+            refined = refine_best(
+                args,
+                g,
+                res,
+                objectives,
+                constraints,
+                executor,
+                _search_progress(args.refine, objective.name),
+            )
     dt = time.perf_counter() - t0
     by_refine = res.n_evaluated - searched
     also = f" + {by_refine} by the refine (CMA-ES)" if by_refine else ""
@@ -610,12 +605,12 @@ def _search(args: argparse.Namespace) -> int:
         print("no feasible design found")
         return 1
     if args.pareto:
-        return _report_front(args, g, res, named)
+        return report_front(args, g, res, named)
     print(
-        f"best {_value_text(objective, res.best.values[objective.name])} (design {res.best.design.hash()})"
+        f"best {value_text(objective, res.best.values[objective.name])} (design {res.best.design.hash()})"
     )
     for other in objectives[1:]:
-        print(f"  {_value_text(other, res.best.values[other.name])}")
+        print(f"  {value_text(other, res.best.values[other.name])}")
     print(res.best.design.to_text(), end="")
     if args.out:
         from robotwright.grammar.winners import write_winners
@@ -632,82 +627,6 @@ def _search(args: argparse.Namespace) -> int:
                 draw_carrier=draw_pose,
             )
         print(f"written to {args.out}: {', '.join(f.name for f in folders)}")
-    return 0
-
-
-def _refine(args: argparse.Namespace, g, res, objectives, constraints, executor) -> str:  # noqa: ANN001
-    """CMA-ES over the best design's continuous parameters; its evaluations join the
-    search's, so the winners and the best include them. Returns the line to print."""
-    from robotwright.grammar.refine import refine
-
-    before = res.best
-    searched = {e.design.hash(): e for e in res.evaluations}
-    out = refine(
-        g,
-        before.design,
-        objectives,
-        constraints,
-        budget=args.refine,
-        seed=args.seed,
-        executor=executor,
-        workers=args.workers,
-        force_workers=args.force_workers,
-        # the search's log, appended to: a resumed run takes the refine's evaluations too
-        log=args.log or args.resume,
-        resume=args.resume,
-        known=searched,
-        progress=_search_progress(args.refine, objectives[0].name),
-    )
-    res.evaluations.extend(e for e in out.evaluations if e.design.hash() not in searched)
-    if out.best.rank_key > before.rank_key:
-        res.best = out.best
-    first = objectives[0]
-    restarts = (
-        f", {out.restarts} restart(s) after all-infeasible generations" if out.restarts else ""
-    )
-    return (
-        f"refined {len(out.parameters)} continuous parameter(s) of design "
-        f"{before.design.hash()} over {len(out.evaluations)} designs (CMA-ES): "
-        f"{_value_text(first, before.values[first.name])} -> "
-        f"{_value_text(first, res.best.values[first.name])}\n"
-        f"refine stopped: {out.stopped}{restarts}"
-    )
-
-
-def _report_front(args: argparse.Namespace, g, res, objectives: list) -> int:  # noqa: ANN001
-    """Print the Pareto front (values with units) and write it with -o."""
-    from robotwright.grammar.objectives import pareto_front
-    from robotwright.grammar.winners import UNITS, write_front
-
-    front = pareto_front(res.evaluations, objectives)
-    feasible = sum(e.feasible for e in res.evaluations)
-    print(f"Pareto front: {len(front)} of {feasible} feasible designs")
-    header = "  ".join(
-        f"{o.name} [{UNITS[o.name]}]" if UNITS.get(o.name) else o.name for o in objectives
-    )
-    print(f"  #  {header}  design")
-    for i, ev in enumerate(front, 1):
-        cells = "  ".join(f"{ev.values[o.name]:.6g}" for o in objectives)
-        print(f"{i:>3}  {cells}  {ev.design.hash()}")
-    bounded = [o for o in objectives if getattr(o, "limit", None) is not None]
-    for o in bounded:
-        if any(ev.values[o.name] >= o.limit for ev in front):
-            print(f"note: {_value_text(o, o.limit)}")
-    if args.out:
-        from robotwright.render.api import draw_pose
-
-        with working(f"writing the front to {args.out}"):
-            folders = write_front(
-                g,
-                front,
-                objectives,
-                args.out,
-                evaluated=res.evaluations,
-                pictures=not args.no_picture,
-                draw_carrier=draw_pose,
-            )
-        extra = "" if args.no_picture else ", pareto.png"
-        print(f"written to {args.out}: {', '.join(f.name for f in folders)}, front.json{extra}")
     return 0
 
 
