@@ -250,7 +250,7 @@ def furnish(world: World) -> World:
 STEPS: list[tuple[str, Callable[[Path, dict[str, Any]], str]]] = [
     ("bundled robots (HRDF)", step_hrdf),
     ("export to MJCF and URDF (generators)", step_export),
-    ("parse the exports back and compare in MuJoCo (parsers)", step_roundtrip),
+    ("parse the exports back and compare in MuJoCo (parsers, proof)", step_roundtrip),
     ("grow a limb with the grammar and mount it", step_limb),
     ("compose a scene and furnish it (composite + Things)", step_scene),
     ("semantic LiDAR scan (sensors)", step_lidar),
