@@ -132,6 +132,9 @@ def test_min_max_range_make_misses(analytic_model):
     assert far.get_hit_mask()[0].tolist() == [True, True, False, True, True, False]
     assert near.get_hit_mask()[0].tolist() == [True, True, True, True, False, False]
     assert near.get_distances()[0, 4] == -1.0  # the configured miss value
+    # A hit the range model drops is a miss in every output: no geom id, so no label.
+    assert far._raw_geom_ids[0, 2] == -1 and near._raw_geom_ids[0, 4] == -1
+    assert far._raw_geom_ids[0, 0] >= 0 and near._raw_geom_ids[0, 3] >= 0
 
 
 def test_alignment_base_yaw_world(analytic_model):
@@ -213,6 +216,7 @@ def test_noise_and_dropout_are_seeded_and_keep_misses(analytic_model):
     err = d[hit] - expected[hit]
     assert abs(err.mean()) < 0.01 * 5 / math.sqrt(err.size)
     assert 0.0095 < err.std() < 0.0105
+    assert (a._raw_geom_ids[0][~hit] == -1).all() and (a._raw_geom_ids[0][hit] >= 0).all()
     kept = hit[~up].mean()  # binomial(10000, 0.8): std 0.004
     assert abs(kept - 0.8) < 0.02
     a.update()

@@ -543,19 +543,26 @@ class LidarSensor:
     def _apply_range_model(self, dist: np.ndarray, geom_ids: np.ndarray) -> None:
         """Ranges, noise and dropout on the engine output (both arrays are modified)."""
         cfg = self.cfg
+        # The engine marks a miss with geom id -1; ``dropped`` collects the hits the range
+        # model turns into misses. Each pass below is over every ray of every frame, so
+        # the ones a configuration does not need are skipped.
         hit = geom_ids >= 0
-        if cfg.min_distance > 0:
-            hit &= dist >= cfg.min_distance
-        hit &= dist <= cfg.max_distance
+        dropped = dist < cfg.min_distance if cfg.min_distance > 0 else None
+        # mj_multiRay's cutoff culls whole geoms only, so a few hits may lie beyond it.
+        far = dist > cfg.max_distance
+        if far.any():
+            dropped = far if dropped is None else dropped | far
         if cfg.range_noise_std > 0:
             dist = dist + self._rng.normal(0.0, cfg.range_noise_std, size=dist.shape)
             np.clip(dist, cfg.min_distance, cfg.max_distance, out=dist)
         if cfg.dropout_prob > 0:
-            hit &= self._rng.random(dist.shape) >= cfg.dropout_prob
-        miss = ~hit
+            lost = self._rng.random(dist.shape) < cfg.dropout_prob
+            dropped = lost if dropped is None else dropped | lost
+        if dropped is not None:
+            hit &= ~dropped
+            np.copyto(geom_ids, -1, where=dropped)
         # copyto(where=) is several times faster than boolean-index assignment here.
-        np.copyto(dist, cfg.miss_distance, where=miss)
-        np.copyto(geom_ids, -1, where=miss)
+        np.copyto(dist, cfg.miss_distance, where=~hit)
         self._data.hit_mask = hit
         self._data.distances = dist
         self._raw_geom_ids = geom_ids

@@ -163,7 +163,8 @@ class SemanticLidarSensor(LidarSensor):
         ids = self._raw_geom_ids[rows]
         if self._data.semantic_labels is not None:
             if env_ids is None:
-                np.take(self._label_lut, ids, out=self._data.semantic_labels)
+                # "wrap": index -1 (a miss) is the last entry, with no bounds check to pay
+                np.take(self._label_lut, ids, out=self._data.semantic_labels, mode="wrap")
             else:
                 self._data.semantic_labels[rows] = self._label_lut[ids]
         if self._data.mesh_ids is not None:
