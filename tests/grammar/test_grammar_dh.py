@@ -52,6 +52,22 @@ def test_slide_row_and_batch():
         DHRow(0, 0, 0, type="ball")
 
 
+def test_one_pose_and_a_batch_give_the_same_frames_on_random_tables():
+    # One pose takes its own path (Python floats); the batched one is the reference.
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        n = int(rng.integers(1, 7))
+        rows = [
+            DHRow(*rng.uniform(-1, 1, 4), type="slide" if rng.random() < 0.3 else "hinge")
+            for _ in range(n)
+        ]
+        q = rng.uniform(-2, 2, n)
+        one = fk_frames(rows, q)
+        assert one.shape == (n, 4, 4)
+        np.testing.assert_allclose(one, fk_frames(rows, q[None])[0], atol=1e-12)
+        np.testing.assert_allclose(fk(rows, q), fk(rows, q[None])[0], atol=1e-12)
+
+
 def _design(text: str) -> Design:
     return Design.from_text("# grammar=srl\n" + text)
 

@@ -10,6 +10,7 @@ Joint ``i`` moves along/about the z axis of frame ``i``: a hinge adds ``q_i`` to
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
@@ -43,7 +44,7 @@ class DHRow:
                 f"DHRow {self.name!r}: type must be 'hinge' or 'slide', got {self.type!r}"
             )
         for f in ("a", "alpha", "d", "theta"):
-            if not np.isfinite(getattr(self, f)):
+            if not math.isfinite(getattr(self, f)):
                 raise ValueError(f"DHRow {self.name!r}: {f} must be finite")
 
 
@@ -90,6 +91,8 @@ def fk_frames(rows: Sequence[DHRow], q: np.ndarray | Sequence[float]) -> np.ndar
     if q.shape[-1:] != (n,):
         raise ValueError(f"q has shape {q.shape}; expected (..., {n}) for {n} DH rows")
     batch = q.shape[:-1]
+    if not batch:
+        return _fk_frames_one(rows, q)
     out = np.empty(batch + (n, 4, 4))
     T = np.broadcast_to(np.eye(4), batch + (4, 4))
     for i, row in enumerate(rows):
@@ -100,6 +103,29 @@ def fk_frames(rows: Sequence[DHRow], q: np.ndarray | Sequence[float]) -> np.ndar
             A = link_transform(row.a, row.alpha, row.d + qi, np.full(batch, row.theta))
         T = T @ A
         out[..., i, :, :] = T
+    return out
+
+
+def _fk_frames_one(rows: Sequence[DHRow], q: np.ndarray) -> np.ndarray:
+    """:func:`fk_frames` of one pose, row by row on Python floats: a design's build asks
+    for one pose at a time, where the batched arrays' set-up costs more than the work."""
+    out = np.empty((len(rows), 4, 4))
+    T = np.eye(4)
+    for i, row in enumerate(rows):
+        qi = float(q[i])
+        d, theta = (row.d, row.theta + qi) if row.type == "hinge" else (row.d + qi, row.theta)
+        ca, sa = math.cos(row.alpha), math.sin(row.alpha)
+        ct, st = math.cos(theta), math.sin(theta)
+        A = np.array(
+            [
+                [ct, -st, 0.0, row.a],
+                [st * ca, ct * ca, -sa, -sa * d],
+                [st * sa, ct * sa, ca, ca * d],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+        )
+        T = T @ A
+        out[i] = T
     return out
 
 
