@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib.metadata
 import os
 import platform
+import subprocess
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -18,6 +19,26 @@ def versions(packages: tuple[str, ...]) -> dict[str, str]:
         except importlib.metadata.PackageNotFoundError:
             out[name] = "absent"
     return out
+
+
+def peer_version(python: str, package: str) -> str:
+    """``package``'s version in another interpreter (a peer run in its own environment)."""
+    code = f"import importlib.metadata as m; print(m.version({package!r}))"
+    try:
+        done = subprocess.run(
+            [python, "-c", code], capture_output=True, text=True, timeout=60, check=True
+        )
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return done.stdout.strip() or "unknown"
+
+
+def print_peer(python: str | None, package: str) -> None:
+    """One line naming the peer's version and the interpreter it runs in."""
+    if python:
+        print(f"peer: {package} {peer_version(python, package)} (run by {python})")
+    else:
+        print(f"peer: {package} not run (no interpreter given)")
 
 
 def cpu_model() -> str:

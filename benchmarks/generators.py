@@ -28,7 +28,7 @@ import warnings
 from collections.abc import Callable
 from pathlib import Path
 
-from _machine import measured
+from _machine import measured, print_peer
 
 HERE = Path(__file__).resolve().parent
 #: The hurodes-written G1 that tools/fetch_test_data.py makes.
@@ -214,6 +214,7 @@ def main(argv: list[str] | None = None) -> int:
         "disk's write latency, the same for both, does not hide the generators' time)",
     )
     args = parser.parse_args(argv)
+    print_peer(args.hurodes_python, "hurodes")
     robot = args.robot.resolve()
     if not (robot / "meta.yaml").is_file():
         raise SystemExit(f"{robot}: not an HRDF folder (run python tools/fetch_test_data.py)")
@@ -301,5 +302,5 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    with measured(("hurodes",)):
+    with measured():
         sys.exit(main())

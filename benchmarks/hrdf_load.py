@@ -20,7 +20,7 @@ import uuid
 import warnings
 from pathlib import Path
 
-from _machine import measured
+from _machine import measured, print_peer
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _timing import median_seconds, report, run_peer  # noqa: E402
@@ -53,6 +53,7 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=15)
     ap.add_argument("--number", type=int, default=10)
     args = ap.parse_args()
+    print_peer(args.hurodes_python, "hurodes")
     if not (args.fixture / "meta.yaml").is_file():
         print(
             f"fixture not found: {args.fixture} (run python tools/fetch_test_data.py)",
@@ -84,5 +85,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    with measured(("hurodes",)):
+    with measured():
         sys.exit(main())

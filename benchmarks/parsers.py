@@ -20,7 +20,7 @@ import sysconfig
 import time
 from pathlib import Path
 
-from _machine import measured
+from _machine import measured, print_peer
 
 ROOT = Path(__file__).resolve().parents[1]
 G1_MJCF = ROOT / ".testdata/mjlab/mjlab/asset_zoo/robots/unitree_g1/xmls/g1.xml"
@@ -86,6 +86,7 @@ def main() -> int:
     ap.add_argument("--hurodes-python", default=None)
     ap.add_argument("--repeat", type=int, default=7)
     args = ap.parse_args()
+    print_peer(args.hurodes_python, "hurodes")
     logging.getLogger("robotwright.parsers").setLevel(logging.ERROR)
     import tempfile
 
@@ -110,5 +111,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    with measured(("hurodes",)):
+    with measured():
         raise SystemExit(main())
