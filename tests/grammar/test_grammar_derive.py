@@ -146,3 +146,15 @@ def test_feasibility_cache_does_not_depend_on_the_first_limit():
     assert not c.feasible(p, 0)  # every design needs a link
     assert c.feasible(p, 3)
     assert c.min_links(g.start_state, 0) is None and c.min_links(g.start_state, 5) == 1
+
+
+def test_sampling_is_the_same_when_the_counters_memo_is_emptied(monkeypatch) -> None:
+    g = default_grammar()
+    rng, counter = random.Random(5), derive.Counter(g)
+    kept = [derive.sample(g, 4, rng, counter) for _ in range(30)]
+    assert len(counter._conv) > 3
+    monkeypatch.setattr(derive, "CONV_MEMO", 3)  # emptied over and over
+    rng, small = random.Random(5), derive.Counter(g)
+    assert [derive.sample(g, 4, rng, small) for _ in range(30)] == kept
+    assert len(small._conv) <= 3
+    assert derive.count(g, 4) == derive.Counter(g).completions(Partial.start(g), 4)

@@ -159,6 +159,10 @@ def _choices_at(grammar: Grammar, rule: Rule, index: int) -> tuple[Choice, ...]:
     return tuple(out)
 
 
+#: Most memoised convolutions a :class:`Counter` keeps.
+CONV_MEMO = 100_000
+
+
 class Counter:
     """Exact counts of completions, memoised per grammar.
 
@@ -172,6 +176,9 @@ class Counter:
         self._busy: set[tuple[NodeState, int]] = set()
         # state -> (fewest links found or None, largest link count searched)
         self._min: dict[NodeState, tuple[int | None, int]] = {}
+        # (states, n) -> conv(states, n): sampling asks for the same pending states at
+        # every step of every design (emptied at CONV_MEMO entries: a bound on memory)
+        self._conv: dict[tuple[tuple[NodeState, ...], int], int] = {}
 
     def g(self, state: NodeState, n: int) -> int:
         if n < 0:
@@ -207,8 +214,16 @@ class Counter:
             return 0
         if not states:
             return 1 if n == 0 else 0
-        first, rest = states[0], tuple(states[1:])
-        return sum(self.g(first, k) * self.conv(rest, n - k) for k in range(n + 1))
+        key = (tuple(states), n)
+        hit = self._conv.get(key)
+        if hit is None:
+            if len(self._conv) >= CONV_MEMO:
+                self._conv.clear()
+            first, rest = key[0][0], key[0][1:]
+            hit = self._conv[key] = sum(
+                self.g(first, k) * self.conv(rest, n - k) for k in range(n + 1)
+            )
+        return hit
 
     def min_links(self, state: NodeState, limit: int) -> int | None:
         """Fewest links that finish a node in ``state``, or None if more than ``limit``."""

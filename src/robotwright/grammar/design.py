@@ -163,7 +163,12 @@ class Design:
 
     def hash(self) -> str:
         """SHA-256 of :meth:`canonical`, first 16 hex digits."""
-        return hashlib.sha256(self.canonical().encode()).hexdigest()[:16]
+        # Kept on the (immutable) design: a search asks for it several times per design.
+        cached = self.__dict__.get("_hash")
+        if cached is None:
+            cached = hashlib.sha256(self.canonical().encode()).hexdigest()[:16]
+            object.__setattr__(self, "_hash", cached)
+        return cached
 
     def __str__(self) -> str:
         return "; ".join(str(s) for s in self.steps)

@@ -104,8 +104,12 @@ class Grammar:
 
     def n_choices(self, symbol: str) -> int:
         """(component, parameters) choices of a new ``symbol`` node (1 if it has no component)."""
-        n = self.library.n_choices(symbol)
-        return n if n else 1
+        key = ("n_choices", symbol)
+        hit = self._cache.get(key)
+        if hit is None:
+            n = self.library.n_choices(symbol)
+            hit = self._cache[key] = n if n else 1
+        return hit
 
     def is_link(self, symbol: str) -> bool:
         return symbol in self.link_symbols

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import os
 import random
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence, Sized
 from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial as bind
+from itertools import chain
 from pathlib import Path
 from typing import Any
 
@@ -160,21 +161,43 @@ class _Evaluator:
     def left(self) -> int:
         return self.budget - len(self.cache)
 
-    def run(self, designs: Sequence[Design]) -> list[Evaluation | None]:
-        """Evaluations of ``designs`` (``None`` for those past the budget)."""
+    def run(
+        self, designs: Iterable[Design], expected: int | None = None
+    ) -> list[Evaluation | None]:
+        """Evaluations of ``designs`` (``None`` for those past the budget).
+
+        ``designs`` may be a generator (random search draws them as it goes): each batch
+        goes to the executor as soon as it is full, so the workers evaluate while the
+        rest are drawn. ``expected``: how many designs it yields (it sizes the batches;
+        default: its length, or the budget left).
+        """
+        assert self.executor is not None
+        if expected is None:
+            expected = len(designs) if isinstance(designs, Sized) else self.left
+        # Many small batches per worker, so that the last ones end close together; each
+        # batch's pickle of the grammar and objectives is a few kB.
+        workers = getattr(self.executor, "workers", None) or self.workers or usable_cores()
+        chunk = max(1, min(expected, self.left) // (16 * workers))
+        given: list[Design] = []
         todo: list[Design] = []
         seen = set(self.cache)
+        batch: list[Design] = []
+        parts: list[Iterator[Evaluation]] = []
         for d in designs:
+            given.append(d)
             h = d.hash()
-            if h not in seen and len(todo) < self.left:
-                todo.append(d)
-                seen.add(h)
-        assert self.executor is not None
-        new = [d for d in todo if d.hash() not in self.known]
-        # A few batches per worker: fewer pickles of the grammar, still balanced.
-        workers = getattr(self.executor, "workers", None) or self.workers or usable_cores()
-        chunk = max(1, len(new) // (4 * workers))
-        results = iter(self.executor.map(self.fn, new, chunksize=chunk)) if new else iter(())
+            if h in seen or len(todo) >= self.left:
+                continue
+            todo.append(d)
+            seen.add(h)
+            if h not in self.known:
+                batch.append(d)
+                if len(batch) >= chunk:
+                    parts.append(iter(self.executor.map(self.fn, batch, chunksize=chunk)))
+                    batch = []
+        if batch:
+            parts.append(iter(self.executor.map(self.fn, batch, chunksize=chunk)))
+        results = chain.from_iterable(parts)
         for d in todo:  # submission order: the same on every executor
             h = d.hash()
             known = self.known.get(h)
@@ -185,7 +208,7 @@ class _Evaluator:
                 self.log.write(ev, len(self.order) - 1)
         if self.progress is not None and todo:
             self.progress(len(self.order), best_of(self.order))
-        return [self.cache.get(d.hash()) for d in designs]
+        return [self.cache.get(d.hash()) for d in given]
 
 
 def _same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
@@ -238,9 +261,9 @@ def random_search(
         tries = 0
         while ev.left > 0 and tries < 20 * budget:
             size = min(ev.left, RANDOM_BATCH)
-            batch = [sample(grammar, max_links, rng, counter) for _ in range(size)]
-            tries += len(batch)
-            ev.run(batch)
+            # Drawn as they are evaluated: the pool starts on the first designs.
+            ev.run((sample(grammar, max_links, rng, counter) for _ in range(size)), size)
+            tries += size
         stopped = (
             "budget reached"
             if ev.left <= 0

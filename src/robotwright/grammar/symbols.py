@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 from robotwright._names import shown
 
@@ -63,9 +63,11 @@ class NodePattern:
         return f"{'-' if self.keep else ''}{self.symbol}{'*' if self.open else ''}"
 
 
-@dataclass(frozen=True)
-class NodeState:
-    """What a rule's left side can see of a node: its symbol, open mark, and edges."""
+class NodeState(NamedTuple):
+    """What a rule's left side can see of a node: its symbol, open mark, and edges.
+
+    A named tuple, not a dataclass: derivations hash and compare states at every step
+    (sampling, counting, replay), and a tuple does both in C."""
 
     symbol: str
     open: bool
