@@ -3,6 +3,8 @@ settings reach the objectives, a path of waypoints is followed."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -110,3 +112,132 @@ def test_search_cli_takes_a_task_and_refuses_a_bad_one(tmp_path, capsys) -> None
     assert main([*args, "--task", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "payload.samples" in err and str(bad) in err and "Traceback" not in err
+
+
+# A limb free of the carrier with the arms at their reference pose, touched by them
+# when they swing back (shoulders pitched back, elbows bent).
+BEHIND = """# robotwright-design/1 grammar=srl
+r1 @0: B=base(diameter=0.12, thickness=0.04) P=pinned()
+r2 @0: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=1.5708)
+r3 @3: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.15, rotation=-1.5708)
+r4 @5: E=gripper(finger_length=0.06)
+"""
+ARMS_BACK = {
+    "left_shoulder_pitch_joint": 1.0,
+    "right_shoulder_pitch_joint": 1.0,
+    "left_elbow_joint": -2.5,
+    "right_elbow_joint": -2.5,
+}
+_ARMS = ", ".join(f"{k}: {v}" for k, v in ARMS_BACK.items())
+POSTURES = f"""task: two-postures
+carrier:
+  robot: mini_humanoid
+  at: back_mount
+  postures:
+    standing: {{}}
+    arms_back: {{{_ARMS}}}
+payload: {{samples: 8}}
+collision: {{samples: 8}}
+"""
+
+
+def test_a_posture_holds_the_carrier_where_its_joints_put_it() -> None:
+    import warnings
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+
+    from robotwright.generators import MJCFHumanoidGenerator
+    from robotwright.hrdf.model import HRDF
+
+    held = mujoco.MjModel.from_xml_string(
+        P._carrier_xml(P.Carrier(posture=tuple(ARMS_BACK.items())))[0]
+    )
+    assert held.njnt == 0  # locked there
+    # The carrier with its joints, moved to the posture's values.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        gen = MJCFHumanoidGenerator.from_hrdf(HRDF.from_robot_name("mini_humanoid"))
+        xml = ET.tostring(gen.generate(add_scene=False), encoding="unicode")
+        moving = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(moving)
+    for name, value in ARMS_BACK.items():
+        data.qpos[moving.joint(name).qposadr[0]] = value
+    mujoco.mj_kinematics(moving, data)
+    mine = mujoco.MjData(held)
+    mujoco.mj_kinematics(held, mine)
+    assert held.nbody == moving.nbody
+    for b in range(1, held.nbody):
+        other = moving.body(held.body(b).name).id
+        # MJCF text keeps 6 significant digits
+        np.testing.assert_allclose(mine.xpos[b], data.xpos[other], atol=1e-5)
+        np.testing.assert_allclose(mine.xmat[b], data.xmat[other], atol=1e-5)
+    standing = mujoco.MjModel.from_xml_string(P._carrier_xml(P.Carrier())[0])
+    still = mujoco.MjData(standing)
+    mujoco.mj_kinematics(standing, still)
+    assert np.abs(still.xpos - mine.xpos).max() > 0.1  # the arms did move
+
+
+def test_a_task_with_postures_judges_the_limb_in_each(tmp_path) -> None:
+    path = tmp_path / "task.yaml"
+    path.write_text(POSTURES, encoding="utf-8")
+    task = load_task(path)
+    assert [n for n, _ in task.postures] == ["standing", "arms_back"]
+    assert dict(task.postures[1][1].posture) == ARMS_BACK
+    g = default_grammar()
+    from robotwright.grammar.objectives import EvalContext
+
+    ctx = EvalContext(g, Design.from_text(BEHIND))
+    # Free of the carrier standing, touched by its arms swung back: refused, naming it.
+    standing = task.postures[0][1]
+    assert NoCarrierCollision(carrier=standing, samples=8)(ctx) is None
+    message = task.constraint("no-carrier-collision")(ctx)
+    assert message is not None and message.startswith("posture 'arms_back': touches the carrier")
+    # The payload is the worst posture's.
+    payload = task.objective("payload")
+    each = payload.by_posture(ctx)
+    assert set(each) == {"standing", "arms_back"}
+    assert payload(ctx) == min(each.values())
+    assert payload.name == "payload" and payload.maximize and payload.limit == 100.0
+    track = task.objective("track")
+    assert track(ctx) == max(track.by_posture(ctx).values()) and not track.maximize
+
+
+@pytest.mark.parametrize(
+    ("postures", "field", "words"),
+    [
+        ("{up: {no_such_joint: 1}}", "carrier.postures.up", "no hinge or slide joint"),
+        ("{up: {left_elbow_joint: 1.0}}", "carrier.postures.up", "expects a value in"),
+        ("{up: {left_elbow_joint: .inf}}", "carrier.postures.up.left_elbow_joint", "within"),
+        ("{up: [1, 2]}", "carrier.postures.up", "mapping of joint"),
+        ("[standing]", "carrier.postures", "mapping of 1 to 16"),
+        ("{" + ", ".join(f"p{i}: {{}}" for i in range(17)) + "}", "carrier.postures", "1 to 16"),
+    ],
+)
+def test_bad_postures_are_refused_naming_the_field(tmp_path, postures, field, words) -> None:
+    path = tmp_path / "task.yaml"
+    path.write_text(f"task: t\ncarrier: {{postures: {postures}}}\n", encoding="utf-8")
+    with pytest.raises(GrammarError) as err:
+        load_task(path)
+    hits = [p for p in err.value.problems if p.column == field]
+    assert hits and words in hits[0].message, err.value.problems
+
+
+def test_a_search_with_postures_logs_them_and_resumes(tmp_path, capsys) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(POSTURES, encoding="utf-8")
+    log = tmp_path / "log.jsonl"
+    args = ["grammar", "search", "--objective", "payload", "--budget", "8", "--task", str(task)]
+    args += ["--method", "random", "--max-links", "3", "--seed", "1", "--workers", "1"]
+    out = tmp_path / "winners"
+    assert main([*args, "--log", str(log), "-o", str(out), "--top", "1"]) == 0
+    header = log.read_text().splitlines()[0]
+    assert "WorstPosture" in header and "arms_back" in header
+    # The winner pictured in each posture, in the task's order.
+    values = json.loads((out / "best_1" / "values.json").read_text())
+    assert values["postures"] == ["standing", "arms_back"]
+    assert (out / "best_1" / "on_carrier.png").is_file()
+    assert (out / "best_1" / "on_carrier_2.png").is_file()
+    capsys.readouterr()
+    assert main([*args, "--resume", str(log)]) == 0
+    assert "Traceback" not in capsys.readouterr().err

@@ -605,7 +605,7 @@ def _search(args: argparse.Namespace) -> int:
         print("no feasible design found")
         return 1
     if args.pareto:
-        return report_front(args, g, res, named)
+        return report_front(args, g, res, named, task)
     print(
         f"best {value_text(objective, res.best.values[objective.name])} (design {res.best.design.hash()})"
     )
@@ -623,6 +623,7 @@ def _search(args: argparse.Namespace) -> int:
                 objectives,
                 args.out,
                 k=args.top,
+                task=task,
                 pictures=not args.no_picture,
                 draw_carrier=draw_pose,
             )

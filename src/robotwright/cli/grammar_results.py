@@ -64,8 +64,9 @@ def refine_best(
     )
 
 
-def report_front(args: argparse.Namespace, g, res, objectives: list) -> int:  # noqa: ANN001
-    """Print the Pareto front (values with units) and write it with -o."""
+def report_front(args: argparse.Namespace, g, res, objectives: list, task) -> int:  # noqa: ANN001
+    """Print the Pareto front (values with units) and write it with -o (the pictures on
+    ``task``'s carrier)."""
     from robotwright.grammar.objectives import pareto_front
     from robotwright.grammar.winners import UNITS, write_front
 
@@ -93,6 +94,7 @@ def report_front(args: argparse.Namespace, g, res, objectives: list) -> int:  # 
                 objectives,
                 args.out,
                 evaluated=res.evaluations,
+                task=task,
                 pictures=not args.no_picture,
                 draw_carrier=draw_pose,
             )

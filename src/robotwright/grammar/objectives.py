@@ -381,6 +381,76 @@ class NoCarrierCollision:
         return f"touches the carrier at {poses} of {self.samples + 1} poses (first: pose {k}, {a} and {b})"
 
 
+@dataclass(frozen=True)
+class WorstPosture:
+    """One objective measured with the carrier in several postures (``parts``, one per
+    posture, named by ``postures``): the worst posture's value (the smallest when larger
+    is better, else the largest). NaN in any posture is the result."""
+
+    parts: tuple[Objective, ...]
+    postures: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        names = {p.name for p in self.parts}
+        if not self.parts or len(names) != 1 or len(self.postures) != len(self.parts):
+            raise ValueError(
+                "WorstPosture: expected one objective of one name per posture, got "
+                f"{len(self.parts)} objective(s) ({sorted(names)}) for "
+                f"{len(self.postures)} posture(s)"
+            )
+
+    @property
+    def name(self) -> str:
+        return self.parts[0].name
+
+    @property
+    def maximize(self) -> bool:
+        return self.parts[0].maximize
+
+    @property
+    def limit(self) -> float | None:
+        """The objective's own bound (``payload``'s ``limit``), if it has one."""
+        return getattr(self.parts[0], "limit", None)
+
+    def __call__(self, ctx: EvalContext) -> float:
+        values = [ctx.value(p) for p in self.parts]
+        if any(math.isnan(v) for v in values):
+            return math.nan
+        return min(values) if self.maximize else max(values)
+
+    def by_posture(self, ctx: EvalContext) -> dict[str, float]:
+        """The value in each posture, by posture name."""
+        return {n: ctx.value(p) for n, p in zip(self.postures, self.parts)}
+
+
+@dataclass(frozen=True)
+class InEveryPosture:
+    """One constraint that must hold with the carrier in each of several postures
+    (``parts``, one per posture, named by ``postures``); the message names the first
+    posture where it does not."""
+
+    parts: tuple[Constraint, ...]
+    postures: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if not self.parts or len(self.postures) != len(self.parts):
+            raise ValueError(
+                f"InEveryPosture: expected one constraint per posture, got {len(self.parts)} "
+                f"for {len(self.postures)} posture(s)"
+            )
+
+    @property
+    def name(self) -> str:
+        return self.parts[0].name
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        for posture, part in zip(self.postures, self.parts):
+            message = part(ctx)
+            if message is not None:
+                return f"posture {posture!r}: {message}"
+        return None
+
+
 def signed(objective: Objective, value: float) -> float:
     """``value`` oriented so that larger is better (negated for a minimised objective)."""
     return value if objective.maximize else -value

@@ -35,13 +35,18 @@ BACKWARDS = (math.sqrt(0.5), 0.0, -math.sqrt(0.5), 0.0)
 @dataclass(frozen=True)
 class Carrier:
     """Where a limb is worn: a bundled robot (``robot``, by name), the body or site
-    ``at`` that carries the limb's base, and the limb's pose there (m; w, x, y, z)."""
+    ``at`` that carries the limb's base, and the limb's pose there (m; w, x, y, z).
+
+    ``posture`` holds joints of the carrier at other values than its reference pose
+    (joint name, rad for a hinge or m for a slide); every joint is locked where the
+    posture (or else the reference pose) puts it."""
 
     robot: str = "mini_humanoid"
     at: str = "back_mount"
     pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
     quat: tuple[float, float, float, float] = BACKWARDS
     prefix: str = "srl_"
+    posture: tuple[tuple[str, float], ...] = ()
 
 
 #: The range of every setting of the physics objectives (payload, track, energy,
@@ -77,10 +82,12 @@ def check_settings(what: str, **values: float) -> None:
 DEFAULT_CARRIER = Carrier()
 
 
-@lru_cache(maxsize=8)
+# Room for a task's every posture (16) and the carrier itself, twice over.
+@lru_cache(maxsize=40)
 def _carrier_xml(carrier: Carrier) -> tuple[str, str, tuple[float, ...], tuple[float, ...]]:
     """MJCF text of the carrier with every joint, actuator and sensor removed (held in
-    its reference pose), and the body and pose (in that body) where the limb goes."""
+    its reference pose, or in ``carrier.posture``), and the body and pose (in that body)
+    where the limb goes."""
     from robotwright.errors import ConversionWarning
     from robotwright.generators import MJCFHumanoidGenerator
     from robotwright.grammar.mount import _compose
@@ -100,10 +107,48 @@ def _carrier_xml(carrier: Carrier) -> tuple[str, str, tuple[float, ...], tuple[f
         root = MJCFHumanoidGenerator.from_hrdf(robot).generate(add_scene=False)
     xml = ET.tostring(root, encoding="unicode")
     spec = mujoco.MjSpec.from_string(xml)
+    if carrier.posture:
+        _hold_posture(spec, carrier)
     for kind in ("sensors", "actuators", "joints"):
         for item in list(getattr(spec, kind)):
             spec.delete(item)
     return spec.to_xml(), body, pos, quat
+
+
+def _hold_posture(spec: mujoco.MjSpec, carrier: Carrier) -> None:
+    """Pose every body of ``spec`` where the joints at ``carrier.posture`` put it, so that
+    the pose stays when the joints are deleted.
+
+    Raises:
+        ValueError: a joint the carrier lacks (or that is not a hinge or slide), or a
+            value outside the joint's range.
+    """
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    hinge, slide = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
+    for name, value in carrier.posture:
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if jid < 0 or int(model.jnt_type[jid]) not in (hinge, slide):
+            raise ValueError(
+                f"posture: carrier {carrier.robot!r} has no hinge or slide joint named {name!r}"
+            )
+        lo, hi = model.jnt_range[jid]
+        if model.jnt_limited[jid] and not lo <= value <= hi:
+            unit = "rad" if int(model.jnt_type[jid]) == hinge else "m"
+            raise ValueError(
+                f"posture: joint {name!r} expects a value in [{lo:g}, {hi:g}] {unit}, got {value:g}"
+            )
+        data.qpos[model.jnt_qposadr[jid]] = value
+    mujoco.mj_kinematics(model, data)
+    for b in spec.bodies[1:]:
+        i, parent = model.body(b.name).id, model.body(b.parent.name).id
+        rot = data.xmat[parent].reshape(3, 3)
+        b.pos = rot.T @ (data.xpos[i] - data.xpos[parent])
+        quat = np.zeros(4)
+        mujoco.mju_negQuat(quat, data.xquat[parent])
+        mujoco.mju_mulQuat(quat, quat, data.xquat[i])
+        b.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT
+        b.quat = quat
 
 
 @dataclass

@@ -14,6 +14,9 @@ built-in one. Every field is optional; the built-in objectives are
       at: back_mount                   # its body or site carrying the limb's base
       pos: [0.0, 0.0, 0.0]             # the base's pose there [m]
       quat: [0.7071068, 0.0, -0.7071068, 0.0]
+      postures:                        # optional: judge the limb in each of these
+        standing: {}                   # the reference pose
+        arms_raised: {left_shoulder_pitch_joint: -2.6, right_shoulder_pitch_joint: -2.6}
     payload: {samples: 32, seed: 0, limit: 100.0, min_free_share: 0.5}
     track:
       duration: 2.0                    # [s]
@@ -23,15 +26,23 @@ built-in one. Every field is optional; the built-in objectives are
 ``track.path`` lists waypoints, offsets [m] in the world frame from the tool point at
 the limb's display pose, visited in order (each leg the same time, starting and stopping
 at rest); without it the reference is the built-in circle and line of ``scale`` times
-the limb's reach. The file is untrusted input: read within its size cap, every field
-checked, problems reported together naming the file and field.
+the limb's reach.
+
+``carrier.postures`` names postures of the carrier, each the joint values (rad for a
+hinge, m for a slide; joints not named stay at the reference pose) it holds while the
+limb is judged. With postures, every physics objective is measured in each of them and
+scored by the worst (the smallest payload, the largest tracking error or power), and the
+limb must not touch the carrier in any of them: a limb that does its job in every posture.
+
+The file is untrusted input: read within its size cap, every field checked, problems
+reported together naming the file and field.
 """
 
 from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +59,11 @@ __all__ = ["DEFAULT_TASK", "Task", "load_task"]
 MAX_OFFSET = 10.0
 #: Most waypoints in a path.
 MAX_WAYPOINTS = 1000
+#: Most carrier postures in a task (each multiplies the physics objectives' cost).
+MAX_POSTURES = 16
+#: Largest joint value a posture may give (rad or m); a limited joint's range is
+#: checked too.
+MAX_POSTURE_VALUE = 100.0
 
 
 @dataclass(frozen=True)
@@ -59,25 +75,50 @@ class Task:
     payload: dict[str, float] = field(default_factory=dict)
     track: dict[str, Any] = field(default_factory=dict)
     collision: dict[str, float] = field(default_factory=dict)
+    #: (name, the carrier in that posture) for each posture the limb is judged in; none:
+    #: the carrier as it is.
+    postures: tuple[tuple[str, Carrier], ...] = ()
+
+    def carriers(self) -> tuple[Carrier, ...]:
+        """The carrier in each posture (the carrier alone when the task names none)."""
+        return tuple(c for _, c in self.postures) or (self.carrier,)
 
     def objective(self, name: str) -> Any:
-        """The objective ``name`` (any of ``grammar search --objective``) set for this task."""
-        from robotwright.grammar.objectives import OBJECTIVES
+        """The objective ``name`` (any of ``grammar search --objective``) set for this
+        task; a physics objective over several postures is scored by the worst."""
+        from robotwright.grammar.objectives import OBJECTIVES, WorstPosture
 
         cls = OBJECTIVES[name]
         if name == "payload":
-            return cls(carrier=self.carrier, **self.payload)
-        if name in ("track", "energy"):
-            return cls(carrier=self.carrier, **self.track)
-        return cls()
+            settings = self.payload
+        elif name in ("track", "energy"):
+            settings = self.track
+        else:
+            return cls()
+        if not self.postures:
+            return cls(carrier=self.carrier, **settings)
+        return WorstPosture(
+            tuple(cls(carrier=c, **settings) for _, c in self.postures),
+            tuple(n for n, _ in self.postures),
+        )
 
     def constraint(self, text: str) -> Any:
-        """The constraint ``text`` (as ``--constraint`` takes it) set for this task."""
-        from robotwright.grammar.objectives import NoCarrierCollision, make_constraint
+        """The constraint ``text`` (as ``--constraint`` takes it) set for this task; the
+        carrier collision check holds in every posture."""
+        from robotwright.grammar.objectives import (
+            InEveryPosture,
+            NoCarrierCollision,
+            make_constraint,
+        )
 
-        if text == "no-carrier-collision":
+        if text != "no-carrier-collision":
+            return make_constraint(text)
+        if not self.postures:
             return NoCarrierCollision(carrier=self.carrier, **self.collision)
-        return make_constraint(text)
+        return InEveryPosture(
+            tuple(NoCarrierCollision(carrier=c, **self.collision) for _, c in self.postures),
+            tuple(n for n, _ in self.postures),
+        )
 
 
 #: The built-in task: the bundled humanoid carries the limb on its back, 32 payload
@@ -93,7 +134,7 @@ _SECTIONS = {
 }
 #: Largest quaternion component accepted (the quaternion is normalised).
 MAX_QUAT_COMPONENT = 1e6
-_CARRIER_KEYS = ("robot", "at", "pos", "quat")
+_CARRIER_KEYS = ("robot", "at", "pos", "quat", "postures")
 
 
 def load_task(path: str | os.PathLike[str]) -> Task:
@@ -124,11 +165,22 @@ def load_task(path: str | os.PathLike[str]) -> Task:
         )
         name = "task"
     carrier = _carrier(data.get("carrier"), bad)
+    raw_carrier = data.get("carrier")
+    postures = (
+        _postures(raw_carrier.get("postures"), carrier, bad)
+        if isinstance(raw_carrier, dict) and not problems
+        else ()
+    )
     sections = {key: _section(key, data.get(key), bad) for key in _SECTIONS}
     if problems:
         raise GrammarError(problems, f"invalid task file {path}")
     task = Task(
-        name.strip(), carrier, sections["payload"], sections["track"], sections["collision"]
+        name.strip(),
+        carrier,
+        sections["payload"],
+        sections["track"],
+        sections["collision"],
+        postures,
     )
     # The objectives check their settings as they are built: report as the file's.
     for what in ("payload", "track"):
@@ -194,6 +246,48 @@ def _carrier(raw: Any, bad: Any) -> Carrier:
     except RobotwrightError as exc:  # $HURODES_ASSETS_PATH may hold another of that name
         bad("carrier.robot", str(exc))
     return carrier
+
+
+def _postures(raw: Any, carrier: Carrier, bad: Any) -> tuple[tuple[str, Carrier], ...]:
+    """``carrier.postures``: name -> {joint: value}, each checked against the carrier."""
+    if raw is None:
+        return ()
+    where = "carrier.postures"
+    if not isinstance(raw, dict) or not 1 <= len(raw) <= MAX_POSTURES:
+        bad(where, f"expected a mapping of 1 to {MAX_POSTURES} postures (name: {{joint: value}})")
+        return ()
+    out = []
+    for name, joints in raw.items():
+        here = f"{where}.{shown_key(name)}"
+        if not isinstance(name, str) or name_problem(name) is not None:
+            bad(here, f"expected a posture name (at most {MAX_NAME_LENGTH} characters)")
+            continue
+        if joints is None:
+            joints = {}
+        if not isinstance(joints, dict):
+            bad(here, "expected a mapping of joint name to value (rad or m)")
+            continue
+        values = []
+        for joint, value in joints.items():
+            number = finite_number(value)
+            if not isinstance(joint, str) or number is None or abs(number) > MAX_POSTURE_VALUE:
+                bad(
+                    f"{here}.{shown_key(joint)}",
+                    f"expected a joint value within +-{MAX_POSTURE_VALUE:g} (rad or m), "
+                    f"got {shown(value)}",
+                )
+                continue
+            values.append((joint, number))
+        if len(values) != len(joints):
+            continue
+        posed = replace(carrier, posture=tuple(values))
+        try:
+            _carrier_xml(posed)  # every joint exists and every value is in its range
+        except ValueError as exc:
+            bad(here, str(exc))
+            continue
+        out.append((name, posed))
+    return tuple(out)
 
 
 def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:

@@ -6,12 +6,16 @@ URDF, design text/JSON, tree, picture of the limb alone), readable by
 
 - ``values.json`` / ``values.txt``: every objective's value with its unit, the score,
   the rank and the design hash;
-- ``on_carrier.png``: the limb worn by its carrier in its display pose, drawn by the
-  ``draw_carrier`` function given (``robotwright grammar search -o`` passes
+- ``on_carrier.png``: the limb worn by the task's carrier in its display pose, drawn by
+  the ``draw_carrier`` function given (``robotwright grammar search -o`` passes
   :func:`robotwright.render.api.draw_pose`: OpenGL when available, else the software
   renderer; the grammar does not import the renderer, which reads design folders);
-- ``track.png`` (objectives ``track`` and ``energy``): the tool path against the
+- ``track.png`` (objectives ``track`` and ``energy``): the tool path against the task's
   reference, seen from the front (y-z) and from above (x-y).
+
+With a task of several carrier postures, each posture gets its pictures, numbered in the
+task's order (``on_carrier.png``, ``on_carrier_2.png``, ...; ``track_2.png``, ...), and
+``values.json`` lists the postures' names in that order.
 
 ``OUT/winners.txt`` lists the ranking. The whole folder is written at once (a failure
 leaves the earlier output, or none). A Pareto search writes ``front_1`` ... instead, with
@@ -30,15 +34,9 @@ import numpy as np
 from robotwright._atomic import atomic_dir
 from robotwright.grammar.build import build
 from robotwright.grammar.objectives import Evaluation, Objective
-from robotwright.grammar.physics import (
-    DEFAULT_CARRIER,
-    Carrier,
-    TrackResult,
-    display_pose,
-    mount,
-    track,
-)
+from robotwright.grammar.physics import TrackResult, display_pose, mount, track
 from robotwright.grammar.rules import Grammar
+from robotwright.grammar.task import DEFAULT_TASK, Task
 
 #: Draws a model at joint values ``qpos`` into a PNG at ``path`` under a ``title``.
 DrawPose = Callable[[mujoco.MjModel, np.ndarray, Path, str], None]
@@ -70,7 +68,7 @@ def write_winners(
     out: str | Path,
     *,
     k: int = 3,
-    carrier: Carrier = DEFAULT_CARRIER,
+    task: Task = DEFAULT_TASK,
     pictures: bool = True,
     draw_carrier: DrawPose | None = None,
 ) -> list[Path]:
@@ -89,7 +87,7 @@ def write_winners(
         objectives,
         Path(out),
         "best",
-        carrier=carrier,
+        task=task,
         pictures=pictures,
         draw_carrier=draw_carrier,
     )
@@ -102,7 +100,7 @@ def write_front(
     out: str | Path,
     *,
     evaluated: Sequence[Evaluation] = (),
-    carrier: Carrier = DEFAULT_CARRIER,
+    task: Task = DEFAULT_TASK,
     pictures: bool = True,
     draw_carrier: DrawPose | None = None,
 ) -> list[Path]:
@@ -132,7 +130,7 @@ def write_front(
         objectives,
         Path(out),
         "front",
-        carrier=carrier,
+        task=task,
         pictures=pictures,
         draw_carrier=draw_carrier,
         extra=extra,
@@ -146,7 +144,7 @@ def _write_designs(
     out: Path,
     prefix: str,
     *,
-    carrier: Carrier,
+    task: Task,
     pictures: bool,
     draw_carrier: DrawPose | None,
     extra: Callable[[Path], None] | None = None,
@@ -170,6 +168,8 @@ def _write_designs(
                 "objectives": {n: {"value": ev.values[n], "unit": UNITS.get(n, "")} for n in names},
                 "values": dict(ev.values),
             }
+            if task.postures:
+                values["postures"] = [name for name, _ in task.postures]
             (folder / "values.json").write_text(json.dumps(values, indent=2) + "\n", "utf-8")
             text = "".join(
                 f"{n}: {ev.values[n]:.6g} {UNITS.get(n, '')}\n".replace(" \n", "\n")
@@ -182,13 +182,20 @@ def _write_designs(
             lines.append(f"{label}: {ev.design.hash()}  {summary.strip()}\n")
             if pictures:
                 limb = build(grammar, ev.design)
-                m = mount(limb, carrier)
-                if draw_carrier is not None:
-                    title = f"{label} on its carrier"
-                    draw_carrier(m.model, display_pose(limb), folder / "on_carrier.png", title)
-                if {"track", "energy"} & set(names):
-                    run = track(limb, carrier, mounted=m)
-                    plot_track(run, folder / "track.png", f"{label} ({ev.design.hash()})")
+                carriers = task.carriers()
+                for i, carrier in enumerate(carriers, 1):
+                    m = mount(limb, carrier)
+                    # Numbered, not named: a posture's name comes from the task file.
+                    suffix = "" if i == 1 else f"_{i}"
+                    of = f", posture {i} of {len(carriers)}" if len(carriers) > 1 else ""
+                    if draw_carrier is not None:
+                        title = f"{label} on its carrier{of}"
+                        png = folder / f"on_carrier{suffix}.png"
+                        draw_carrier(m.model, display_pose(limb), png, title)
+                    if {"track", "energy"} & set(names):
+                        run = track(limb, carrier, mounted=m, **task.track)
+                        title = f"{label} ({ev.design.hash()}){of}"
+                        plot_track(run, folder / f"track{suffix}.png", title)
             written.append(out / label)
         (tmp / "winners.txt").write_text("".join(lines) or "no feasible design\n", encoding="utf-8")
         if extra is not None:
