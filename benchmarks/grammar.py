@@ -35,17 +35,23 @@ from robotwright.grammar.objectives import NoSelfCollision, Reach  # noqa: E402
 from robotwright.grammar.search import random_search  # noqa: E402
 
 
-def rate(fn, n: int, repeat: int, clock=time.perf_counter) -> float:
-    """Median items per second of ``fn()`` (which handles ``n`` items) over ``repeat`` runs,
-    timed by ``clock`` (``time.process_time``: per second of this process's CPU time, what
-    one core does when other work shares the machine)."""
+def rates(fn, n: int, repeat: int) -> tuple[float, float]:
+    """Median items per second of ``fn()`` (which handles ``n`` items) over ``repeat``
+    runs, by the wall clock and per second of this process's CPU time (what one core
+    does when other work shares the machine), both taken on the same runs."""
     fn()
-    samples = []
+    wall, cpu = [], []
     for _ in range(repeat):
-        t0 = clock()
+        t0, c0 = time.perf_counter(), time.process_time()
         fn()
-        samples.append(n / (clock() - t0))
-    return statistics.median(samples)
+        wall.append(n / (time.perf_counter() - t0))
+        cpu.append(n / (time.process_time() - c0))
+    return statistics.median(wall), statistics.median(cpu)
+
+
+def rate(fn, n: int, repeat: int) -> float:
+    """Median items per second of ``fn()`` by the wall clock (see :func:`rates`)."""
+    return rates(fn, n, repeat)[0]
 
 
 def main() -> int:
@@ -110,8 +116,7 @@ def main() -> int:
     )
     print(f"{'task':42s} {'designs/s':>12s} {'per CPU-s':>12s}")
     for task, fn in tasks:
-        wall = rate(fn, n, args.repeat)
-        cpu = rate(fn, n, args.repeat, time.process_time)
+        wall, cpu = rates(fn, n, args.repeat)
         print(f"{task:42s} {wall:12.1f} {cpu:12.1f}")
 
     total = count(g, 3)
@@ -132,19 +137,19 @@ def main() -> int:
     }
     # Alternating runs, so that a change of load touches both sides alike; the pool's
     # start-up is inside its timing, as in a user's search.
-    rates: dict[str, list[float]] = {label: [] for label in makers}
+    search_rates: dict[str, list[float]] = {label: [] for label in makers}
     for _ in range(args.repeat):
         for label, make in makers.items():
             with make() as ex:
                 t0 = time.perf_counter()
                 random_search(g, objs, cons, budget=budget, max_links=L, seed=0, executor=ex)
-                rates[label].append(budget / (time.perf_counter() - t0))
-    for label, values in rates.items():
+                search_rates[label].append(budget / (time.perf_counter() - t0))
+    for label, values in search_rates.items():
         print(
             f"search evaluations (reach + self-collision), {label:30s} "
             f"{statistics.median(values):8.1f} designs/s"
         )
-    one, pool = (statistics.median(v) for v in rates.values())
+    one, pool = (statistics.median(v) for v in search_rates.values())
     print(
         f"process pool speed-up: {pool / one:.2f}x with 2 workers (median of {args.repeat} "
         "alternating runs of each)"
