@@ -490,6 +490,56 @@ def test_urdf_form_names_each_changed_value() -> None:
         assert field in {d.field for d in diffs}, (field, diffs)
 
 
+TWO_ARMS = """<mujoco model="p">
+  <worldbody>
+    <body name="base">
+      <geom type="box" size="0.1 0.1 0.1" mass="1"/>
+      <body name="arm" pos="0 0 0.2">
+        <joint name="shoulder" axis="0 1 0" range="-1 1" damping="0.5"/>
+        <geom type="capsule" size="0.03" fromto="0 0 0 0 0 0.3" mass="0.5" friction="1"/>
+        <body name="hand" pos="0 0 0.3" quat="0.9 0 0.1 0">
+          <joint name="wrist" axis="1 0 0" range="-2 2"/>
+          <geom type="sphere" size="0.04" mass="0.2"/>
+          <geom type="box" size="0.01 0.02 0.03" pos="0.05 0 0" mass="0.1"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_urdf_form_lists_every_change_object_by_object() -> None:
+    from robotwright.proof.urdf_output import compare_urdf_form
+
+    a = _model(TWO_ARMS)
+    # A quaternion and its negative are the same rotation: no difference.
+    flipped = _model(TWO_ARMS.replace('quat="0.9 0 0.1 0"', 'quat="-0.9 0 -0.1 0"'))
+    assert compare_urdf_form(a, flipped) == []
+    changed = TWO_ARMS
+    for old, new in [
+        ('range="-2 2"', 'range="-2 2.5"'),  # wrist
+        ('damping="0.5"', 'damping="0.7"'),  # shoulder
+        ('mass="0.2"', 'mass="0.3"'),  # hand: mass, inertia, centre of mass
+        ('friction="1"', 'friction="0.8"'),  # arm's geom
+        ('size="0.01 0.02 0.03" pos="0.05 0 0"', 'size="0.01 0.02 0.03" pos="0.06 0 0"'),
+    ]:
+        assert old in changed
+        changed = changed.replace(old, new)
+    diffs = compare_urdf_form(a, _model(changed))
+    got = [(d.obj, d.field) for d in diffs]
+    assert got == [
+        ("body 'hand'", "body_mass"),
+        ("body 'hand'", "body_ipos"),
+        ("body 'hand'", "body_inertia"),
+        ("joint 'shoulder'", "dof_damping"),
+        ("joint 'wrist'", "jnt_range"),
+        ("geom #1 of body 'arm'", "geom_friction"),
+        ("geom #3 of body 'hand'", "(object)"),  # moved: no geom of the hand matches it
+    ], got
+    assert (diffs[0].source, diffs[0].result) == ("0.3", "0.4")  # sphere + box
+
+
 def test_export_urdf_proof(tmp_path: Path, monkeypatch, capsys) -> None:
     hrdf_dir = tmp_path / "robot"
     convert(_write(tmp_path, PLAIN), hrdf_dir)

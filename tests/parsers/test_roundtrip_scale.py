@@ -226,3 +226,26 @@ def _motor_model(joints: list[str], motors: tuple[str, ...] | list[str] = ()) ->
     xml += "</body></worldbody><actuator>"
     xml += "".join(f"<motor joint='{j}'/>" for j in motors)
     return mujoco.MjModel.from_xml_string(xml + "</actuator></mujoco>")
+
+
+def test_a_chain_too_deep_for_mjcf_exports_to_urdf_saying_the_proof_is_not_made(
+    tmp_path: Path, capsys
+) -> None:
+    from robotwright.cli import main
+
+    source = tmp_path / "chain.urdf"
+    source.write_text(tree_urdf(600, branching=1))
+    assert main(["convert", str(source), "-o", str(tmp_path / "hrdf")]) == 0
+    capsys.readouterr()
+    out = tmp_path / "out.urdf"
+    # URDF files are flat: the chain is written; only the proof (through our MJCF,
+    # whose nesting MuJoCo's reader limits) cannot be made, and the note says so.
+    assert main(["-v", "export", str(tmp_path / "hrdf"), "--format", "urdf", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "proof: not made" in err and "600 bodies deep" in err, err
+    text = out.read_text()
+    assert all(f'<link name="l{i}"' in text for i in range(600))
+    # MJCF cannot hold it: refused, saying what can.
+    assert main(["export", str(tmp_path / "hrdf"), "-o", str(tmp_path / "out.xml")]) == 2
+    assert "write URDF or HRDF" in capsys.readouterr().err
+    assert not (tmp_path / "out.xml").exists()

@@ -1,0 +1,166 @@
+"""How the cost of converting and exporting grows with the robot: chains and trees of
+100, 300, 1,000 and 3,000 links, each step with its proof, as the command line runs it.
+
+Robots (URDF, built here): link i hangs from link i-1 (a chain) or from link (i-1)//4 (a
+tree), each with a box visual and collision geom, on revolute joints. Steps, timed in
+this process (CPU seconds, median of --repeat runs):
+
+  convert     robotwright convert ROBOT.urdf -o HRDF       (URDF -> HRDF, with its proof)
+  export-mjcf robotwright export HRDF --format mjcf        (with its proof; a chain deeper
+                                                            than MuJoCo's MJCF reader takes
+                                                            has no MJCF: skipped)
+  export-urdf robotwright export HRDF --format urdf        (with its proof)
+  export-usd  robotwright export HRDF --format usd         (only where mujoco-usd-converter
+                                                            is installed: Isaac Lab's
+                                                            environment; --usd)
+
+CPU time counts this process and the reader processes it starts. One conversion of a
+small robot runs first, untimed (imports, caches).
+
+  mujoco      mujoco.MjModel.from_xml_path(ROBOT.urdf): MuJoCo's own import of the source,
+              the reference every proof compiles at least once
+
+Prints each time and, per step and shape, the growth exponent k of time ~ links^k fitted
+over the sizes (least squares on the logs; the goal is k <= 1.2) and the exponent between
+the two largest sizes (where a step that grows faster than the links shows first).
+
+    python benchmarks/scaling.py [--sizes 100 300 1000 3000] [--repeat 1] [--usd]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import math
+import resource
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import mujoco
+from _machine import measured
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "parsers"))
+from test_roundtrip_scale import tree_urdf  # noqa: E402
+
+from robotwright._inputs import MJCF_MAX_BODY_DEPTH  # noqa: E402
+from robotwright.cli import main as cli  # noqa: E402
+
+SHAPES = {"chain": 1, "tree": 4}
+
+
+def _depth(n: int, branching: int) -> int:
+    """Bodies from the root to the deepest link of a robot of ``n`` links."""
+    depth, i = 1, n - 1
+    while i > 0:
+        i = (i - 1) // branching
+        depth += 1
+    return depth
+
+
+def _cpu() -> float:
+    """CPU seconds of this process and of its finished children (the confined readers
+    run in child processes)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
+def _run(args: list[str]) -> float:
+    """CPU seconds of one command (its output swallowed); exit code 0 required."""
+    out, err = io.StringIO(), io.StringIO()
+    c0 = _cpu()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = cli(args)
+    spent = _cpu() - c0
+    if code != 0:
+        raise SystemExit(f"robotwright {' '.join(args)} exited {code}:\n{err.getvalue()}")
+    return spent
+
+
+def _mujoco_import(source: Path) -> float | None:
+    """CPU seconds of MuJoCo's own import of ``source`` (None: MuJoCo refuses it)."""
+    c0 = _cpu()
+    try:
+        mujoco.MjModel.from_xml_path(str(source))
+    except ValueError:  # a chain deeper than its compiler's own depth limit
+        return None
+    return _cpu() - c0
+
+
+def exponent(sizes: list[int], times: list[float]) -> float:
+    """k of ``time ~ size^k``, least squares on the logs."""
+    xs = [math.log(s) for s in sizes]
+    ys = [math.log(max(t, 1e-9)) for t in times]
+    mx, my = statistics.fmean(xs), statistics.fmean(ys)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument("--sizes", type=int, nargs="+", default=[100, 300, 1000, 3000])
+    ap.add_argument("--repeat", type=int, default=1, help="runs per step (median)")
+    ap.add_argument("--usd", action="store_true", help="also export USD (Isaac Lab's env)")
+    args = ap.parse_args()
+    steps = ["convert", "export-mjcf", "export-urdf"] + (["export-usd"] if args.usd else [])
+    steps.append("mujoco")
+    print(f"{'shape':6} {'links':>6} " + " ".join(f"{s:>12}" for s in steps) + "   (CPU s)")
+    growth: dict[tuple[str, str], tuple[list[int], list[float]]] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        warm = Path(tmp) / "warm.urdf"
+        warm.write_text(tree_urdf(10), encoding="utf-8")
+        _run(["convert", str(warm), "-o", str(Path(tmp) / "warm"), "--overwrite"])
+        for shape, branching in SHAPES.items():
+            for n in args.sizes:
+                folder = Path(tmp) / f"{shape}{n}"
+                folder.mkdir()
+                source = folder / "robot.urdf"
+                source.write_text(tree_urdf(n, branching=branching), encoding="utf-8")
+                hrdf = folder / "hrdf"
+                cells = []
+                for step in steps:
+                    if step == "export-mjcf" and _depth(n, branching) > MJCF_MAX_BODY_DEPTH:
+                        cells.append(f"{'(too deep)':>12}")
+                        continue
+                    if step == "mujoco":
+                        runs = [_mujoco_import(source) for _ in range(args.repeat)]
+                        if None in runs:
+                            cells.append(f"{'(refused)':>12}")
+                            continue
+                        spent = statistics.median(runs)  # type: ignore[type-var]
+                        sizes, times = growth.setdefault((shape, step), ([], []))
+                        sizes.append(n)
+                        times.append(spent)
+                        cells.append(f"{spent:12.2f}")
+                        continue
+                    if step == "convert":
+                        cmd = ["convert", str(source), "-o", str(hrdf), "--overwrite"]
+                    else:
+                        kind = step.split("-")[1]
+                        out = folder / f"out.{'xml' if kind == 'mjcf' else kind}"
+                        cmd = ["export", str(hrdf), "--format", kind, "-o", str(out)]
+                        cmd.append("--overwrite")
+                    spent = statistics.median(_run(cmd) for _ in range(args.repeat))
+                    sizes, times = growth.setdefault((shape, step), ([], []))
+                    sizes.append(n)
+                    times.append(spent)
+                    cells.append(f"{spent:12.2f}")
+                print(f"{shape:6} {n:>6} " + " ".join(cells), flush=True)
+    print("growth exponent k (time ~ links^k; goal <= 1.2):")
+    for (shape, step), (sizes, times) in growth.items():
+        if len(sizes) >= 2:
+            k = exponent(sizes, times)
+            last = exponent(sizes[-2:], times[-2:])
+            print(
+                f"  {shape:6} {step:12} k = {k:.2f} over {sizes[0]}-{sizes[-1]} links, "
+                f"{last:.2f} from {sizes[-2]} to {sizes[-1]}"
+            )
+
+
+if __name__ == "__main__":
+    with measured(("trimesh",)):
+        main()
