@@ -451,15 +451,22 @@ def ik_path(
     targets: np.ndarray,
     q0: np.ndarray,
     iters: int = 6,
-    damping: float = 0.01,
+    damping: float = 0.1,
     max_step: float = 0.02,
-    tol: float = 1e-5,
 ) -> np.ndarray:
     """Joint vectors following ``targets`` (m) with the first tool point, by damped least
     squares (``dq = J^T (J J^T + damping^2 I)^-1 e``, ``damping`` in m, the error ``e``
     shortened to at most ``max_step`` m per iteration so the solution moves
     continuously), warm-started from the previous point (``q0`` first; the first point
-    gets ten times the iterations), clipped to the joint ranges, stopping at ``tol`` m."""
+    gets ten times the iterations), clipped to the joint ranges.
+
+    A fixed number of iterations, each a smooth function of the last: the joint path,
+    and so every score computed from it, moves by as little as the model does. A stop
+    once the error is small, or a damping of 0.01 m, made it chaotic where a target is
+    out of reach (the iteration overshoots and wanders): a 1e-9 change of a mass moved
+    the tracking error of 17 of 48 random designs by 3-87%; with these settings none
+    moves by more than 2e-9 of its value (72 designs).
+    """
     model, data = m.model, mujoco.MjData(m.model)
     site = m.sites[0]
     jac = np.zeros((3, model.nv))
@@ -472,8 +479,6 @@ def ik_path(
             mujoco.mj_kinematics(model, data)
             err = target - data.site_xpos[site]
             norm = float(np.sqrt(err @ err))
-            if norm < tol:
-                break
             if norm > max_step:
                 err *= max_step / norm
             mujoco.mj_comPos(model, data)
@@ -513,7 +518,8 @@ def track(
     Reference: centred on the tool point at the limb's display pose (revolute joints at
     +-0.5 rad, prismatic at mid-stroke), radius ``scale`` times the limb's reach (the
     largest tool-point distance from the base over 256 seeded poses, or ``reach`` m).
-    Joint reference: damped-least-squares IK at 100 Hz; it, its velocity and acceleration
+    Joint reference: damped-least-squares IK (damping 0.1 m, a fixed number of
+    iterations: see :func:`ik_path`) at 100 Hz; it, its velocity and acceleration
     (finite differences at 100 Hz) are interpolated to each step.
     Controller (every 0.002 s step of the carrier model): ``tau = M(q) (qdd_ref + kp e +
     kd de) + bias(q, dq)`` with ``kp = omega^2``, ``kd = 2 omega`` (a PD law scaled by
