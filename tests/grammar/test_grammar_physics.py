@@ -369,7 +369,7 @@ r4 @9: E=gripper(finger_length=0.06)
 
 
 @pytest.mark.parametrize("steps", CHAOTIC_BEFORE)
-def test_a_1e9_mass_change_moves_track_and_energy_by_at_most_1e6(grammar, steps) -> None:
+def test_a_1e9_mass_change_moves_track_energy_and_payload_by_at_most_1e6(grammar, steps) -> None:
     limb = build(grammar, Design.from_text("# robotwright-design/1 grammar=srl\n" + steps))
     base = P.track(limb, mounted=P.mount(limb))
     heavier = P.mount(limb)
@@ -379,3 +379,5 @@ def test_a_1e9_mass_change_moves_track_and_energy_by_at_most_1e6(grammar, steps)
     assert moved.error == pytest.approx(base.error, rel=1e-6, abs=0)
     assert moved.power == pytest.approx(base.power, rel=1e-6, abs=0)
     assert np.abs(moved.path - base.path).max() < 1e-6  # the whole run, not only its mean
+    held = P.payload(limb, mounted=P.mount(limb)).mass
+    assert P.payload(limb, mounted=heavier).mass == pytest.approx(held, rel=1e-6, abs=0)
