@@ -236,6 +236,9 @@ def test_a_search_with_postures_logs_them_and_resumes(tmp_path, capsys) -> None:
     # The winner pictured in each posture, in the task's order.
     values = json.loads((out / "best_1" / "values.json").read_text())
     assert values["postures"] == ["standing", "arms_back"]
+    each = values["by_posture"]["payload"]
+    assert set(each) == {"standing", "arms_back"}
+    assert values["values"]["payload"] == pytest.approx(min(each.values()), rel=1e-12)
     assert (out / "best_1" / "on_carrier.png").is_file()
     assert (out / "best_1" / "on_carrier_2.png").is_file()
     capsys.readouterr()

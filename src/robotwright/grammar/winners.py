@@ -15,7 +15,8 @@ URDF, design text/JSON, tree, picture of the limb alone), readable by
 
 With a task of several carrier postures, each posture gets its pictures, numbered in the
 task's order (``on_carrier.png``, ``on_carrier_2.png``, ...; ``track_2.png``, ...), and
-``values.json`` lists the postures' names in that order.
+``values.json`` lists the postures' names in that order and, under ``by_posture``, each
+physics objective's value in every posture (the score is the worst of them).
 
 ``OUT/winners.txt`` lists the ranking. The whole folder is written at once (a failure
 leaves the earlier output, or none). A Pareto search writes ``front_1`` ... instead, with
@@ -33,7 +34,7 @@ import numpy as np
 
 from robotwright._atomic import atomic_dir
 from robotwright.grammar.build import build
-from robotwright.grammar.objectives import Evaluation, Objective
+from robotwright.grammar.objectives import EvalContext, Evaluation, Objective, WorstPosture
 from robotwright.grammar.physics import TrackResult, display_pose, mount, track
 from robotwright.grammar.rules import Grammar
 from robotwright.grammar.task import DEFAULT_TASK, Task
@@ -170,6 +171,11 @@ def _write_designs(
             }
             if task.postures:
                 values["postures"] = [name for name, _ in task.postures]
+                # Each physics objective's value in every posture (its score is the worst).
+                ctx = EvalContext(grammar, ev.design)
+                values["by_posture"] = {
+                    o.name: o.by_posture(ctx) for o in objectives if isinstance(o, WorstPosture)
+                }
             (folder / "values.json").write_text(json.dumps(values, indent=2) + "\n", "utf-8")
             text = "".join(
                 f"{n}: {ev.values[n]:.6g} {UNITS.get(n, '')}\n".replace(" \n", "\n")
