@@ -114,3 +114,22 @@ def test_the_command_line_simulates_when_asked(tmp_path, capsys) -> None:
     src, out = tmp_path / "arm_capped.xml", tmp_path / "cli.xml"
     assert main(["convert", str(src), "-o", str(out), "--simulate", "-v"]) == 0
     assert "proof: simulation, zero control, 200 steps differs" in capsys.readouterr().err
+
+
+def test_roundtrip_reports_the_simulation_as_a_row_when_asked(tmp_path, capsys) -> None:
+    from robotwright.cli import main
+    from robotwright.proof.roundtrip.run import SIMULATION_CHECK, roundtrip
+
+    _model(tmp_path)
+    _model(tmp_path, ' maxhullvert="8"')
+    same = {r.check: r for r in roundtrip(tmp_path / "arm.xml", configs=5, simulate=True).rows}
+    assert same[SIMULATION_CHECK].ok and same[SIMULATION_CHECK].compared == 1
+    # The source's hull is capped at 8 vertices and our MJCF's is not: the static rows
+    # compare bodies, joints and geoms alike; the simulation row sees the contacts.
+    report = roundtrip(tmp_path / "arm_capped.xml", configs=5, simulate=True)
+    row = {r.check: r for r in report.rows}[SIMULATION_CHECK]
+    assert not row.ok and "differing from step" in row.value and not report.ok
+    assert SIMULATION_CHECK not in {r.check for r in roundtrip(tmp_path / "arm.xml").rows}
+    capsys.readouterr()
+    assert main(["roundtrip", str(tmp_path / "arm_capped.xml"), "--simulate"]) == 1
+    assert "MJCF: simulation" in capsys.readouterr().out

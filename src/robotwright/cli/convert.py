@@ -205,6 +205,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=50,
         help="random joint configurations compared in forward kinematics (default 50)",
     )
+    p.add_argument(
+        "--simulate",
+        action="store_true",
+        help="one more row: the source and our MJCF stepped side by side for 200 steps "
+        "(zero and pseudo-random control, contacts on), flagging joint positions that "
+        "differ by more than 1e-6 and more than the source's own sensitivity",
+    )
     _source_args(p)
     p.add_argument(
         "--show-warnings", action="store_true", help="list the parse warnings (as -v does)"
@@ -305,7 +312,13 @@ def _roundtrip(args: argparse.Namespace) -> int:
     source = Path(args.source)
     if not source.exists() and source.suffix.lower() not in (".urdf", ".xml", ".xacro"):
         source = resolve_source(args.source).path  # a robot name
-    report = roundtrip(source, configs=args.configs, reference=args.reference, **_options(args))
+    report = roundtrip(
+        source,
+        configs=args.configs,
+        reference=args.reference,
+        simulate=args.simulate,
+        **_options(args),
+    )
     if report.input_error is not None:
         raise report.input_error  # bad input: exit 2 on stderr, no table
     print(report.table())

@@ -31,6 +31,7 @@ from robotwright.proof.objects import Difference
 
 __all__ = [
     "CHAOS_MARGIN",
+    "can_roll_out",
     "MAX_ROLLOUT_DOFS",
     "PERTURBATION",
     "ROLLOUT_STEPS",
@@ -76,6 +77,23 @@ def _joint_at(model: mujoco.MjModel, qpos_index: int) -> str:
     return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint #{j}"
 
 
+def can_roll_out(
+    source: mujoco.MjModel,
+    result: mujoco.MjModel,
+    qpos_map: dict[int, int],
+    actuator_map: dict[int, int],
+) -> bool:
+    """Whether the two models can be simulated side by side: every joint position and
+    actuator of the source matched in the result (which has no others), and at most
+    :data:`MAX_ROLLOUT_DOFS` degrees of freedom."""
+    return (
+        source.nq == result.nq == len(qpos_map)
+        and source.nu == result.nu == len(actuator_map)
+        and source.nv <= MAX_ROLLOUT_DOFS
+        and all(r >= 0 for r in actuator_map.values())
+    )
+
+
 def rollout_differences(
     source: mujoco.MjModel,
     result: mujoco.MjModel,
@@ -85,13 +103,9 @@ def rollout_differences(
 ) -> list[Difference]:
     """The rollouts of ``source`` and ``result`` compared (see the module docstring).
     ``qpos_map``: source joint position index -> the result's; ``actuator_map``: source
-    actuator -> the result's. Empty when they agree or cannot be compared."""
-    if not (
-        source.nq == result.nq == len(qpos_map)
-        and source.nu == result.nu == len(actuator_map)
-        and source.nv <= MAX_ROLLOUT_DOFS
-        and all(r >= 0 for r in actuator_map.values())
-    ):
+    actuator -> the result's. Empty when they agree or cannot be compared
+    (:func:`can_roll_out`)."""
+    if not can_roll_out(source, result, qpos_map, actuator_map):
         return []
     src_q = np.fromiter(qpos_map.keys(), dtype=int)
     res_q = np.fromiter(qpos_map.values(), dtype=int)

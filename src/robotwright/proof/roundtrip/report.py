@@ -54,6 +54,8 @@ class RoundTripReport:
     parse: ParseResult | None = field(default=None, repr=False)
     #: MuJoCo's compile of our MJCF of that robot (None when not written or refused).
     mjcf_model: mujoco.MjModel | None = field(default=None, repr=False)
+    #: MuJoCo's model of the source (None when the reference is not MuJoCo's).
+    reference_model: mujoco.MjModel | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

@@ -58,12 +58,16 @@ def roundtrip(
     configs: int = 50,
     urdf: bool = True,
     reference: str = "auto",
+    simulate: bool = False,
     **options: Any,
 ) -> RoundTripReport:
     """The fidelity table of one MJCF or URDF file (see the module docstring).
 
     ``reference``: ``"auto"`` (MuJoCo's import; yourdfpy for a URDF MuJoCo refuses),
-    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``options`` go to the parser. Staged
+    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``simulate``: one more row, the source
+    and our MJCF stepped side by side (:mod:`robotwright.proof.rollout`: 200 steps with
+    zero and with pseudo-random control, contacts on; MuJoCo references only). ``options``
+    go to the parser. Staged
     meshes live in a temporary folder removed at the end (unless ``work_dir`` is given).
 
     Raises:
@@ -73,9 +77,42 @@ def roundtrip(
     """
     _check_input(Path(source), configs)
     if "work_dir" in options:
-        return _roundtrip(Path(source), configs, urdf, reference, options)
-    with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
-        return _roundtrip(Path(source), configs, urdf, reference, {**options, "work_dir": tmp})
+        report = _roundtrip(Path(source), configs, urdf, reference, options)
+    else:
+        with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
+            work = {**options, "work_dir": tmp}
+            report = _roundtrip(Path(source), configs, urdf, reference, work)
+    if simulate and not report.error:
+        report.rows.insert(_after_mjcf_rows(report), simulation_row(report))
+    return report
+
+
+#: The check of the simulation row.
+SIMULATION_CHECK = "MJCF: simulation (200 steps, zero and pseudo-random control, contacts on)"
+
+
+def _after_mjcf_rows(report: RoundTripReport) -> int:
+    return sum(1 for r in report.rows if r.check.startswith("MJCF: "))
+
+
+def simulation_row(report: RoundTripReport) -> Row:
+    """The source's model and our MJCF's stepped side by side, as one row: "n/a" when
+    the two cannot be (no MuJoCo reference, joints or actuators not matched one to
+    one, more than :data:`~robotwright.proof.rollout.MAX_ROLLOUT_DOFS` DoF)."""
+    from robotwright.proof.compare import _matched
+    from robotwright.proof.rollout import can_roll_out, rollout_differences
+
+    source = report.reference_model
+    ours = report.mjcf_model
+    if source is None or ours is None:
+        return Row(SIMULATION_CHECK, "no MuJoCo model of the source", True, compared=0)
+    _, _, maps, cols = _matched(source, ours, None)
+    if not can_roll_out(source, ours, cols["qpos"], maps["actuator"]):
+        return Row(SIMULATION_CHECK, "not comparable one to one", True, compared=0)
+    found = rollout_differences(source, ours, cols["qpos"], maps["actuator"])
+    if not found:
+        return Row(SIMULATION_CHECK, "the same motion (within 1e-6)", True, compared=1)
+    return Row(SIMULATION_CHECK, "; ".join(d.result for d in found), False, compared=1)
 
 
 def _check_input(path: Path, configs: int) -> None:
@@ -179,6 +216,7 @@ def _roundtrip_on(
         report.error = f"no reference: {type(exc).__name__}: {exc}"
         return report
     report.reference = ref.kind
+    report.reference_model = ref.model
     try:
         report.mjcf_model = mjcf_job.result()
         ours = view_from_model(report.mjcf_model)
