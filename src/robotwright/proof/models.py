@@ -206,7 +206,7 @@ def result_model(
     import tempfile
     import warnings
 
-    from robotwright.proof.roundtrip.run import our_mjcf_text, our_urdf_model
+    from robotwright.proof.roundtrip.sides import our_mjcf_text, our_urdf_model
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
