@@ -23,17 +23,23 @@ def test_every_benchmark_says_where_it_ran(script: Path) -> None:
     )
 
 
-def test_measured_prints_cpu_load_and_versions() -> None:
-    code = (
-        "import sys; sys.path.insert(0, sys.argv[1]);"
-        "from _machine import measured\n"
-        "with measured(('numpy',)):\n    print('figures')"
-    )
+def _with_machine(code: str) -> list[str]:
+    """The lines ``code`` prints in a fresh interpreter that imports from benchmarks/."""
     run = subprocess.run(
-        [sys.executable, "-c", code, str(BENCHMARKS)], capture_output=True, text=True
-    )
+        [sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv[1])\n" + code,
+         str(BENCHMARKS)],
+        capture_output=True,
+        text=True,
+    )  # fmt: skip
     assert run.returncode == 0, run.stderr
-    first, versions, figures, after = run.stdout.splitlines()
+    return run.stdout.splitlines()
+
+
+def test_measured_prints_cpu_load_and_versions() -> None:
+    lines = _with_machine(
+        "from _machine import measured\nwith measured(('numpy',)):\n    print('figures')"
+    )
+    first, versions, figures, after = lines
     assert "CPU cores, load" in first and first.startswith("Python ")
     assert versions.startswith("versions: robotwright ") and "numpy" in versions
     assert figures == "figures" and after.startswith("load average after: ")
@@ -42,17 +48,11 @@ def test_measured_prints_cpu_load_and_versions() -> None:
 def test_a_peer_in_its_own_interpreter_is_named_with_its_version() -> None:
     import importlib.metadata
 
-    code = (
-        "import sys; sys.path.insert(0, sys.argv[1]);"
+    numpy_line, absent, unknown = _with_machine(
         "from _machine import print_peer\n"
         "print_peer(sys.executable, 'numpy'); print_peer(None, 'hurodes')\n"
         "print_peer(sys.executable, 'no-such-distribution-here')"
     )
-    run = subprocess.run(
-        [sys.executable, "-c", code, str(BENCHMARKS)], capture_output=True, text=True
-    )
-    assert run.returncode == 0, run.stderr
-    numpy_line, absent, unknown = run.stdout.splitlines()
     assert numpy_line.startswith(f"peer: numpy {importlib.metadata.version('numpy')} (run by ")
     assert absent == "peer: hurodes not run (no interpreter given)"
     assert unknown.startswith("peer: no-such-distribution-here unknown")

@@ -329,7 +329,8 @@ class _TrackingRun:
     def __post_init__(self) -> None:
         check_settings(type(self).__name__, duration=self.duration, scale=self.scale)
 
-    def _run(self, ctx: EvalContext) -> TrackResult:
+    def run(self, ctx: EvalContext) -> TrackResult:
+        """The tracking run these settings ask for, made once per design in ``ctx``."""
         return ctx.tracking(self.carrier, self.duration, self.scale, self.path)
 
 
@@ -343,7 +344,7 @@ class Track(_TrackingRun):
     maximize: bool = False
 
     def __call__(self, ctx: EvalContext) -> float:
-        return self._run(ctx).error
+        return self.run(ctx).error
 
 
 @dataclass(frozen=True)
@@ -355,7 +356,7 @@ class Energy(_TrackingRun):
     maximize: bool = False
 
     def __call__(self, ctx: EvalContext) -> float:
-        return self._run(ctx).power
+        return self.run(ctx).power
 
 
 @dataclass(frozen=True)

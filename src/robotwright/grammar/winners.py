@@ -33,9 +33,14 @@ import mujoco
 import numpy as np
 
 from robotwright._atomic import atomic_dir
-from robotwright.grammar.build import build
-from robotwright.grammar.objectives import EvalContext, Evaluation, Objective, WorstPosture
-from robotwright.grammar.physics import TrackResult, display_pose, mount, track
+from robotwright.grammar.objectives import (
+    EvalContext,
+    Evaluation,
+    Objective,
+    Track,
+    WorstPosture,
+)
+from robotwright.grammar.physics import TrackResult, display_pose
 from robotwright.grammar.rules import Grammar
 from robotwright.grammar.task import DEFAULT_TASK, Task
 
@@ -169,10 +174,12 @@ def _write_designs(
                 "objectives": {n: {"value": ev.values[n], "unit": UNITS.get(n, "")} for n in names},
                 "values": dict(ev.values),
             }
+            # One context per winner: the values by posture, the drawings and the track
+            # plots share its limb, mounted models and tracking runs.
+            ctx = EvalContext(grammar, ev.design)
             if task.postures:
                 values["postures"] = [name for name, _ in task.postures]
                 # Each physics objective's value in every posture (its score is the worst).
-                ctx = EvalContext(grammar, ev.design)
                 values["by_posture"] = {
                     o.name: o.by_posture(ctx) for o in objectives if isinstance(o, WorstPosture)
                 }
@@ -187,10 +194,10 @@ def _write_designs(
             summary = ", ".join(f"{n} {ev.values[n]:.4g} {UNITS.get(n, '')}" for n in names)
             lines.append(f"{label}: {ev.design.hash()}  {summary.strip()}\n")
             if pictures:
-                limb = build(grammar, ev.design)
+                limb = ctx.limb
                 carriers = task.carriers()
                 for i, carrier in enumerate(carriers, 1):
-                    m = mount(limb, carrier)
+                    m = ctx.mounted(carrier)
                     # Numbered, not named: a posture's name comes from the task file.
                     suffix = "" if i == 1 else f"_{i}"
                     of = f", posture {i} of {len(carriers)}" if len(carriers) > 1 else ""
@@ -199,7 +206,7 @@ def _write_designs(
                         png = folder / f"on_carrier{suffix}.png"
                         draw_carrier(m.model, display_pose(limb), png, title)
                     if {"track", "energy"} & set(names):
-                        run = track(limb, carrier, mounted=m, **task.track)
+                        run = Track(carrier=carrier, **task.track).run(ctx)
                         title = f"{label} ({ev.design.hash()}){of}"
                         plot_track(run, folder / f"track{suffix}.png", title)
             written.append(out / label)

@@ -344,13 +344,16 @@ def prove(
         geom_order=kind != "urdf",
     )
     if simulate and kind == "mjcf" and root is None:
-        diffs += _rollouts(src, res)
+        diffs += _rollouts(src, res) or []
     return found + as_problems(str(source), uncovered(diffs, [*notes, *written]))
 
 
-def _rollouts(source: mujoco.MjModel, result: mujoco.MjModel) -> list[Difference]:
-    """The two models simulated side by side (:mod:`robotwright.proof.rollout`)."""
-    from robotwright.proof.rollout import rollout_differences
+def _rollouts(source: mujoco.MjModel, result: mujoco.MjModel) -> list[Difference] | None:
+    """The two models simulated side by side (:mod:`robotwright.proof.rollout`); None
+    when they cannot be (:func:`~robotwright.proof.rollout.can_roll_out`)."""
+    from robotwright.proof.rollout import can_roll_out, rollout_differences
 
     _, _, maps, cols = _matched(source, result, None)
+    if not can_roll_out(source, result, cols["qpos"], maps["actuator"]):
+        return None
     return rollout_differences(source, result, cols["qpos"], maps["actuator"])

@@ -95,6 +95,7 @@ def compare_urdf_form(
     # (object index, order of the check, difference): sorted at the end so that the
     # differences come object by object, each object's checks in the order below.
     found: list[tuple[int, int, Difference]] = []
+    fam_word = {"body": "body", "jnt": "joint", "dof": "joint"}
 
     def flag(rank: int, field, fam, bad, rows, names, a, b) -> None:
         for k in np.flatnonzero(bad):
@@ -115,7 +116,6 @@ def compare_urdf_form(
                 )
             )
 
-    fam_word = {"body": "body", "jnt": "joint", "dof": "joint"}
     body_of: dict[int, int] = {0: 0}
     pairs: list[tuple[int, int]] = []
     for i in range(1, mjcf.nbody):

@@ -99,17 +99,15 @@ def simulation_row(report: RoundTripReport) -> Row:
     """The source's model and our MJCF's stepped side by side, as one row: "n/a" when
     the two cannot be (no MuJoCo reference, joints or actuators not matched one to
     one, more than :data:`~robotwright.proof.rollout.MAX_ROLLOUT_DOFS` DoF)."""
-    from robotwright.proof.compare import _matched
-    from robotwright.proof.rollout import can_roll_out, rollout_differences
+    from robotwright.proof.compare import _rollouts
 
     source = report.reference_model
     ours = report.mjcf_model
     if source is None or ours is None:
         return Row(SIMULATION_CHECK, "no MuJoCo model of the source", True, compared=0)
-    _, _, maps, cols = _matched(source, ours, None)
-    if not can_roll_out(source, ours, cols["qpos"], maps["actuator"]):
+    found = _rollouts(source, ours)
+    if found is None:
         return Row(SIMULATION_CHECK, "not comparable one to one", True, compared=0)
-    found = rollout_differences(source, ours, cols["qpos"], maps["actuator"])
     if not found:
         return Row(SIMULATION_CHECK, "the same motion (within 1e-6)", True, compared=1)
     return Row(SIMULATION_CHECK, "; ".join(d.result for d in found), False, compared=1)
