@@ -142,16 +142,39 @@ def test_payload_grows_with_torque_and_is_zero_when_the_limb_cannot_hold_itself(
             )
 
 
-def test_tracking_strong_vs_weak_and_static_reference(arm):
-    strong = P.track(scaled(arm, 100.0), scale=0.05)
-    weak = P.track(scaled(arm, 0.01), scale=0.05)
+#: A limb of four revolute joints that follows the built-in circle (a track winner).
+TRACKER = """# robotwright-design/1 grammar=srl
+r1 @0: B=base(diameter=0.12, thickness=0.04) P=pinned()
+r2 @0: C=revolute(limit=2.618) L=link(diameter=0.04, length=0.25, rotation=0.0)
+r3 @3: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.25, rotation=1.5708)
+r3 @5: C=revolute(limit=1.5708) L=link(diameter=0.04, length=0.15, rotation=-1.5708)
+r3 @7: C=revolute(limit=2.618) L=link(diameter=0.04, length=0.25, rotation=-1.5708)
+r4 @9: E=tool(length=0.08)
+"""
+
+
+def test_tracking_strong_vs_weak_and_static_reference(grammar):
+    limb = build(grammar, Design.from_text(TRACKER))
+    strong = P.track(scaled(limb, 100.0))
+    weak = P.track(scaled(limb, 0.01))
+    assert strong.contact_share == 0 and strong.first_contact is None
+    assert strong.first_overlap is None
     assert strong.error < 0.01 < weak.error
     assert weak.error > 10 * strong.error
     assert strong.power >= 0 and weak.power >= 0
     assert strong.path.shape == strong.reference.shape == (1001, 3)
-    # the reference is a circle of 5 % of the reach about the display pose's tool point
+    assert strong.qpos.shape == strong.qvel.shape == (1001, limb.dof)
+    # the reference: a circle of TRACK_RADIUS about TRACK_CENTER (mount frame), the same
+    # for every design, closed at half time
+    m = P.mount(limb)
+    data = mujoco.MjData(m.model)
+    mujoco.mj_kinematics(m.model, data)
+    centre = m.to_world(data, np.array(P.TRACK_CENTER))
+    radii = np.linalg.norm(strong.reference[:501] - centre, axis=1)
+    np.testing.assert_allclose(radii, P.TRACK_RADIUS, atol=1e-12)
     assert np.linalg.norm(strong.reference[0] - strong.reference[500]) == pytest.approx(0, abs=1e-9)
-    static = P.track(arm, scale=0.0)
+    # a reference that stays at the display pose's tool point: nothing moves
+    static = P.track(limb, center=None, radius=0.0)
     assert static.error == pytest.approx(0.0, abs=1e-9)
     assert static.power == pytest.approx(0.0, abs=1e-9)
 

@@ -223,9 +223,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--constraint",
         action="append",
         default=None,
-        help="no-self-collision (default; with no-carrier-collision for payload, track and "
-        "energy), no-carrier-collision, joint-limits, max-mass=KG, "
-        "max-dof=N, min-dof=N; repeatable",
+        help="no-self-collision and no-overlap (default; with no-carrier-collision for "
+        "payload, track and energy, and no-contact-on-track and within-ratings for track "
+        "and energy), no-carrier-collision, no-contact-on-track, within-ratings, "
+        "joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable",
     )
     q.add_argument(
         "--budget",
@@ -457,9 +458,13 @@ _CARRIER_OBJECTIVES = ("payload", "track", "energy")
 
 
 def _default_constraints(args: argparse.Namespace) -> list[str]:
-    if set(args.objective or ()) & set(_CARRIER_OBJECTIVES):
-        return ["no-self-collision", "no-carrier-collision"]
-    return ["no-self-collision"]
+    asked = set(args.objective or ())
+    out = ["no-self-collision", "no-overlap"]
+    if asked & set(_CARRIER_OBJECTIVES):
+        out.append("no-carrier-collision")
+    if asked & {"track", "energy"}:
+        out += ["no-contact-on-track", "within-ratings"]
+    return out
 
 
 _OBJECTIVE_NAMES = ["reach", "workspace", "mass", "dof", "payload", "track", "energy"]

@@ -21,8 +21,12 @@ import numpy as np
 
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.design import Design
+from robotwright.grammar.overlap import overlaps
 from robotwright.grammar.physics import (
     MIN_FREE_SHARE,
+    PAYLOAD_MIN_REACH,
+    TRACK_CENTER,
+    TRACK_RADIUS,
     Carrier,
     Mounted,
     TrackResult,
@@ -30,6 +34,7 @@ from robotwright.grammar.physics import (
     check_settings,
     mount,
     payload,
+    sample_joint_vectors,
     sample_poses,
     track,
 )
@@ -72,9 +77,12 @@ class EvalContext:
         duration: float,
         scale: float,
         path: tuple[tuple[float, float, float], ...] | None = None,
+        center: tuple[float, float, float] | None = TRACK_CENTER,
+        radius: float | None = TRACK_RADIUS,
     ) -> TrackResult:
-        """One tracking run (shared by ``track`` and ``energy``)."""
-        key = (carrier, duration, scale, path)
+        """One tracking run (shared by ``track``, ``energy`` and the constraints
+        measured on it)."""
+        key = (carrier, duration, scale, path, center, radius)
         cache = self.__dict__.setdefault("_tracks", {})
         if key not in cache:
             cache[key] = track(
@@ -84,6 +92,8 @@ class EvalContext:
                 scale=scale,
                 mounted=self.mounted(carrier),
                 path=path,
+                center=center,
+                radius=radius,
             )
         return cache[key]
 
@@ -279,7 +289,8 @@ class NoSelfCollision:
 class Payload:
     """Largest mass (kg) at every tool point that the limb, worn by ``carrier``, holds
     still at the zero pose and ``samples`` seeded random poses with every joint torque
-    within its peak (:func:`robotwright.grammar.physics.payload`); larger is better.
+    within its peak, counting the poses with the tool points at least ``min_reach`` m
+    from the mount (:func:`robotwright.grammar.physics.payload`); larger is better.
     Every pose counts: with fewer than ``min_free_share`` of them free of contact with
     the limb itself or the carrier, the payload is 0; it is at most ``limit`` kg, a
     bound the command line names when a design reaches it."""
@@ -289,6 +300,8 @@ class Payload:
     carrier: Carrier = Carrier()
     limit: float = 100.0
     min_free_share: float = MIN_FREE_SHARE
+    #: Only poses with every tool point at least this far (m) from the mount count.
+    min_reach: float = PAYLOAD_MIN_REACH
     name: str = "payload"
     maximize: bool = True
 
@@ -299,6 +312,7 @@ class Payload:
             seed=self.seed,
             limit=self.limit,
             min_free_share=self.min_free_share,
+            min_reach=self.min_reach,
         )
 
     def __call__(self, ctx: EvalContext) -> float:
@@ -311,6 +325,7 @@ class Payload:
             limit=self.limit,
             min_free_share=self.min_free_share,
             mounted=m,
+            min_reach=self.min_reach,
         ).mass
 
 
@@ -322,23 +337,41 @@ class _TrackingRun:
     duration: float = 2.0
     scale: float = 0.15
     carrier: Carrier = Carrier()
-    #: Waypoints [m] (offsets from the tool point at the display pose) to follow instead
-    #: of the circle and line; ``scale`` is then unused.
+    #: Waypoints [m] (offsets from ``center``) to follow instead of the circle and line.
     path: tuple[tuple[float, float, float], ...] | None = None
+    #: The reference's centre [m] in the mount frame (the limb's base); ``None``: the
+    #: tool point at the design's display pose.
+    center: tuple[float, float, float] | None = TRACK_CENTER
+    #: The circle's radius [m]; ``None``: ``scale`` times the design's reach.
+    radius: float | None = TRACK_RADIUS
 
     def __post_init__(self) -> None:
         check_settings(type(self).__name__, duration=self.duration, scale=self.scale)
+        if self.radius is not None:
+            check_settings(type(self).__name__, radius=self.radius)
+        if self.center is not None and (
+            len(self.center) != 3
+            or not all(isinstance(v, (int, float)) and abs(v) <= 10.0 for v in self.center)
+        ):
+            raise ValueError(
+                f"{type(self).__name__}: center expected 3 finite numbers [m] within +-10, "
+                f"got {self.center!r}"
+            )
 
     def run(self, ctx: EvalContext) -> TrackResult:
         """The tracking run these settings ask for, made once per design in ``ctx``."""
-        return ctx.tracking(self.carrier, self.duration, self.scale, self.path)
+        return ctx.tracking(
+            self.carrier, self.duration, self.scale, self.path, self.center, self.radius
+        )
 
 
 @dataclass(frozen=True)
 class Track(_TrackingRun):
     """RMS distance (m) between the first tool point and a circle-then-line reference
-    in front of the limb over ``duration`` s, under PD + gravity compensation within
-    the peak torques (:func:`robotwright.grammar.physics.track`); smaller is better."""
+    (built in: 5 cm radius about (0.4, 0, 0.4) m in the mount frame, the same for every design) over
+    ``duration`` s, under PD + gravity compensation within the peak torques and the
+    rated speeds, contacts on (:func:`robotwright.grammar.physics.track`); smaller is
+    better."""
 
     name: str = "track"
     maximize: bool = False
@@ -380,6 +413,72 @@ class NoCarrierCollision:
         k, a, b = hits[0]
         poses = len({h[0] for h in hits})
         return f"touches the carrier at {poses} of {self.samples + 1} poses (first: pose {k}, {a} and {b})"
+
+
+@dataclass(frozen=True)
+class NoContactOnTrack(_TrackingRun):
+    """The limb touches neither itself nor its carrier at any step of the tracking run
+    (the run of :class:`Track` and :class:`Energy`, simulated with contacts on), and no
+    two of its parts overlap there, parent and child included (the geometric check of
+    :class:`NoOverlap`, at every step): collisions checked along the whole trajectory,
+    not at sampled poses alone."""
+
+    name: str = "no-contact-on-track"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        run = self.run(ctx)
+        found = []
+        if run.first_contact is not None:
+            t, a, b = run.first_contact
+            found.append(
+                f"touches on {run.contact_share:.1%} of the tracking run's steps "
+                f"(first at {t:.3f} s: {a} and {b})"
+            )
+        if run.first_overlap is not None:
+            t, a, b, depth = run.first_overlap
+            found.append(f"{a} and {b} overlap by {depth * 1e3:.1f} mm at {t:.3f} s")
+        return "; ".join(found) or None
+
+
+@dataclass(frozen=True)
+class WithinRatings(_TrackingRun):
+    """No joint moves faster than its rated speed (the component's ``peak_velocity``)
+    at any step of the tracking run; torques are held within their peaks by MuJoCo."""
+
+    name: str = "within-ratings"
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        ratio = self.run(ctx).speed_ratio
+        if ratio <= 1.0:
+            return None
+        return f"a joint reaches {ratio:.2f}x its rated speed on the tracking run"
+
+
+@dataclass(frozen=True)
+class NoOverlap:
+    """No two parts of the limb overlap at the zero pose and ``samples`` seeded poses,
+    parent and child included: a geometric check of every housing, link and end part
+    that MuJoCo's contact filter does not hide (:mod:`robotwright.grammar.overlap`)."""
+
+    samples: int = 32
+    seed: int = 0
+    name: str = "no-overlap"
+
+    def __post_init__(self) -> None:
+        check_settings("NoOverlap", samples=self.samples, seed=self.seed)
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        limb = ctx.limb
+        lo, hi = limb.joint_ranges().T
+        found = overlaps(limb, ctx.model, sample_joint_vectors(lo, hi, self.samples, self.seed))
+        if not found:
+            return None
+        deepest = max(found, key=lambda o: o.depth)
+        poses = len({o.pose for o in found})
+        return (
+            f"parts overlap at {poses} of {self.samples + 1} poses (deepest: {deepest.a} "
+            f"and {deepest.b} by {deepest.depth * 1e3:.1f} mm at pose {deepest.pose})"
+        )
 
 
 @dataclass(frozen=True)
@@ -524,16 +623,23 @@ OBJECTIVES: dict[str, type] = {
 
 _FLAGS = {
     "no-self-collision": NoSelfCollision,
+    "no-overlap": NoOverlap,
     "no-carrier-collision": NoCarrierCollision,
+    "no-contact-on-track": NoContactOnTrack,
+    "within-ratings": WithinRatings,
     "joint-limits": JointLimitsFeasible,
 }
+#: The constraints measured on the tracking run (set by a task's ``track`` section).
+TRACK_CONSTRAINTS = ("no-contact-on-track", "within-ratings")
 _EXPECTED = (
-    "no-self-collision, no-carrier-collision, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
+    "no-self-collision, no-overlap, no-carrier-collision, no-contact-on-track, "
+    "within-ratings, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
 )
 
 
 def make_constraint(text: str) -> Constraint:
-    """Parse ``no-self-collision``, ``no-carrier-collision``, ``joint-limits``,
+    """Parse ``no-self-collision``, ``no-overlap``, ``no-carrier-collision``,
+    ``no-contact-on-track``, ``within-ratings``, ``joint-limits``,
     ``max-mass=KG`` (a finite number >= 0), ``max-dof=N``, ``min-dof=N`` (integers >= 0).
 
     Raises:

@@ -17,16 +17,21 @@ built-in one. Every field is optional; the built-in objectives are
       postures:                        # optional: judge the limb in each of these
         standing: {}                   # the reference pose
         arms_raised: {left_shoulder_pitch_joint: -2.6, right_shoulder_pitch_joint: -2.6}
-    payload: {samples: 32, seed: 0, limit: 100.0, min_free_share: 0.5}
+    payload: {samples: 32, seed: 0, limit: 100.0, min_free_share: 0.5, min_reach: 0.25}
     track:
       duration: 2.0                    # [s]
+      center: [0.4, 0.0, 0.4]          # [m] in the mount frame (z out of the base)
+      radius: 0.05                     # [m], the circle's
       path: [[0, 0, 0], [0, 0.1, 0], [0, 0.1, 0.1], [0, 0, 0]]  # offsets [m]
     collision: {samples: 32, seed: 0}
 
-``track.path`` lists waypoints, offsets [m] in the world frame from the tool point at
-the limb's display pose, visited in order (each leg the same time, starting and stopping
-at rest); without it the reference is the built-in circle and line of ``scale`` times
-the limb's reach.
+Targets are absolute, the same for every design: ``track.center`` is fixed in the mount
+frame (``display`` instead: the tool point at the design's display pose), ``radius`` is
+in metres (``scale`` instead: that share of the design's reach), and ``payload.min_reach``
+counts only poses that hold the tool points at least that far from the mount.
+``track.path`` lists waypoints, offsets [m] in the world frame from the centre, visited
+in order (each leg the same time, starting and stopping at rest); without it the
+reference is the built-in circle and line.
 
 ``carrier.postures`` names postures of the carrier, each the joint values (rad for a
 hinge, m for a slide; joints not named stay at the reference pose) it holds while the
@@ -103,33 +108,41 @@ class Task:
         )
 
     def constraint(self, text: str) -> Any:
-        """The constraint ``text`` (as ``--constraint`` takes it) set for this task; the
-        carrier collision check holds in every posture."""
+        """The constraint ``text`` (as ``--constraint`` takes it) set for this task: the
+        carrier collision check with the task's ``collision`` settings, the tracking
+        run's (``no-contact-on-track``, ``within-ratings``) with its ``track`` settings;
+        each holds in every posture."""
         from robotwright.grammar.objectives import (
+            TRACK_CONSTRAINTS,
             InEveryPosture,
             NoCarrierCollision,
             make_constraint,
         )
 
-        if text != "no-carrier-collision":
+        if text == "no-carrier-collision":
+            cls, settings = NoCarrierCollision, self.collision
+        elif text in TRACK_CONSTRAINTS:
+            cls, settings = type(make_constraint(text)), self.track
+        else:
             return make_constraint(text)
         if not self.postures:
-            return NoCarrierCollision(carrier=self.carrier, **self.collision)
+            return cls(carrier=self.carrier, **settings)
         return InEveryPosture(
-            tuple(NoCarrierCollision(carrier=c, **self.collision) for _, c in self.postures),
+            tuple(cls(carrier=c, **settings) for _, c in self.postures),
             tuple(n for n, _ in self.postures),
         )
 
 
 #: The built-in task: the bundled humanoid carries the limb on its back, 32 payload
-#: poses, the circle and line at 0.15 of the reach over 2 s, 32 collision poses.
+#: poses counted at 0.25 m or more from the mount, the circle (5 cm radius, centred at
+#: (0.4, 0, 0.4) m in the mount frame) and line over 2 s, 32 collision poses.
 DEFAULT_TASK = Task()
 
 #: The fields of each section; the ranges of numbers are the objectives' own
 #: (:data:`~robotwright.grammar.physics.SETTING_BOUNDS`), ``path`` is the waypoints.
 _SECTIONS = {
-    "payload": ("samples", "seed", "limit", "min_free_share"),
-    "track": ("duration", "scale", "path"),
+    "payload": ("samples", "seed", "limit", "min_free_share", "min_reach"),
+    "track": ("duration", "center", "radius", "scale", "path"),
     "collision": ("samples", "seed"),
 }
 #: Largest quaternion component accepted (the quaternion is normalised).
@@ -296,11 +309,27 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
     if not isinstance(raw, dict):
         bad(key, f"expected a mapping of {', '.join(_SECTIONS[key])}")
         return {}
+    if key == "track" and "scale" in raw and "radius" in raw:
+        bad("track.scale", "give radius [m] or scale (of the design's reach), not both")
     out: dict[str, Any] = {}
     for name, value in raw.items():
         where = f"{key}.{shown_key(name)}"
         if name not in _SECTIONS[key]:
             bad(where, f"unknown key; expected {', '.join(_SECTIONS[key])}")
+        elif name == "center":
+            if value == "display":
+                out[name] = None
+            else:
+                center = _vector(value, 3)
+                if center is None or any(abs(v) > MAX_OFFSET for v in center):
+                    bad(
+                        where,
+                        f"expected [x, y, z] of finite numbers [m] in the mount frame, each "
+                        f"within +-{MAX_OFFSET:g}, or display (the tool point at the "
+                        "design's display pose)",
+                    )
+                else:
+                    out[name] = center
         elif name == "path":
             waypoints = _waypoints(value)
             if waypoints is None:
@@ -318,6 +347,8 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
                 bad(where, f"{bound.expected()}, got {shown(value)}")
             else:
                 out[name] = number
+    if key == "track" and "scale" in out:
+        out["radius"] = None  # the circle follows the design's reach
     return out
 
 
