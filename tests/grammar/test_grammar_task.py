@@ -68,6 +68,23 @@ def test_a_path_of_waypoints_is_the_reference_followed() -> None:
     assert run.error == pytest.approx(float(np.sqrt(np.mean(err**2))))
 
 
+def test_a_task_file_gives_absolute_targets_or_asks_for_relative_ones(tmp_path) -> None:
+    path = tmp_path / "task.yaml"
+    path.write_text(
+        "task: t\ntrack: {center: [0.3, 0.1, 0.5], radius: 0.08}\npayload: {min_reach: 0.4}\n",
+        encoding="utf-8",
+    )
+    task = load_task(path)
+    t, p = task.objective("track"), task.objective("payload")
+    assert (t.center, t.radius, p.min_reach) == ((0.3, 0.1, 0.5), 0.08, 0.4)
+    assert task.constraint("no-contact-on-track").center == (0.3, 0.1, 0.5)
+    assert task.constraint("max-track-error=0.02").radius == 0.08
+    assert task.constraint("max-track-error=0.02").limit == 0.02
+    path.write_text("task: t\ntrack: {center: display, scale: 0.2}\n", encoding="utf-8")
+    t = load_task(path).objective("track")
+    assert (t.center, t.radius, t.scale) == (None, None, 0.2)  # the design-relative circle
+
+
 @pytest.mark.parametrize(
     ("text", "field"),
     [
@@ -82,6 +99,12 @@ def test_a_path_of_waypoints_is_the_reference_followed() -> None:
         ("task: t\ntrack: {path: [[0, 0, 0]]}\n", "track.path"),
         ("task: t\ntrack: {path: [[0, 0, 0], [0, 0, 99]]}\n", "track.path"),
         ("task: t\ntrack: {speed: 2}\n", "track.speed"),
+        ("task: t\ntrack: {center: [0, 0]}\n", "track.center"),
+        ("task: t\ntrack: {center: [0, 0, 11]}\n", "track.center"),
+        ("task: t\ntrack: {center: here}\n", "track.center"),
+        ("task: t\ntrack: {radius: -0.1}\n", "track.radius"),
+        ("task: t\ntrack: {radius: 0.1, scale: 0.2}\n", "track.scale"),
+        ("task: t\npayload: {min_reach: .inf}\n", "payload.min_reach"),
         ("task: t\ncollision: 3\n", "collision"),
         ("- not a mapping\n", None),
     ],

@@ -224,9 +224,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="append",
         default=None,
         help="no-self-collision and no-overlap (default; with no-carrier-collision for "
-        "payload, track and energy, and no-contact-on-track and within-ratings for track "
-        "and energy), no-carrier-collision, no-contact-on-track, within-ratings, "
-        "joint-limits, max-mass=KG, max-dof=N, min-dof=N; repeatable",
+        "payload, track and energy, no-contact-on-track and within-ratings for track "
+        "and energy, and max-track-error=0.01 for energy), no-carrier-collision, "
+        "no-contact-on-track, within-ratings, joint-limits, max-mass=KG, "
+        "max-track-error=M, max-dof=N, min-dof=N; repeatable",
     )
     q.add_argument(
         "--budget",
@@ -457,6 +458,11 @@ def _search_progress(budget: int, name: str):
 _CARRIER_OBJECTIVES = ("payload", "track", "energy")
 
 
+#: The RMS tracking error (m) an ``energy`` search allows by default: a fifth of the
+#: built-in circle's radius.
+ENERGY_TRACK_ERROR = 0.01
+
+
 def _default_constraints(args: argparse.Namespace) -> list[str]:
     asked = set(args.objective or ())
     out = ["no-self-collision", "no-overlap"]
@@ -464,6 +470,8 @@ def _default_constraints(args: argparse.Namespace) -> list[str]:
         out.append("no-carrier-collision")
     if asked & {"track", "energy"}:
         out += ["no-contact-on-track", "within-ratings"]
+    if "energy" in asked:  # the power of a limb that does the job, not of one that idles
+        out.append(f"max-track-error={ENERGY_TRACK_ERROR:g}")
     return out
 
 

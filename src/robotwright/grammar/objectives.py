@@ -21,7 +21,7 @@ import numpy as np
 
 from robotwright.grammar.build import Limb, build
 from robotwright.grammar.design import Design
-from robotwright.grammar.overlap import overlaps
+from robotwright.grammar.overlap import checked_pairs, overlaps
 from robotwright.grammar.physics import (
     MIN_FREE_SHARE,
     PAYLOAD_MIN_REACH,
@@ -97,18 +97,49 @@ class EvalContext:
             )
         return cache[key]
 
+    def pose_is_free(self, pose: int, samples: int, seed: int) -> bool:
+        """Whether pose number ``pose`` of :meth:`tool_points`'s poses is one the limb can
+        take: no contact of the limb with itself (MuJoCo) and no overlapping parts."""
+        q = self._poses(samples, seed)[pose]
+        model, data = self.model, self._data
+        for j, value in zip(self.limb.joints, q):
+            data.qpos[model.jnt_qposadr[model.joint(j.name).id]] = value
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        return data.ncon == 0 and not overlaps(
+            self.limb, model, q[None], first_only=True, pairs=self._overlap_pairs
+        )
+
+    @cached_property
+    def _data(self) -> mujoco.MjData:
+        return mujoco.MjData(self.model)
+
+    @cached_property
+    def _overlap_pairs(self) -> np.ndarray:
+        return checked_pairs(self.limb, self.model)
+
+    def _poses(self, samples: int, seed: int) -> np.ndarray:
+        """The zero pose (clipped into the ranges) and ``samples`` joint vectors drawn
+        uniformly inside them (seeded), in the limb's joint order."""
+        key = (samples, seed)
+        cache = self.__dict__.setdefault("_pose_sets", {})
+        if key not in cache:
+            rng = np.random.default_rng(seed)
+            limb = self.limb
+            lo, hi = limb.joint_ranges().T if limb.joints else (np.zeros(0), np.zeros(0))
+            q = rng.uniform(lo, hi, size=(samples, len(limb.joints)))
+            cache[key] = np.vstack([np.clip(np.zeros(len(limb.joints)), lo, hi), q])
+        return cache[key]
+
     def tool_points(self, samples: int, seed: int) -> np.ndarray:
         """Tool-point positions (m, mount frame) of every branch for ``samples`` joint
         vectors drawn uniformly inside the joint ranges (seeded), plus the zero pose."""
         key = (samples, seed)
         cache = self.__dict__.setdefault("_points", {})
         if key not in cache:
-            rng = np.random.default_rng(seed)
             limb = self.limb
             names = [j.name for j in limb.joints]
-            lo, hi = limb.joint_ranges().T if limb.joints else (np.zeros(0), np.zeros(0))
-            q = rng.uniform(lo, hi, size=(samples, len(names)))
-            q = np.vstack([np.clip(np.zeros(len(names)), lo, hi), q])
+            q = self._poses(samples, seed)
             pts = []
             for br in limb.branches:
                 cols = [names.index(n) for n in br.joints]
@@ -134,16 +165,34 @@ class Constraint(Protocol):
 
 @dataclass(frozen=True)
 class Reach:
-    """Largest distance (m) of a tool point from the mount origin over sampled poses."""
+    """Largest distance (m) of a tool point from the mount origin over sampled poses
+    (the zero pose and ``samples`` seeded ones) that the limb can take: with
+    ``free_only``, a pose where it touches itself (MuJoCo contacts) or two of its parts
+    overlap (:mod:`robotwright.grammar.overlap`) does not count; 0 when none is free."""
 
     samples: int = 256
     seed: int = 0
+    free_only: bool = True
     name: str = "reach"
     maximize: bool = True
 
     def __call__(self, ctx: EvalContext) -> float:
         pts = ctx.tool_points(self.samples, self.seed)
-        return float(np.linalg.norm(pts, axis=1).max()) if len(pts) else 0.0
+        if not len(pts):
+            return 0.0
+        dist = np.linalg.norm(pts, axis=1)
+        if not self.free_only:
+            return float(dist.max())
+        # The farthest first: usually the first pose checked is free.
+        n = self.samples + 1
+        checked: dict[int, bool] = {}
+        for k in np.argsort(-dist, kind="stable"):
+            pose = int(k) % n  # the points are branch by branch, each over every pose
+            if pose not in checked:
+                checked[pose] = ctx.pose_is_free(pose, self.samples, self.seed)
+            if checked[pose]:
+                return float(dist[k])
+        return 0.0
 
 
 @dataclass(frozen=True)
@@ -455,6 +504,26 @@ class WithinRatings(_TrackingRun):
 
 
 @dataclass(frozen=True)
+class TracksWithin(_TrackingRun):
+    """The tracking run's RMS error is at most ``limit`` m: the limb does the job whose
+    power :class:`Energy` measures (a limb that cannot follow the path, or stays
+    still, spends next to nothing)."""
+
+    limit: float = 0.01
+    name: str = "max-track-error"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_settings("TracksWithin", max_track_error=self.limit)
+
+    def __call__(self, ctx: EvalContext) -> str | None:
+        error = self.run(ctx).error
+        if error <= self.limit:
+            return None
+        return f"tracking error {error:.4g} m > {self.limit:g} m: it does not follow the path"
+
+
+@dataclass(frozen=True)
 class NoOverlap:
     """No two parts of the limb overlap at the zero pose and ``samples`` seeded poses,
     parent and child included: a geometric check of every housing, link and end part
@@ -630,16 +699,17 @@ _FLAGS = {
     "joint-limits": JointLimitsFeasible,
 }
 #: The constraints measured on the tracking run (set by a task's ``track`` section).
-TRACK_CONSTRAINTS = ("no-contact-on-track", "within-ratings")
+TRACK_CONSTRAINTS = ("no-contact-on-track", "within-ratings", "max-track-error")
 _EXPECTED = (
     "no-self-collision, no-overlap, no-carrier-collision, no-contact-on-track, "
-    "within-ratings, joint-limits, max-mass=KG, max-dof=N or min-dof=N"
+    "within-ratings, joint-limits, max-mass=KG, max-track-error=M, max-dof=N or min-dof=N"
 )
 
 
 def make_constraint(text: str) -> Constraint:
     """Parse ``no-self-collision``, ``no-overlap``, ``no-carrier-collision``,
-    ``no-contact-on-track``, ``within-ratings``, ``joint-limits``,
+    ``no-contact-on-track``, ``within-ratings``, ``joint-limits``, ``max-track-error=M``
+    (m, a finite number >= 0),
     ``max-mass=KG`` (a finite number >= 0), ``max-dof=N``, ``min-dof=N`` (integers >= 0).
 
     Raises:
@@ -650,20 +720,24 @@ def make_constraint(text: str) -> Constraint:
         if eq:
             raise ValueError(f"constraint {text!r}: {name} takes no value")
         return _FLAGS[name]()
-    if name not in ("max-mass", "max-dof", "min-dof"):
+    if name not in ("max-mass", "max-track-error", "max-dof", "min-dof"):
         raise ValueError(f"unknown constraint {text!r}: expected {_EXPECTED}")
+    real = name in ("max-mass", "max-track-error")
     try:
-        number = float(value) if name == "max-mass" else int(value)
+        number = float(value) if real else int(value)
     except ValueError:
         number = None
     if number is None or not math.isfinite(number) or number < 0:
+        unit = "kg" if name == "max-mass" else "m"
         raise ValueError(
             f"constraint {text!r}: {name} needs a "
-            f"{'finite number >= 0 (kg)' if name == 'max-mass' else 'whole number >= 0'}, "
-            f"e.g. {name}=2"
+            f"{f'finite number >= 0 ({unit})' if real else 'whole number >= 0'}, "
+            f"e.g. {name}={'0.01' if name == 'max-track-error' else '2'}"
         )
     if name == "max-mass":
         return MaxMass(float(number))
+    if name == "max-track-error":
+        return TracksWithin(limit=float(number))
     return DoFRange(high=int(number)) if name == "max-dof" else DoFRange(low=int(number))
 
 

@@ -87,15 +87,18 @@ def overlaps(
     tolerance: float = OVERLAP_TOLERANCE,
     first_only: bool = False,
     prefix: str = "",
+    pairs: np.ndarray | None = None,
 ) -> list[Overlap]:
     """Every pair of parts overlapping by more than ``tolerance`` m at each of ``poses``
     (joint vectors in ``limb.joints`` order, rad or m), in ``model``: the limb alone or
     worn by a carrier (its names prefixed with ``prefix``).
 
     A pair is measured only where their bounding spheres meet, so a pose costs a few
-    microseconds per close pair. ``first_only`` stops at the first overlap found.
+    microseconds per close pair. ``first_only`` stops at the first overlap found;
+    ``pairs``: :func:`checked_pairs` of the same model, when already made.
     """
-    pairs = checked_pairs(limb, model, prefix)
+    if pairs is None:
+        pairs = checked_pairs(limb, model, prefix)
     out: list[Overlap] = []
     if len(pairs) == 0:
         return out

@@ -110,8 +110,8 @@ class Task:
     def constraint(self, text: str) -> Any:
         """The constraint ``text`` (as ``--constraint`` takes it) set for this task: the
         carrier collision check with the task's ``collision`` settings, the tracking
-        run's (``no-contact-on-track``, ``within-ratings``) with its ``track`` settings;
-        each holds in every posture."""
+        run's (``no-contact-on-track``, ``within-ratings``, ``max-track-error=M``) with
+        its ``track`` settings; each holds in every posture."""
         from robotwright.grammar.objectives import (
             TRACK_CONSTRAINTS,
             InEveryPosture,
@@ -120,15 +120,15 @@ class Task:
         )
 
         if text == "no-carrier-collision":
-            cls, settings = NoCarrierCollision, self.collision
-        elif text in TRACK_CONSTRAINTS:
-            cls, settings = type(make_constraint(text)), self.track
+            base, settings = NoCarrierCollision(), self.collision
+        elif text.partition("=")[0] in TRACK_CONSTRAINTS:
+            base, settings = make_constraint(text), self.track
         else:
             return make_constraint(text)
         if not self.postures:
-            return cls(carrier=self.carrier, **settings)
+            return replace(base, carrier=self.carrier, **settings)
         return InEveryPosture(
-            tuple(cls(carrier=c, **settings) for _, c in self.postures),
+            tuple(replace(base, carrier=c, **settings) for _, c in self.postures),
             tuple(n for n, _ in self.postures),
         )
 
