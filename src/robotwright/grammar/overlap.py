@@ -80,6 +80,18 @@ def checked_pairs(limb: Limb, model: mujoco.MjModel, prefix: str = "") -> np.nda
     return np.array(pairs, dtype=int).reshape(-1, 2)
 
 
+def hidden_pairs(model: mujoco.MjModel, pairs: np.ndarray) -> np.ndarray:
+    """The ``pairs`` MuJoCo's collision detection never reports: two geoms of one body
+    (or of bodies welded together), or of a body and its parent, unless the parent is
+    welded to the world (MuJoCo's parent filter spares the world's children). Where
+    MuJoCo's contacts are already watched, these are the pairs left to measure."""
+    weld, parent = model.body_weldid, model.body_parentid
+    w1, w2 = weld[model.geom_bodyid[pairs[:, 0]]], weld[model.geom_bodyid[pairs[:, 1]]]
+    p1, p2 = weld[parent[w1]], weld[parent[w2]]
+    hidden = (w1 == w2) | ((p1 == w2) & (w2 != 0)) | ((p2 == w1) & (w1 != 0))
+    return pairs[hidden]
+
+
 def overlaps(
     limb: Limb,
     model: mujoco.MjModel,

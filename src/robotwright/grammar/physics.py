@@ -26,7 +26,7 @@ import numpy as np
 from robotwright._bounds import Bound
 from robotwright._names import shown
 from robotwright.grammar.build import Limb
-from robotwright.grammar.overlap import overlaps
+from robotwright.grammar.overlap import checked_pairs, hidden_pairs, overlaps
 
 #: The limb's z axis (its base normal) along the site's -x: worn on the back, pointing
 #: backwards. Rotation of -90 deg about y, as (w, x, y, z).
@@ -528,17 +528,23 @@ def ik_path(
     q = np.clip(np.asarray(q0, dtype=float), m.lo, m.hi)
     out = np.empty((len(targets), model.nv))
     eye = damping**2 * np.eye(3)
+    chol, step = np.empty((3, 3)), np.empty(3)
     for k, target in enumerate(targets):
         for _ in range(iters * (50 if k == 0 else 1)):
             data.qpos[:] = q
             mujoco.mj_kinematics(model, data)
             err = target - data.site_xpos[site]
-            norm = float(np.sqrt(err @ err))
+            norm = math.sqrt(float(err @ err))
             if norm > max_step:
                 err *= max_step / norm
             mujoco.mj_comPos(model, data)
             mujoco.mj_jacSite(model, data, jac, None, site)
-            q = np.clip(q + jac.T @ np.linalg.solve(jac @ jac.T + eye, err), m.lo, m.hi)
+            # (J J^T + damping^2 I) is symmetric positive definite: MuJoCo's Cholesky
+            # solves it in a third of numpy's time for a 3x3.
+            np.add(jac @ jac.T, eye, out=chol)
+            mujoco.mju_cholFactor(chol, 0.0)
+            mujoco.mju_cholSolve(step, chol, err)
+            q = np.clip(q + jac.T @ step, m.lo, m.hi)
         out[k] = q
     return out
 
@@ -711,7 +717,9 @@ def track(
     mujoco.mj_kinematics(model, data)
     path[-1] = data.site_xpos[m.sites[0]]
     err = np.linalg.norm(path - ref, axis=1)
-    found = overlaps(limb, model, qpos, first_only=True, prefix=m.prefix)
+    # MuJoCo's contacts above watched every other pair at every step.
+    hidden = hidden_pairs(model, checked_pairs(limb, model, m.prefix))
+    found = overlaps(limb, model, qpos, first_only=True, prefix=m.prefix, pairs=hidden)
     overlap = (found[0].pose * dt, found[0].a, found[0].b, found[0].depth) if found else None
     return TrackResult(
         float(np.sqrt(np.mean(err**2))),
