@@ -238,8 +238,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument(
         "--method",
         default="beam",
-        choices=["beam", "mcts", "random"],
-        help="beam search (default), Monte Carlo tree search, or uniform random sampling",
+        choices=["beam", "mcts", "random", "learned"],
+        help="beam search (default), Monte Carlo tree search, uniform random sampling, or "
+        "the learned search (a value network over partial designs, trained as it goes)",
     )
     q.add_argument(
         "--beam-width",
@@ -591,6 +592,10 @@ def _search(args: argparse.Namespace) -> int:
 
             batch = args.batch or MCTS_BATCH
             res = mcts_search(g, objectives, constraints, batch=batch, **kw)
+        elif args.method == "learned":
+            from robotwright.grammar.learned import learned_search
+
+            res = learned_search(g, objectives, constraints, **kw)
         else:
             res = random_search(g, objectives, constraints, **kw)
         refined = ""
