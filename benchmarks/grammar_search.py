@@ -6,7 +6,8 @@ each search method reaches per evaluation budget instead.
     python benchmarks/grammar_search.py [--seconds 3] [--max-links 3] [--ray-cpus 2 8]
     python benchmarks/grammar_search.py --quality [--seeds 0 1 2] [--budget 1000]
 
-Quality: random, beam, MCTS and the learned search run on the same task (``reach`` and
+Quality: random, beam, MCTS (each also guided by the value network: ``+value``) and
+the learned search run on the same task (``reach`` and
 ``payload`` with the command line's default constraints, designs of at most 4 links)
 with the same seeds; the table gives the best value found after 50, 100, 200, 300, 500
 and 1,000 evaluations, averaged over the seeds, and the last line the mean number of
@@ -31,6 +32,7 @@ import sys
 import time
 import warnings
 from concurrent.futures import Executor, ProcessPoolExecutor
+from functools import partial
 
 from _machine import measured
 
@@ -51,7 +53,9 @@ from robotwright.grammar.search import beam_search, mcts_search, random_search
 METHODS = {
     "random": random_search,
     "beam": beam_search,
+    "beam+value": partial(beam_search, guided=True),
     "mcts": mcts_search,
+    "mcts+value": partial(mcts_search, guided=True),
     "learned": learned_search,
 }
 CHECKPOINTS = (50, 100, 200, 300, 500, 1000)
@@ -177,10 +181,10 @@ def quality(g, seeds: list[int], budget: int, max_links: int = 4) -> int:
                 needed.setdefault(name, []).append(hit if hit is not None else budget + 1)
             unit = "m" if name == "reach" else "kg"
             print(f"{name} [{unit}], mean over seeds of the best value after N evaluations")
-            print(f"  {'method':8s}" + "".join(f" {m:>8d}" for m in marks))
+            print(f"  {'method':10s}" + "".join(f" {m:>8d}" for m in marks))
             for method, runs in curves.items():
                 means = [sum(run[m - 1] for run in runs) / len(runs) for m in marks]
-                print(f"  {method:8s}" + "".join(f" {v:8.4f}" for v in means))
+                print(f"  {method:10s}" + "".join(f" {v:8.4f}" for v in means))
             print(f"  learned search reached random's best at {needed[name]} evaluations")
     n1, n2 = (sum(v) / len(v) for v in needed.values())
     print(

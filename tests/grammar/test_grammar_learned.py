@@ -94,3 +94,35 @@ def test_command_line_runs_logs_and_resumes_it(grammar, tmp_path, capsys) -> Non
     resumed = capsys.readouterr().out
     best = [line for line in whole.splitlines() if line.startswith("best reach")]
     assert best and best[0] in resumed  # the same best as the uninterrupted search
+
+
+@pytest.mark.parametrize("method", ["beam", "mcts"])
+def test_a_guided_beam_or_mcts_is_reproducible_and_beats_its_unguided_self(grammar, method) -> None:
+    """At 100 evaluations (reach, at most 4 links, seeds 0 and 2), the value network
+    raised the best reach found from 1.09 to 1.13 m (beam) and 1.11 to 1.13 m (MCTS)."""
+    from robotwright.grammar.search import beam_search, mcts_search
+
+    search = beam_search if method == "beam" else mcts_search
+    guided, plain = [], []
+    for seed in (0, 2):
+        kw = dict(budget=100, max_links=4, seed=seed, executor=InProcessExecutor())
+        guided.append(search(grammar, *TASK, guided=True, **kw))
+        plain.append(search(grammar, *TASK, **kw).best.score)
+    assert sum(r.best.score for r in guided) / 2 > sum(plain) / 2 + 0.01
+    with ProcessPoolExecutor(2) as pool:
+        again = search(grammar, *TASK, guided=True, budget=100, max_links=4, seed=2, executor=pool)
+    assert [e.design.hash() for e in again.evaluations] == [
+        e.design.hash() for e in guided[1].evaluations
+    ]
+
+
+def test_guided_is_refused_where_it_means_nothing_and_recorded_in_the_log(tmp_path, capsys):
+    args = ["grammar", "search", "--objective", "reach", "--budget", "8", "--workers", "1"]
+    assert main([*args, "--method", "random", "--guided"]) == 2
+    assert "--guided: applies to --method beam or mcts" in capsys.readouterr().err
+    log = tmp_path / "guided.jsonl"
+    assert main([*args, "--guided", "--log", str(log), "--no-picture"]) == 0
+    header = log.read_text(encoding="utf-8").splitlines()[0]
+    assert '"guided": true' in header
+    # an unguided search does not resume a guided one's log
+    assert main([*args, "--budget", "12", "--resume", str(log)]) == 2

@@ -243,6 +243,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "the learned search (a value network over partial designs, trained as it goes)",
     )
     q.add_argument(
+        "--guided",
+        action="store_true",
+        help="beam and mcts: a value network over partial designs, trained on the "
+        "evaluations so far, picks the expansions to try (what --method learned uses)",
+    )
+    q.add_argument(
         "--beam-width",
         type=_int_at_least(1),
         default=4,
@@ -558,6 +564,10 @@ def _search(args: argparse.Namespace) -> int:
         except ImportError as exc:
             print(f"error: --refine: {exc}", file=sys.stderr)
             return 2
+    if args.guided and args.method not in ("beam", "mcts"):
+        message = f"error: --guided: applies to --method beam or mcts, not {args.method}"
+        print(message, file=sys.stderr)
+        return 2
     if args.batch is not None and args.method != "mcts":
         print(f"error: --batch: applies to --method mcts, not {args.method}", file=sys.stderr)
         return 2
@@ -586,12 +596,14 @@ def _search(args: argparse.Namespace) -> int:
     with _ray_executor(args) as executor:
         kw.update(executor=executor)
         if args.method == "beam":
-            res = beam_search(g, objectives, constraints, beam_width=args.beam_width, **kw)
+            res = beam_search(
+                g, objectives, constraints, beam_width=args.beam_width, guided=args.guided, **kw
+            )
         elif args.method == "mcts":
             from robotwright.grammar.search import MCTS_BATCH
 
             batch = args.batch or MCTS_BATCH
-            res = mcts_search(g, objectives, constraints, batch=batch, **kw)
+            res = mcts_search(g, objectives, constraints, batch=batch, guided=args.guided, **kw)
         elif args.method == "learned":
             from robotwright.grammar.learned import learned_search
 

@@ -37,7 +37,7 @@ from robotwright.grammar.design import Design, Step
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, best_of
 from robotwright.grammar.rules import Grammar
 
-__all__ = ["FeatureMap", "ValueNet", "learned_search"]
+__all__ = ["FeatureMap", "PrefixValue", "ValueNet", "learned_search"]
 
 #: Designs drawn uniformly before the network steers.
 WARMUP = 32
@@ -143,6 +143,44 @@ class ValueNet:
                 p -= upd
 
 
+class PrefixValue:
+    """The value of partial designs, learned from evaluations: for each prefix of an
+    evaluated design's steps (the partial derivations on its way), the best normalised
+    score of any evaluated design through it (:func:`_normalised`), fitted by a
+    :class:`ValueNet` over :class:`FeatureMap` features. Guides the learned search, and
+    beam search and MCTS when asked (``guided=True``)."""
+
+    def __init__(self, grammar: Grammar, hidden: int = 32, seed: int = 0) -> None:
+        self.features = FeatureMap(grammar)
+        self.net = ValueNet(self.features.size, hidden=hidden, seed=seed)
+        self._x: dict[tuple[Step, ...], np.ndarray] = {}
+        self.trained = False
+
+    def learn(self, evaluations: Sequence[Evaluation]) -> None:
+        """Fit the network to every prefix of ``evaluations`` (nothing to learn while no
+        design is feasible)."""
+        finite = [e.score for e in evaluations if math.isfinite(e.score)]
+        if not finite:
+            return
+        lo, hi = min(finite), max(finite)
+        targets: dict[tuple[Step, ...], float] = {}
+        for e in evaluations:
+            value = _normalised(e.score, lo, hi)
+            steps = e.design.steps
+            for k in range(len(steps) + 1):
+                key = steps[:k]
+                if key not in self._x:
+                    self._x[key] = self.features(key)
+                targets[key] = max(targets.get(key, 0.0), value)
+        keys = list(targets)
+        self.net.fit(np.stack([self._x[k] for k in keys]), np.array([targets[k] for k in keys]))
+        self.trained = True
+
+    def rate(self, partials: Sequence[Partial]) -> np.ndarray:
+        """The network's value of each partial derivation (about 0-1, larger better)."""
+        return self.net.predict(np.stack([self.features(p.steps) for p in partials]))
+
+
 def _normalised(score: float, lo: float, hi: float) -> float:
     """A score as a training target: feasible ones in [0.1, 1] by the range ``lo``-``hi``
     seen, an infeasible one (-inf) 0."""
@@ -215,15 +253,10 @@ def learned_search(
             raise ValueError(f"{name} must be in [{low}, {high}], got {value!r}")
     rng = random.Random(seed)
     counter = Counter(grammar)
-    features = FeatureMap(grammar)
-    net = ValueNet(features.size, hidden=hidden, seed=seed)
-    targets: dict[tuple[Step, ...], float] = {}
-    prefix_x: dict[tuple[Step, ...], np.ndarray] = {}
-    scores: list[float] = []
-    trained = False
+    value = PrefixValue(grammar, hidden=hidden, seed=seed)
 
     def grow() -> Design:
-        if not trained or rng.random() < epsilon / 4:
+        if not value.trained or rng.random() < epsilon / 4:
             return sample(grammar, max_links, rng, counter)
         p = Partial.start(grammar)
         while not p.complete:
@@ -233,7 +266,7 @@ def learned_search(
             if rng.random() < epsilon:
                 p = kids[rng.randrange(len(kids))]
                 continue
-            rated = net.predict(np.stack([features(k.steps) for k in kids]))
+            rated = value.rate(kids)
             # Boltzmann choice: the best child mostly, its close rivals sometimes, so
             # that designs near the best are tried rather than the same one again.
             weights = np.exp((rated - rated.max()) / temperature)
@@ -255,7 +288,7 @@ def learned_search(
     ) as ev:
         stalls = 0
         while ev.left > 0 and stalls < 50:
-            size = min(ev.left, warmup if not trained else batch)
+            size = min(ev.left, warmup if not value.trained else batch)
             seen = {e.design.hash() for e in ev.order}
             designs: list[Design] = []
             for _ in range(size):
@@ -268,24 +301,7 @@ def learned_search(
             before = len(ev.order)
             ev.run(designs)
             stalls = stalls + 1 if len(ev.order) == before else 0
-            for e in ev.order[before:]:
-                scores.append(e.score)
-            finite = [s for s in scores if math.isfinite(s)]
-            if not finite:
-                continue
-            lo, hi = min(finite), max(finite)
-            targets.clear()
-            for e in ev.order:
-                value = _normalised(e.score, lo, hi)
-                steps = e.design.steps
-                for k in range(len(steps) + 1):
-                    key = steps[:k]
-                    if key not in prefix_x:
-                        prefix_x[key] = features(key)
-                    targets[key] = max(targets.get(key, 0.0), value)
-            keys = list(targets)
-            net.fit(np.stack([prefix_x[k] for k in keys]), np.array([targets[k] for k in keys]))
-            trained = True
+            value.learn(ev.order)
         stopped = (
             "budget reached"
             if ev.left <= 0

@@ -20,11 +20,14 @@ from itertools import chain
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from robotwright.grammar.derive import Counter, Partial, choices_at, options, random_step, sample
 from robotwright.grammar.design import Design
 from robotwright.grammar.executors import RayExecutor, die_with_parent, pool_size, usable_cores
+from robotwright.grammar.learned import PrefixValue
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, best_of, evaluate
-from robotwright.grammar.rules import Grammar
+from robotwright.grammar.rules import Grammar, Rule
 from robotwright.grammar.searchlog import SearchLog, read_log
 
 __all__ = [
@@ -65,6 +68,9 @@ def check_workers(
 #: Leaves MCTS picks per round by default. A fixed number, not one that follows the
 #: workers: the same seed then gives the same search on any machine, pool or Ray cluster.
 MCTS_BATCH = 8
+#: A guided beam search rolls out this many times ``beam_width`` expansions per step:
+#: those its value network rates highest.
+GUIDED_KEEP = 3
 
 #: Designs random search draws per round: the pool starts, the log fills and progress
 #: is reported from the first round, not after all ``budget`` draws. The result does not
@@ -282,6 +288,7 @@ def beam_search(
     max_links: int = 4,
     beam_width: int = 4,
     rollouts: int = 1,
+    guided: bool = False,
     seed: int = 0,
     executor: Executor | None = None,
     workers: int | None = None,
@@ -296,12 +303,21 @@ def beam_search(
     by evaluating ``rollouts`` uniform random completions of it; the ``beam_width``
     best partial derivations are kept. Stops when ``budget`` distinct designs have been
     evaluated or the beam empties. The first objective is optimised.
+
+    ``guided``: a value network over partial designs (:class:`~robotwright.grammar.
+    learned.PrefixValue`), trained on every evaluation so far, picks which expansions
+    are rolled out: once it has learned, only the ``GUIDED_KEEP`` times ``beam_width``
+    it rates highest are, so the budget goes to the promising ones.
     """
     if budget < 1 or beam_width < 1 or rollouts < 1:
         raise ValueError("budget, beam_width and rollouts must be >= 1")
     rng = random.Random(seed)
     counter = Counter(grammar)
     beam = [Partial.start(grammar)]
+    value = PrefixValue(grammar, seed=seed) if guided else None
+    header = dict(method="beam", seed=seed, budget=budget, max_links=max_links)
+    if guided:  # a log of a guided search resumes only as one
+        header["guided"] = True
     with _Evaluator(
         grammar,
         objectives,
@@ -313,7 +329,7 @@ def beam_search(
         force_workers,
         log=log,
         resume=resume,
-        header=dict(method="beam", seed=seed, budget=budget, max_links=max_links),
+        header=header,
     ) as ev:
         while beam and ev.left > 0:
             children: list[Partial] = []
@@ -325,6 +341,11 @@ def beam_search(
                         children += [p.apply(rule, choices_at(grammar, rule, i)) for i in range(n)]
             children = [c for c in children if counter.completions(c, max_links) > 0]
             rng.shuffle(children)  # ties and the budget cut are broken at random, seeded
+            if value is not None and value.trained and children:
+                keep = GUIDED_KEEP * beam_width
+                rated = value.rate(children)
+                order = sorted(range(len(children)), key=lambda i: (-rated[i], i))
+                children = [children[i] for i in order[:keep]]
             designs: list[list[Design]] = []
             for c in children:
                 if c.complete:
@@ -350,6 +371,8 @@ def beam_search(
                     scored.append((max(r.score for r in rs), i, c))
             scored.sort(key=lambda t: (-t[0], t[1]))
             beam = [c for _, _, c in scored[:beam_width]]
+            if value is not None:
+                value.learn(ev.order)
         stopped = (
             "budget reached" if ev.left <= 0 else "the beam emptied: every design was complete"
         )
@@ -387,6 +410,7 @@ def mcts_search(
     max_links: int = 4,
     exploration: float = 0.5,
     batch: int = MCTS_BATCH,
+    guided: bool = False,
     seed: int = 0,
     executor: Executor | None = None,
     workers: int | None = None,
@@ -404,6 +428,11 @@ def mcts_search(
     parameter of the search (recorded in its log, checked on resume), not the number of
     workers, so the same seed gives the same search with any executor. Scores are
     normalised to [0, 1] by the range seen so far; infeasible designs count as 0.
+
+    ``guided``: a value network over partial designs (:class:`~robotwright.grammar.
+    learned.PrefixValue`), trained after every batch, picks which untried decision a
+    node expands first (the one whose partial design it rates highest) instead of a
+    seeded random one.
     """
     import math
 
@@ -416,6 +445,19 @@ def mcts_search(
     start = Partial.start(grammar)
     root = _Node(start, _decisions(start, rng))
     lo, hi = math.inf, -math.inf
+    prior = PrefixValue(grammar, seed=seed) if guided else None
+    header = dict(method="mcts", seed=seed, budget=budget, max_links=max_links, batch=batch)
+    if guided:
+        header["guided"] = True
+
+    def expand(p: Partial, rule: Rule | None, i: int) -> Partial:
+        return p.stop() if rule is None else p.apply(rule, choices_at(grammar, rule, i))
+
+    def next_decision(node: _Node) -> tuple:
+        if prior is None or not prior.trained or len(node.untried) == 1:
+            return node.untried.pop()
+        rated = prior.rate([expand(node.partial, r, i) for r, i in node.untried])
+        return node.untried.pop(int(np.argmax(rated)))
 
     def norm(score: float) -> float:
         if not math.isfinite(score) or hi <= lo:
@@ -436,7 +478,7 @@ def mcts_search(
         force_workers,
         log=log,
         resume=resume,
-        header=dict(method="mcts", seed=seed, budget=budget, max_links=max_links, batch=batch),
+        header=header,
     ) as ev:
         stalls = 0
         while ev.left > 0 and stalls < 50 and (root.untried or root.children):
@@ -452,11 +494,8 @@ def mcts_search(
                     )
                     path.append(node)
                 while node.untried:
-                    rule, i = node.untried.pop()
-                    p = node.partial
-                    child_p = (
-                        p.stop() if rule is None else p.apply(rule, choices_at(grammar, rule, i))
-                    )
+                    rule, i = next_decision(node)
+                    child_p = expand(node.partial, rule, i)
                     if counter.feasible(child_p, max_links):
                         child = _Node(child_p, _decisions(child_p, rng))
                         node.children.append(child)
@@ -487,6 +526,8 @@ def mcts_search(
                 for n in path:
                     n.total += s
                     n.best = max(n.best, s)
+            if prior is not None:
+                prior.learn(ev.order)
         if ev.left <= 0:
             stopped = "budget reached"
         elif stalls >= 50:
