@@ -124,11 +124,9 @@ class EvalContext:
         key = (samples, seed)
         cache = self.__dict__.setdefault("_pose_sets", {})
         if key not in cache:
-            rng = np.random.default_rng(seed)
             limb = self.limb
             lo, hi = limb.joint_ranges().T if limb.joints else (np.zeros(0), np.zeros(0))
-            q = rng.uniform(lo, hi, size=(samples, len(limb.joints)))
-            cache[key] = np.vstack([np.clip(np.zeros(len(limb.joints)), lo, hi), q])
+            cache[key] = sample_joint_vectors(lo, hi, samples, seed)
         return cache[key]
 
     def tool_points(self, samples: int, seed: int) -> np.ndarray:
@@ -406,6 +404,8 @@ class _TrackingRun:
                 f"{type(self).__name__}: center expected 3 finite numbers [m] within +-10, "
                 f"got {self.center!r}"
             )
+        if self.center is not None:  # a list from Python or tyro: kept hashable
+            object.__setattr__(self, "center", tuple(float(v) for v in self.center))
 
     def run(self, ctx: EvalContext) -> TrackResult:
         """The tracking run these settings ask for, made once per design in ``ctx``."""
@@ -417,10 +417,10 @@ class _TrackingRun:
 @dataclass(frozen=True)
 class Track(_TrackingRun):
     """RMS distance (m) between the first tool point and a circle-then-line reference
-    (built in: 5 cm radius about (0.4, 0, 0.4) m in the mount frame, the same for every design) over
-    ``duration`` s, under PD + gravity compensation within the peak torques and the
-    rated speeds, contacts on (:func:`robotwright.grammar.physics.track`); smaller is
-    better."""
+    (built in: 5 cm radius about (0.4, 0, 0.4) m in the mount frame, the same for
+    every design) over ``duration`` s, under PD + gravity compensation within the peak
+    torques and the rated speeds, contacts on
+    (:func:`robotwright.grammar.physics.track`); smaller is better."""
 
     name: str = "track"
     maximize: bool = False
