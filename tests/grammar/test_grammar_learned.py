@@ -12,9 +12,10 @@ from robotwright.cli import main
 from robotwright.grammar import default_grammar
 from robotwright.grammar.design import Design
 from robotwright.grammar.executors import InProcessExecutor
-from robotwright.grammar.learned import FeatureMap, ValueNet, learned_search
+from robotwright.grammar.learned import learned_search
 from robotwright.grammar.objectives import NoOverlap, NoSelfCollision, Reach
 from robotwright.grammar.search import random_search
+from robotwright.grammar.value import FeatureMap, ValueNet
 
 from .helpers import ARM
 

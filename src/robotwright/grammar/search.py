@@ -25,10 +25,10 @@ import numpy as np
 from robotwright.grammar.derive import Counter, Partial, choices_at, options, random_step, sample
 from robotwright.grammar.design import Design
 from robotwright.grammar.executors import RayExecutor, die_with_parent, pool_size, usable_cores
-from robotwright.grammar.learned import PrefixValue
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, best_of, evaluate
 from robotwright.grammar.rules import Grammar, Rule
 from robotwright.grammar.searchlog import SearchLog, read_log
+from robotwright.grammar.value import PrefixValue
 
 __all__ = [
     "RayExecutor",
@@ -305,7 +305,7 @@ def beam_search(
     evaluated or the beam empties. The first objective is optimised.
 
     ``guided``: a value network over partial designs (:class:`~robotwright.grammar.
-    learned.PrefixValue`), trained on every evaluation so far, picks which expansions
+    value.PrefixValue`), trained on every evaluation so far, picks which expansions
     are rolled out: once it has learned, only the ``GUIDED_KEEP`` times ``beam_width``
     it rates highest are, so the budget goes to the promising ones.
     """
@@ -430,7 +430,7 @@ def mcts_search(
     normalised to [0, 1] by the range seen so far; infeasible designs count as 0.
 
     ``guided``: a value network over partial designs (:class:`~robotwright.grammar.
-    learned.PrefixValue`), trained after every batch, picks which untried decision a
+    value.PrefixValue`), trained after every batch, picks which untried decision a
     node expands first (the one whose partial design it rates highest) instead of a
     seeded random one.
     """
