@@ -182,6 +182,37 @@ def test_reach_counts_only_poses_the_limb_can_take(grammar):
     assert all(not ctx.pose_is_free(int(i) % 257, 256, 0) for i in farther)
 
 
+#: Worn facing into the torso, its farthest free poses reach through the carrier.
+INTO_THE_BODY = (
+    HEADER
+    + """r1 @0: B=base(diameter=0.12, thickness=0.04) P=pinned()
+r2 @0: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.15, rotation=-1.5708)
+r3 @3: C=prismatic(stroke=0.1) L=link(diameter=0.04, length=0.25, rotation=1.5708)
+r3 @5: C=universal(limit=1.5708) L=link(diameter=0.04, length=0.15, rotation=0.0)
+r4 @7: E=gripper(finger_length=0.06)
+"""
+)
+
+
+def test_reach_on_a_carrier_counts_no_pose_that_touches_it(grammar, tmp_path) -> None:
+    from robotwright.grammar.objectives import Carrier
+    from robotwright.grammar.task import DEFAULT_TASK, load_task
+
+    facing_in = Carrier(quat=(0.7071068, 0.0, 0.7071068, 0.0))
+    ctx = ctx_of(grammar, INTO_THE_BODY)
+    alone, worn = Reach()(ctx), Reach(carrier=facing_in)(ctx)
+    assert 0 < worn < alone - 0.05
+    pts = ctx.tool_points(256, 0)
+    k = int(np.argmin(np.abs(np.linalg.norm(pts, axis=1) - worn))) % 257
+    m = ctx.mounted(facing_in)
+    assert not P.carrier_collisions(m, ctx._poses(256, 0)[k][None])
+    # a task file that names a carrier wears the limb for reach; the built-in task does not
+    assert DEFAULT_TASK.objective("reach") == Reach()
+    path = tmp_path / "task.yaml"
+    path.write_text("task: t\ncarrier: {quat: [0.7071068, 0.0, 0.7071068, 0.0]}\n")
+    assert load_task(path).objective("reach").carrier == load_task(path).carrier
+
+
 #: Three slides in a row: it cannot move in the circle's plane, and spends nothing.
 IDLE_SLIDES = (
     HEADER
@@ -236,6 +267,15 @@ def _housings_apart(limb, model, data) -> bool:
     return True
 
 
+def _posed(ctx: EvalContext, carrier, q: np.ndarray) -> mujoco.MjData:
+    """The mounted model's data at joint vector ``q``, kinematics computed."""
+    m = ctx.mounted(carrier)
+    data = mujoco.MjData(m.model)
+    data.qpos[:] = q
+    mujoco.mj_kinematics(m.model, data)
+    return data
+
+
 def test_a_designers_task_gets_winners_that_pass_an_independent_replay(tmp_path) -> None:
     """A new task file; the winners of track, energy, payload and reach are replayed in
     MuJoCo by the test itself: no touch of the carrier or the limb, no joint past its
@@ -287,12 +327,19 @@ def test_a_designers_task_gets_winners_that_pass_an_independent_replay(tmp_path)
             assert min(np.linalg.norm(t) for t in tools) >= 0.3
     reach = winners["reach"]
     ctx = EvalContext(grammar, reach.design)
-    value = Reach()(ctx)
-    pts = ctx.tool_points(256, 0)
-    k = int(np.argmin(np.abs(np.linalg.norm(pts, axis=1) - value))) % 257
-    limb_only = ctx.model
-    data = mujoco.MjData(limb_only)
-    data.qpos[:] = ctx._poses(256, 0)[k]
-    mujoco.mj_kinematics(limb_only, data)
-    mujoco.mj_collision(limb_only, data)
-    assert data.ncon == 0  # the pose its reach was scored on is one it can take
+    for _, carrier in task.postures:  # the task wears the limb: reach counts that too
+        value = Reach(carrier=carrier)(ctx)
+        pts = ctx.tool_points(256, 0)
+        k = int(np.argmin(np.abs(np.linalg.norm(pts, axis=1) - value))) % 257
+        q = ctx._poses(256, 0)[k]
+        limb_only = ctx.model
+        data = mujoco.MjData(limb_only)
+        data.qpos[:] = q
+        mujoco.mj_kinematics(limb_only, data)
+        mujoco.mj_collision(limb_only, data)
+        assert data.ncon == 0  # the pose its reach was scored on is one it can take
+        assert _housings_apart(reach, ctx.mounted(carrier).model, _posed(ctx, carrier, q))
+        m = ctx.mounted(carrier)
+        worn = _posed(ctx, carrier, q)
+        mujoco.mj_collision(m.model, worn)
+        assert not P.contacts(m, worn)

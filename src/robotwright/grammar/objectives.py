@@ -97,18 +97,25 @@ class EvalContext:
             )
         return cache[key]
 
-    def pose_is_free(self, pose: int, samples: int, seed: int) -> bool:
+    def pose_is_free(
+        self, pose: int, samples: int, seed: int, carrier: Carrier | None = None
+    ) -> bool:
         """Whether pose number ``pose`` of :meth:`tool_points`'s poses is one the limb can
-        take: no contact of the limb with itself (MuJoCo) and no overlapping parts."""
+        take: no contact of the limb with itself (MuJoCo), no overlapping parts, and,
+        given ``carrier``, no contact with it while worn."""
         q = self._poses(samples, seed)[pose]
         model, data = self.model, self._data
         for j, value in zip(self.limb.joints, q):
             data.qpos[model.jnt_qposadr[model.joint(j.name).id]] = value
         mujoco.mj_kinematics(model, data)
         mujoco.mj_collision(model, data)
-        return data.ncon == 0 and not overlaps(
+        if data.ncon or overlaps(
             self.limb, model, q[None], first_only=True, pairs=self._overlap_pairs
-        )
+        ):
+            return False
+        if carrier is None:
+            return True
+        return not carrier_collisions(self.mounted(carrier), q[None])
 
     @cached_property
     def _data(self) -> mujoco.MjData:
@@ -166,11 +173,15 @@ class Reach:
     """Largest distance (m) of a tool point from the mount origin over sampled poses
     (the zero pose and ``samples`` seeded ones) that the limb can take: with
     ``free_only``, a pose where it touches itself (MuJoCo contacts) or two of its parts
-    overlap (:mod:`robotwright.grammar.overlap`) does not count; 0 when none is free."""
+    overlap (:mod:`robotwright.grammar.overlap`), or touches ``carrier`` when one is
+    given, does not count; 0 when none is free."""
 
     samples: int = 256
     seed: int = 0
     free_only: bool = True
+    #: Worn by this carrier (a task file's): a pose that touches it does not count
+    #: either. ``None``: the limb alone (the built-in task).
+    carrier: Carrier | None = None
     name: str = "reach"
     maximize: bool = True
 
@@ -187,7 +198,7 @@ class Reach:
         for k in np.argsort(-dist, kind="stable"):
             pose = int(k) % n  # the points are branch by branch, each over every pose
             if pose not in checked:
-                checked[pose] = ctx.pose_is_free(pose, self.samples, self.seed)
+                checked[pose] = ctx.pose_is_free(pose, self.samples, self.seed, self.carrier)
             if checked[pose]:
                 return float(dist[k])
         return 0.0

@@ -33,6 +33,9 @@ counts only poses that hold the tool points at least that far from the mount.
 in order (each leg the same time, starting and stopping at rest); without it the
 reference is the built-in circle and line.
 
+A task that names a carrier wears the limb for ``reach`` too: a pose that touches the
+carrier (in any posture) does not count towards it.
+
 ``carrier.postures`` names postures of the carrier, each the joint values (rad for a
 hinge, m for a slide; joints not named stay at the reference pose) it holds while the
 limb is judged. With postures, every physics objective is measured in each of them and
@@ -83,6 +86,9 @@ class Task:
     #: (name, the carrier in that posture) for each posture the limb is judged in; none:
     #: the carrier as it is.
     postures: tuple[tuple[str, Carrier], ...] = ()
+    #: The task's file names a carrier: ``reach`` counts only poses that do not touch
+    #: it (in every posture). The built-in task measures the limb's own reach.
+    worn: bool = False
 
     def carriers(self) -> tuple[Carrier, ...]:
         """The carrier in each posture (the carrier alone when the task names none)."""
@@ -98,6 +104,8 @@ class Task:
             settings = self.payload
         elif name in ("track", "energy"):
             settings = self.track
+        elif name == "reach" and self.worn:
+            settings = {}
         else:
             return cls()
         if not self.postures:
@@ -194,6 +202,7 @@ def load_task(path: str | os.PathLike[str]) -> Task:
         sections["track"],
         sections["collision"],
         postures,
+        worn=data.get("carrier") is not None,
     )
     # The objectives check their settings as they are built: report as the file's.
     for what in ("payload", "track"):
