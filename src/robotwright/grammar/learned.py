@@ -22,14 +22,12 @@ import numpy as np
 from robotwright.grammar.derive import (
     Counter,
     Partial,
-    choices_at,
-    options,
     sample,
 )
 from robotwright.grammar.design import Design
 from robotwright.grammar.objectives import Constraint, Evaluation, Objective, best_of
 from robotwright.grammar.rules import Grammar
-from robotwright.grammar.search import SearchResult, _Evaluator
+from robotwright.grammar.search import SearchResult, _Evaluator, expansions
 from robotwright.grammar.value import PrefixValue
 
 __all__ = ["learned_search"]
@@ -44,18 +42,6 @@ def _pick(weights: np.ndarray, rng: random.Random) -> int:
     """An index drawn with probability proportional to ``weights`` (seeded)."""
     r = rng.random() * float(weights.sum())
     return min(int(np.searchsorted(np.cumsum(weights), r, side="right")), len(weights) - 1)
-
-
-def _children(p: Partial, grammar: Grammar, counter: Counter, max_links: int) -> list[Partial]:
-    """Every next partial derivation of ``p`` that can still complete within
-    ``max_links``."""
-    out = []
-    for rule, n in options(p):
-        if rule is None:
-            out.append(p.stop())
-        else:
-            out += [p.apply(rule, choices_at(grammar, rule, i)) for i in range(n)]
-    return [c for c in out if counter.completions(c, max_links) > 0]
 
 
 def learned_search(
@@ -109,7 +95,7 @@ def learned_search(
             return sample(grammar, max_links, rng, counter)
         p = Partial.start(grammar)
         while not p.complete:
-            kids = _children(p, grammar, counter, max_links)
+            kids = expansions(p, grammar, counter, max_links)
             if not kids:  # cannot happen for a feasible partial; be safe
                 return sample(grammar, max_links, rng, counter)
             if rng.random() < epsilon:

@@ -279,6 +279,19 @@ def random_search(
         return SearchResult(best_of(ev.order), ev.order, stopped)
 
 
+def expansions(p: Partial, grammar: Grammar, counter: Counter, max_links: int) -> list[Partial]:
+    """Every next partial derivation of ``p`` (one decision at its current node: a rule
+    with each of its choices, or stopping) that can still complete within
+    ``max_links``."""
+    out = []
+    for rule, n in options(p):
+        if rule is None:
+            out.append(p.stop())
+        else:
+            out += [p.apply(rule, choices_at(grammar, rule, i)) for i in range(n)]
+    return [c for c in out if counter.completions(c, max_links) > 0]
+
+
 def beam_search(
     grammar: Grammar,
     objectives: Sequence[Objective],
@@ -332,14 +345,7 @@ def beam_search(
         header=header,
     ) as ev:
         while beam and ev.left > 0:
-            children: list[Partial] = []
-            for p in beam:
-                for rule, n in options(p):
-                    if rule is None:
-                        children.append(p.stop())
-                    else:
-                        children += [p.apply(rule, choices_at(grammar, rule, i)) for i in range(n)]
-            children = [c for c in children if counter.completions(c, max_links) > 0]
+            children = [c for p in beam for c in expansions(p, grammar, counter, max_links)]
             rng.shuffle(children)  # ties and the budget cut are broken at random, seeded
             if value is not None and value.trained and children:
                 keep = GUIDED_KEEP * beam_width
