@@ -343,3 +343,37 @@ def test_a_designers_task_gets_winners_that_pass_an_independent_replay(tmp_path)
         worn = _posed(ctx, carrier, q)
         mujoco.mj_collision(m.model, worn)
         assert not P.contacts(m, worn)
+
+
+def test_coverage_is_the_share_of_a_given_box_reached_from_poses_it_can_take(
+    grammar, tmp_path
+) -> None:
+    from robotwright.grammar.objectives import Coverage
+    from robotwright.grammar.task import load_task
+
+    tracker, bracket = ctx_of(grammar, TRACKER), ctx_of(grammar, BRACKET)
+    assert Coverage()(bracket) == 0.0  # nowhere near the box 0.2-0.6 m out
+    share = Coverage()(tracker)
+    assert 0 < share <= 1.0
+    # by hand: the cells holding a tool point of a pose the limb can take
+    pts = tracker.tool_points(1024, 0)
+    low, high = np.array(Coverage().low), np.array(Coverage().high)
+    cells = set()
+    for k, p in enumerate(pts):
+        if np.all((p >= low) & (p < high)) and tracker.pose_is_free(k % 1025, 1024, 0):
+            cells.add(tuple(((p - low) // 0.05).astype(int)))
+    assert share == pytest.approx(len(cells) / 512)
+    # a box the tracker cannot reach at all, and bad boxes
+    assert Coverage(low=(-2.0, -2.0, -2.0), high=(-1.5, -1.5, -1.5))(tracker) == 0.0
+    for bad in (dict(low=(0.6, 0, 0), high=(0.2, 1, 1)), dict(voxel=0.0), dict(low=(0, 0))):
+        with pytest.raises(ValueError):
+            Coverage(**bad)
+    path = tmp_path / "task.yaml"
+    path.write_text(
+        "task: t\ncoverage: {low: [0.1, -0.1, 0.3], high: [0.3, 0.1, 0.5], voxel: 0.04}\n"
+    )
+    c = load_task(path).objective("coverage")
+    assert (c.low, c.high, c.voxel, c.carrier) == ((0.1, -0.1, 0.3), (0.3, 0.1, 0.5), 0.04, None)
+    path.write_text("task: t\ncoverage: {low: [0, 0, 99]}\n")
+    with pytest.raises(Exception, match="coverage.low"):
+        load_task(path)

@@ -167,7 +167,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         choices=_OBJECTIVE_NAMES,
         help="reach: farthest end point [m] (default); workspace: reachable volume "
-        "estimate [m^3]; mass: lightest [kg]; dof: most joints; worn by the carrier "
+        "estimate [m^3]; coverage: share of a given box (0.2-0.6 m, +-0.2 m, 0.2-0.6 m "
+        "in the mount frame, 5 cm cells) the tool reaches; mass: lightest [kg]; dof: most joints; worn by the carrier "
         "(mini_humanoid's back): payload: heaviest load held at every sampled pose [kg]; "
         "track: smallest RMS error following a circle and a line [m]; energy: least mean "
         "mechanical power on that path [W]. Repeatable: the first scores a design and the "
@@ -482,7 +483,16 @@ def _default_constraints(args: argparse.Namespace) -> list[str]:
     return out
 
 
-_OBJECTIVE_NAMES = ["reach", "workspace", "mass", "dof", "payload", "track", "energy"]
+_OBJECTIVE_NAMES = [
+    "reach",
+    "workspace",
+    "coverage",
+    "mass",
+    "dof",
+    "payload",
+    "track",
+    "energy",
+]
 
 
 def _weights(text: str) -> tuple[float, ...]:

@@ -237,6 +237,72 @@ class WorkspaceVolume:
         return hull_volume(pts)
 
 
+#: The built-in workspace to cover (mount frame, m): a 0.4 m cube about the tracking
+#: target's centre, in 5 cm cells.
+COVERAGE_LOW: tuple[float, float, float] = (0.2, -0.2, 0.2)
+COVERAGE_HIGH: tuple[float, float, float] = (0.6, 0.2, 0.6)
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Share (0-1) of a given box the tool points reach: the box from ``low`` to
+    ``high`` (m, mount frame) is cut into cubes of edge ``voxel`` m, and a cube counts
+    when a tool point lands in it at one of ``samples`` seeded poses the limb can take
+    (no contact with itself, no overlapping parts, and none with ``carrier`` when
+    given). An absolute target: the same box for every design, where a workspace volume
+    rewards reaching anywhere."""
+
+    low: tuple[float, float, float] = COVERAGE_LOW
+    high: tuple[float, float, float] = COVERAGE_HIGH
+    voxel: float = 0.05
+    samples: int = 1024
+    seed: int = 0
+    carrier: Carrier | None = None
+    name: str = "coverage"
+    maximize: bool = True
+
+    def __post_init__(self) -> None:
+        check_settings("Coverage", samples=self.samples, seed=self.seed, voxel=self.voxel)
+        for which in ("low", "high"):
+            v = getattr(self, which)
+            if len(v) != 3 or not all(isinstance(x, (int, float)) and abs(x) <= 10 for x in v):
+                raise ValueError(
+                    f"Coverage: {which} expected 3 finite numbers [m] within +-10, got {v!r}"
+                )
+            object.__setattr__(self, which, tuple(float(x) for x in v))
+        cells = np.ceil((np.array(self.high) - np.array(self.low)) / self.voxel - 1e-9)
+        if not (cells >= 1).all() or cells.prod() > MAX_COVERAGE_CELLS:
+            raise ValueError(
+                f"Coverage: high must exceed low on every axis, in at most "
+                f"{MAX_COVERAGE_CELLS} cells of {self.voxel} m; got {self.low} to {self.high}"
+            )
+
+    def __call__(self, ctx: EvalContext) -> float:
+        low, high = np.array(self.low), np.array(self.high)
+        shape = np.ceil((high - low) / self.voxel - 1e-9).astype(np.int64)
+        pts = ctx.tool_points(self.samples, self.seed)
+        if not len(pts):
+            return 0.0
+        n = self.samples + 1
+        inside = np.all((pts >= low) & (pts < high), axis=1)
+        hit: set[tuple[int, ...]] = set()
+        free: dict[int, bool] = {}
+        for k in np.flatnonzero(inside):
+            cell = tuple(np.minimum(((pts[k] - low) // self.voxel).astype(np.int64), shape - 1))
+            if cell in hit:
+                continue
+            pose = int(k) % n  # the points are branch by branch, each over every pose
+            if pose not in free:
+                free[pose] = ctx.pose_is_free(pose, self.samples, self.seed, self.carrier)
+            if free[pose]:
+                hit.add(cell)
+        return len(hit) / float(shape.prod())
+
+
+#: Most cells a coverage box may have (each costs memory and a pose check at most).
+MAX_COVERAGE_CELLS = 1_000_000
+
+
 def hull_volume(points: np.ndarray) -> float:
     """Convex hull volume (m^3) of ``points`` (N, 3): MuJoCo builds the hull of a mesh
     with these vertices and, at density 1, its mass is the hull's volume."""
@@ -693,6 +759,7 @@ def pareto_front(
 OBJECTIVES: dict[str, type] = {
     "reach": Reach,
     "workspace": WorkspaceVolume,
+    "coverage": Coverage,
     "mass": Mass,
     "dof": DoFCount,
     "payload": Payload,

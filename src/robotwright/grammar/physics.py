@@ -65,6 +65,7 @@ SETTING_BOUNDS: dict[str, Bound] = {
     "radius": Bound(0.0, 10.0, unit="m"),
     "min_reach": Bound(0.0, 10.0, unit="m"),
     "max_track_error": Bound(0.0, 10.0, unit="m"),
+    "voxel": Bound(0.001, 1.0, unit="m"),
 }
 
 #: The built-in tracking target, fixed in the mount frame (the limb's base: z out of

@@ -23,6 +23,7 @@ built-in one. Every field is optional; the built-in objectives are
       center: [0.4, 0.0, 0.4]          # [m] in the mount frame (z out of the base)
       radius: 0.05                     # [m], the circle's
       path: [[0, 0, 0], [0, 0.1, 0], [0, 0.1, 0.1], [0, 0, 0]]  # offsets [m]
+    coverage: {low: [0.2, -0.2, 0.2], high: [0.6, 0.2, 0.6], voxel: 0.05}  # [m], mount frame
     collision: {samples: 32, seed: 0}
 
 Targets are absolute, the same for every design: ``track.center`` is fixed in the mount
@@ -33,8 +34,9 @@ counts only poses that hold the tool points at least that far from the mount.
 in order (each leg the same time, starting and stopping at rest); without it the
 reference is the built-in circle and line.
 
-A task that names a carrier wears the limb for ``reach`` too: a pose that touches the
-carrier (in any posture) does not count towards it.
+``coverage`` is the box whose share of cells the tool must reach (``coverage``'s
+objective). A task that names a carrier wears the limb for ``reach`` and ``coverage``
+too: a pose that touches the carrier (in any posture) does not count towards them.
 
 ``carrier.postures`` names postures of the carrier, each the joint values (rad for a
 hinge, m for a slide; joints not named stay at the reference pose) it holds while the
@@ -86,9 +88,12 @@ class Task:
     #: (name, the carrier in that posture) for each posture the limb is judged in; none:
     #: the carrier as it is.
     postures: tuple[tuple[str, Carrier], ...] = ()
-    #: The task's file names a carrier: ``reach`` counts only poses that do not touch
-    #: it (in every posture). The built-in task measures the limb's own reach.
+    #: The task's file names a carrier: ``reach`` and ``coverage`` count only poses
+    #: that do not touch it (in every posture). The built-in task measures the limb's own.
     worn: bool = False
+    #: The box ``coverage`` asks the tool to reach: ``low``, ``high`` (m, mount frame),
+    #: ``voxel`` (m), ``samples``, ``seed``.
+    coverage: dict[str, Any] = field(default_factory=dict)
 
     def carriers(self) -> tuple[Carrier, ...]:
         """The carrier in each posture (the carrier alone when the task names none)."""
@@ -104,6 +109,10 @@ class Task:
             settings = self.payload
         elif name in ("track", "energy"):
             settings = self.track
+        elif name == "coverage":
+            settings = self.coverage
+            if not self.worn:
+                return cls(**settings)
         elif name == "reach" and self.worn:
             settings = {}
         else:
@@ -151,6 +160,7 @@ DEFAULT_TASK = Task()
 _SECTIONS = {
     "payload": ("samples", "seed", "limit", "min_free_share", "min_reach"),
     "track": ("duration", "center", "radius", "scale", "path"),
+    "coverage": ("low", "high", "voxel", "samples", "seed"),
     "collision": ("samples", "seed"),
 }
 #: Largest quaternion component accepted (the quaternion is normalised).
@@ -203,9 +213,10 @@ def load_task(path: str | os.PathLike[str]) -> Task:
         sections["collision"],
         postures,
         worn=data.get("carrier") is not None,
+        coverage=sections["coverage"],
     )
     # The objectives check their settings as they are built: report as the file's.
-    for what in ("payload", "track"):
+    for what in ("payload", "track", "coverage"):
         try:
             task.objective(what)
         except ValueError as exc:
@@ -325,6 +336,16 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
         where = f"{key}.{shown_key(name)}"
         if name not in _SECTIONS[key]:
             bad(where, f"unknown key; expected {', '.join(_SECTIONS[key])}")
+        elif name in ("low", "high"):
+            corner = _vector(value, 3)
+            if corner is None or any(abs(v) > MAX_OFFSET for v in corner):
+                bad(
+                    where,
+                    f"expected [x, y, z] of finite numbers [m] in the mount frame, each "
+                    f"within +-{MAX_OFFSET:g}",
+                )
+            else:
+                out[name] = corner
         elif name == "center":
             if value == "display":
                 out[name] = None

@@ -51,6 +51,7 @@ DrawPose = Callable[[mujoco.MjModel, np.ndarray, Path, str], None]
 UNITS = {
     "reach": "m",
     "workspace": "m^3",
+    "coverage": "share of the box",
     "mass": "kg",
     "dof": "DoF",
     "payload": "kg",
