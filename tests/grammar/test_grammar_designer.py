@@ -3,6 +3,8 @@ absolute targets and overlapping parts that MuJoCo's contact filter hides."""
 
 from __future__ import annotations
 
+import json
+
 import mujoco
 import numpy as np
 import pytest
@@ -295,6 +297,11 @@ def test_a_designers_task_gets_winners_that_pass_an_independent_replay(tmp_path)
         assert main([*args, "-o", str(out), "--no-picture", "--top", "1"]) == 0
         text = (out / "best_1" / "design.txt").read_text(encoding="utf-8")
         winners[objective] = build(grammar, Design.from_text(text))
+        if objective in ("track", "energy"):  # what the toolkit says of its runs
+            runs = json.loads((out / "best_1" / "values.json").read_text())["tracking_run"]
+            assert [r["posture"] for r in runs] == ["standing", "arms_raised"]
+            assert all(r["speed_over_rating"] <= 1 and r["contact_share"] == 0 for r in runs)
+            assert all(r["first_contact"] is None and r["first_overlap"] is None for r in runs)
     for objective in ("track", "energy"):
         limb = winners[objective]
         rated = np.array([j.peak_velocity for j in limb.joints])

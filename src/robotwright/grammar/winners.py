@@ -5,7 +5,10 @@ URDF, design text/JSON, tree, picture of the limb alone), readable by
 ``robotwright view OUT/best_N`` and ``robotwright render``, plus:
 
 - ``values.json`` / ``values.txt``: every objective's value with its unit, the score,
-  the rank and the design hash;
+  the rank and the design hash; for ``track`` and ``energy``, ``values.json`` also gives
+  each tracking run (one per posture) as a designer checks it: the RMS and largest tool
+  error (m), the largest joint speed over its rating, the share of steps touching
+  anything and the first touch or overlap (``tracking_run``);
 - ``on_carrier.png``: the limb worn by the task's carrier in its display pose, drawn by
   the ``draw_carrier`` function given (``robotwright grammar search -o`` passes
   :func:`robotwright.render.api.draw_pose`: OpenGL when available, else the software
@@ -184,6 +187,8 @@ def _write_designs(
                 values["by_posture"] = {
                     o.name: o.by_posture(ctx) for o in objectives if isinstance(o, WorstPosture)
                 }
+            if {"track", "energy"} & set(names):
+                values["tracking_run"] = _tracking_runs(ctx, task)
             (folder / "values.json").write_text(json.dumps(values, indent=2) + "\n", "utf-8")
             text = "".join(
                 f"{n}: {ev.values[n]:.6g} {UNITS.get(n, '')}\n".replace(" \n", "\n")
@@ -215,6 +220,28 @@ def _write_designs(
         if extra is not None:
             extra(tmp)
     return written
+
+
+def _tracking_runs(ctx: EvalContext, task: Task) -> list[dict]:
+    """What a designer checks of each tracking run (one per posture): the largest tool
+    error (m), the largest joint speed over its rating, the share of steps touching
+    anything and the first touch or overlap."""
+    names = [n for n, _ in task.postures] or ["carrier"]
+    out = []
+    for name, carrier in zip(names, task.carriers()):
+        run = Track(carrier=carrier, **task.track).run(ctx)
+        out.append(
+            {
+                "posture": name,
+                "rms_error_m": run.error,
+                "largest_error_m": float(np.linalg.norm(run.path - run.reference, axis=1).max()),
+                "speed_over_rating": run.speed_ratio,
+                "contact_share": run.contact_share,
+                "first_contact": list(run.first_contact) if run.first_contact else None,
+                "first_overlap": list(run.first_overlap) if run.first_overlap else None,
+            }
+        )
+    return out
 
 
 def plot_front(
