@@ -103,7 +103,7 @@ def test_a_path_through_the_carrier_is_refused_though_every_sampled_pose_is_free
     assert not (a.startswith("srl_") and b.startswith("srl_"))  # a carrier geom
     message = NoContactOnTrack()(ctx)
     assert message is not None and "touches on" in message
-    # the same run with contacts off would have sailed through: contacts push back
+    # a limb whose path clears the carrier and itself passes
     free = Track().run(ctx_of(grammar, TRACKER))
     assert free.contact_share == 0 and NoContactOnTrack()(ctx_of(grammar, TRACKER)) is None
 
