@@ -707,14 +707,14 @@ def track(
         fastest = max(fastest, float(np.max(np.abs(data.qvel) / rated)))
         path[k + 1] = data.site_xpos[m.sites[0]]
         qpos[k + 1], qvel[k + 1] = data.qpos, data.qvel
-        if data.ncon:
+        if data.ncon:  # found by mj_step1, at the state before this step: time k * dt
             geoms = data.contact.geom[: data.ncon]
             hit = limb_geoms[geoms].any(axis=1)
             if hit.any():
                 touching += 1
                 if first is None:
                     a, b = geoms[int(np.argmax(hit))]
-                    first = ((k + 1) * dt, model.geom(int(a)).name, model.geom(int(b)).name)
+                    first = (k * dt, model.geom(int(a)).name, model.geom(int(b)).name)
     mujoco.mj_kinematics(model, data)
     path[-1] = data.site_xpos[m.sites[0]]
     err = np.linalg.norm(path - ref, axis=1)
