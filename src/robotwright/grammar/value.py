@@ -23,6 +23,10 @@ from robotwright.grammar.rules import Grammar
 
 __all__ = ["FeatureMap", "PrefixValue", "ValueNet"]
 
+#: Rows of training a :class:`PrefixValue` round passes at most (beyond 2 epochs): a
+#: search of 1,000 designs (about 7,000 prefixes) still trains 20 epochs a round.
+TRAIN_ROWS = 200_000
+
 
 class FeatureMap:
     """The feature vector of a partial design (a tuple of steps) in one grammar."""
@@ -152,7 +156,11 @@ class PrefixValue:
                     self._x[key] = self.features(key)
                 targets[key] = max(targets.get(key, 0.0), value)
         keys = list(targets)
-        self.net.fit(np.stack([self._x[k] for k in keys]), np.array([targets[k] for k in keys]))
+        # 20 epochs while the prefixes are few; then a fixed number of rows a round, so
+        # that a long search's training grows with its length, not with its square.
+        epochs = max(2, min(20, TRAIN_ROWS // len(keys)))
+        x = np.stack([self._x[k] for k in keys])
+        self.net.fit(x, np.array([targets[k] for k in keys]), epochs=epochs)
         self.trained = True
 
     def rate(self, partials: Sequence[Partial]) -> np.ndarray:
