@@ -280,3 +280,37 @@ def test_masses_from_geoms_read_back_per_body(tmp_path, layout):
         if p.HasAPI(UsdPhysics.RigidBodyAPI)
     }
     assert masses == pytest.approx({"base": 6.0, "leg": 0.5})
+
+
+_TENDON_ARM = """<mujoco model="tendon_arm">
+  <worldbody>
+    <body name="base"><geom type="box" size="0.05 0.05 0.05" mass="1"/>
+      <body name="upper" pos="0 0 0.1"><joint name="shoulder" axis="0 1 0" range="-1 1"/>
+        <geom type="capsule" fromto="0 0 0 0 0 0.2" size="0.02" mass="0.5"/>
+        <body name="lower" pos="0 0 0.2"><joint name="elbow" axis="0 1 0" range="-1 1"/>
+          <geom type="capsule" fromto="0 0 0 0 0 0.2" size="0.02" mass="0.3"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <tendon><fixed name="coupling"><joint joint="shoulder" coef="1"/>
+    <joint joint="elbow" coef="-1"/></fixed></tendon>
+  <actuator>
+    <position name="shoulder_servo" joint="shoulder" kp="20"/>
+    <motor name="tendon_motor" tendon="coupling" gear="1"/>
+  </actuator>
+  <keyframe><key name="bent" qpos="0.3 -0.6"/><key name="straight" qpos="0 0"/></keyframe>
+</mujoco>
+"""
+
+
+def test_keyframes_and_tendon_actuators_are_named_where_the_usd_cannot_hold_them(tmp_path):
+    """A keyframe and an actuator on a tendon have no USD drive or state: each is noted
+    by name (issue 40, item 2), while the joint actuator gets its drive."""
+    (tmp_path / "tendon_arm.xml").write_text(_TENDON_ARM)
+    hrdf = load_robot(str(tmp_path / "tendon_arm.xml"))
+    done = to_usd(hrdf, tmp_path / "tendon_arm.usda")
+    notes = "\n".join(done.notes)
+    assert "2 keyframe(s) not carried (bent, straight)" in notes
+    assert "actuator 'tendon_motor' drives a tendon, not a joint" in notes
+    assert "shoulder_servo" not in notes and "shoulder" in done.drives

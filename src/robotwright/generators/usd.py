@@ -176,6 +176,30 @@ def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
     ]
 
 
+def _unheld_in_usd(model: mujoco.MjModel) -> list[str]:
+    """Notes for what the robot's MJCF holds that no USD joint drive or state carries:
+    keyframes, and actuators whose transmission is not a joint (a tendon, a site, a
+    body), each named."""
+    notes = []
+    if model.nkey:
+        names = [model.key(k).name or f"#{k}" for k in range(model.nkey)]
+        more = ", ..." if len(names) > 5 else ""
+        notes.append(
+            f"{model.nkey} keyframe(s) not carried ({', '.join(names[:5])}{more}): the USD "
+            "holds no keyframes; it starts in the model's reference pose"
+        )
+    joint_kinds = (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT)
+    for a in range(model.nu):
+        trn = mujoco.mjtTrn(int(model.actuator_trntype[a]))
+        if trn not in joint_kinds:
+            name = model.actuator(a).name or f"#{a}"
+            what = trn.name.removeprefix("mjTRN_").lower()
+            notes.append(
+                f"actuator {name!r} drives a {what}, not a joint: no USD joint drive carries it"
+            )
+    return notes
+
+
 def _author_drives(stage, hrdf: HRDF, kinds: dict[str, str], out: UsdExport) -> None:
     from pxr import Sdf, UsdPhysics
 
@@ -360,6 +384,7 @@ def to_usd(
                 f"{', ...' if len(hrdf.sensors) > 5 else ''}): mujoco-usd-converter writes no "
                 "sensors; add Isaac Lab sensors in the scene config"
             )
+        result.notes += _unheld_in_usd(model)
         _author_drives(stage, hrdf, _joint_kinds(model), result)
         _author_free_joint_names(stage, model)
         flat = stage.Flatten()
