@@ -1,7 +1,7 @@
 """Parts of a limb that overlap: a geometric check that MuJoCo's contact filter cannot hide.
 
-MuJoCo never reports contacts between a body and its parent, so two motor housings on
-consecutive bodies, or a link folding back through the base it stands on, overlap
+MuJoCo never reports contacts between a body and its parent (unless the parent is fixed
+to the world, as a limb's base is), so two motor housings on consecutive bodies overlap
 unseen by every contact-based check. Here each pair of parts is measured with
 ``mujoco.mj_geomDistance`` (the signed distance of two geoms, whatever their bodies),
 except the pairs that meet by construction: the parts that share a joint point (a
