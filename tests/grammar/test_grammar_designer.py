@@ -207,7 +207,7 @@ def test_reach_on_a_carrier_counts_no_pose_that_touches_it(grammar, tmp_path) ->
     pts = ctx.tool_points(256, 0)
     k = int(np.argmin(np.abs(np.linalg.norm(pts, axis=1) - worn))) % 257
     m = ctx.mounted(facing_in)
-    assert not P.carrier_collisions(m, ctx._poses(256, 0)[k][None])
+    assert not P.carrier_collisions(m, ctx.poses(256, 0)[k][None])
     # a task file that names a carrier wears the limb for reach; the built-in task does not
     assert DEFAULT_TASK.objective("reach") == Reach()
     path = tmp_path / "task.yaml"
@@ -338,7 +338,7 @@ def test_a_designers_task_gets_winners_that_pass_an_independent_replay(tmp_path)
         value = Reach(carrier=carrier)(ctx)
         pts = ctx.tool_points(256, 0)
         k = int(np.argmin(np.abs(np.linalg.norm(pts, axis=1) - value))) % 257
-        q = ctx._poses(256, 0)[k]
+        q = ctx.poses(256, 0)[k]
         limb_only = ctx.model
         data = mujoco.MjData(limb_only)
         data.qpos[:] = q

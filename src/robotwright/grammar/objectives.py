@@ -13,144 +13,26 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import Protocol, runtime_checkable
 
 import mujoco
 import numpy as np
 
-from robotwright.grammar.build import Limb, build
+from robotwright.grammar.context import EvalContext
 from robotwright.grammar.design import Design
-from robotwright.grammar.overlap import checked_pairs, overlaps
 from robotwright.grammar.physics import (
     MIN_FREE_SHARE,
     PAYLOAD_MIN_REACH,
     TRACK_CENTER,
     TRACK_RADIUS,
     Carrier,
-    Mounted,
     TrackResult,
     carrier_collisions,
     check_settings,
-    mount,
     payload,
-    sample_joint_vectors,
     sample_poses,
-    track,
 )
 from robotwright.grammar.rules import Grammar
-
-
-class EvalContext:
-    """Lazily built views of one design shared by all objectives and constraints."""
-
-    def __init__(self, grammar: Grammar, design: Design) -> None:
-        self.grammar = grammar
-        self.design = design
-
-    @cached_property
-    def limb(self) -> Limb:
-        return build(self.grammar, self.design)
-
-    def value(self, objective: Objective) -> float:
-        """``objective`` on this design, computed once (a weighted sum and the values
-        reported beside it share one computation)."""
-        cache = self.__dict__.setdefault("_values", {})
-        if objective not in cache:
-            cache[objective] = float(objective(self))
-        return cache[objective]
-
-    @cached_property
-    def model(self) -> mujoco.MjModel:
-        return self.limb.to_spec().compile()
-
-    def mounted(self, carrier: Carrier) -> Mounted:
-        """The limb compiled on ``carrier`` (joints locked), built once per carrier."""
-        cache = self.__dict__.setdefault("_mounted", {})
-        if carrier not in cache:
-            cache[carrier] = mount(self.limb, carrier)
-        return cache[carrier]
-
-    def tracking(
-        self,
-        carrier: Carrier,
-        duration: float,
-        scale: float,
-        path: tuple[tuple[float, float, float], ...] | None = None,
-        center: tuple[float, float, float] | None = TRACK_CENTER,
-        radius: float | None = TRACK_RADIUS,
-    ) -> TrackResult:
-        """One tracking run (shared by ``track``, ``energy`` and the constraints
-        measured on it)."""
-        key = (carrier, duration, scale, path, center, radius)
-        cache = self.__dict__.setdefault("_tracks", {})
-        if key not in cache:
-            cache[key] = track(
-                self.limb,
-                carrier,
-                duration=duration,
-                scale=scale,
-                mounted=self.mounted(carrier),
-                path=path,
-                center=center,
-                radius=radius,
-            )
-        return cache[key]
-
-    def pose_is_free(
-        self, pose: int, samples: int, seed: int, carrier: Carrier | None = None
-    ) -> bool:
-        """Whether pose number ``pose`` of :meth:`tool_points`'s poses is one the limb can
-        take: no contact of the limb with itself (MuJoCo), no overlapping parts, and,
-        given ``carrier``, no contact with it while worn."""
-        q = self._poses(samples, seed)[pose]
-        model, data = self.model, self._data
-        for j, value in zip(self.limb.joints, q):
-            data.qpos[model.jnt_qposadr[model.joint(j.name).id]] = value
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_collision(model, data)
-        if data.ncon or overlaps(
-            self.limb, model, q[None], first_only=True, pairs=self._overlap_pairs
-        ):
-            return False
-        if carrier is None:
-            return True
-        return not carrier_collisions(self.mounted(carrier), q[None])
-
-    @cached_property
-    def _data(self) -> mujoco.MjData:
-        return mujoco.MjData(self.model)
-
-    @cached_property
-    def _overlap_pairs(self) -> np.ndarray:
-        return checked_pairs(self.limb, self.model)
-
-    def _poses(self, samples: int, seed: int) -> np.ndarray:
-        """The zero pose (clipped into the ranges) and ``samples`` joint vectors drawn
-        uniformly inside them (seeded), in the limb's joint order."""
-        key = (samples, seed)
-        cache = self.__dict__.setdefault("_pose_sets", {})
-        if key not in cache:
-            limb = self.limb
-            lo, hi = limb.joint_ranges().T if limb.joints else (np.zeros(0), np.zeros(0))
-            cache[key] = sample_joint_vectors(lo, hi, samples, seed)
-        return cache[key]
-
-    def tool_points(self, samples: int, seed: int) -> np.ndarray:
-        """Tool-point positions (m, mount frame) of every branch for ``samples`` joint
-        vectors drawn uniformly inside the joint ranges (seeded), plus the zero pose."""
-        key = (samples, seed)
-        cache = self.__dict__.setdefault("_points", {})
-        if key not in cache:
-            limb = self.limb
-            names = [j.name for j in limb.joints]
-            q = self._poses(samples, seed)
-            pts = []
-            for br in limb.branches:
-                cols = [names.index(n) for n in br.joints]
-                pts.append(br.tool_pose(q[:, cols])[..., :3, 3])
-            cache[key] = np.concatenate(pts) if pts else np.zeros((0, 3))
-        return cache[key]
 
 
 @runtime_checkable
@@ -193,13 +75,9 @@ class Reach:
         if not self.free_only:
             return float(dist.max())
         # The farthest first: usually the first pose checked is free.
-        n = self.samples + 1
-        checked: dict[int, bool] = {}
         for k in np.argsort(-dist, kind="stable"):
-            pose = int(k) % n  # the points are branch by branch, each over every pose
-            if pose not in checked:
-                checked[pose] = ctx.pose_is_free(pose, self.samples, self.seed, self.carrier)
-            if checked[pose]:
+            pose = ctx.pose_of_point(int(k), self.samples)
+            if ctx.pose_is_free(pose, self.samples, self.seed, self.carrier):
                 return float(dist[k])
         return 0.0
 
@@ -283,18 +161,14 @@ class Coverage:
         pts = ctx.tool_points(self.samples, self.seed)
         if not len(pts):
             return 0.0
-        n = self.samples + 1
         inside = np.all((pts >= low) & (pts < high), axis=1)
         hit: set[tuple[int, ...]] = set()
-        free: dict[int, bool] = {}
         for k in np.flatnonzero(inside):
             cell = tuple(np.minimum(((pts[k] - low) // self.voxel).astype(np.int64), shape - 1))
             if cell in hit:
                 continue
-            pose = int(k) % n  # the points are branch by branch, each over every pose
-            if pose not in free:
-                free[pose] = ctx.pose_is_free(pose, self.samples, self.seed, self.carrier)
-            if free[pose]:
+            pose = ctx.pose_of_point(int(k), self.samples)
+            if ctx.pose_is_free(pose, self.samples, self.seed, self.carrier):
                 hit.add(cell)
         return len(hit) / float(shape.prod())
 
@@ -614,9 +488,7 @@ class NoOverlap:
         check_settings("NoOverlap", samples=self.samples, seed=self.seed)
 
     def __call__(self, ctx: EvalContext) -> str | None:
-        limb = ctx.limb
-        lo, hi = limb.joint_ranges().T
-        found = overlaps(limb, ctx.model, sample_joint_vectors(lo, hi, self.samples, self.seed))
+        found = ctx.overlap_check.over(ctx.poses(self.samples, self.seed))
         if not found:
             return None
         deepest = max(found, key=lambda o: o.depth)

@@ -92,6 +92,71 @@ def hidden_pairs(model: mujoco.MjModel, pairs: np.ndarray) -> np.ndarray:
     return pairs[hidden]
 
 
+class OverlapCheck:
+    """The overlap check of one compiled model holding the limb (alone, or worn with
+    its names prefixed with ``prefix``), made once and used at many poses: the pairs
+    measured (:func:`checked_pairs`; with ``hidden_only`` just the ones MuJoCo's contacts
+    cannot see, :func:`hidden_pairs`), where each joint's value goes in ``qpos``, and
+    the bounding-sphere reach of each pair."""
+
+    def __init__(
+        self,
+        limb: Limb,
+        model: mujoco.MjModel,
+        prefix: str = "",
+        tolerance: float = OVERLAP_TOLERANCE,
+        hidden_only: bool = False,
+    ) -> None:
+        pairs = checked_pairs(limb, model, prefix)
+        self.pairs = hidden_pairs(model, pairs) if hidden_only else pairs
+        self.model = model
+        self.tolerance = tolerance
+        self.qpos_adr = np.array(
+            [model.jnt_qposadr[model.joint(prefix + j.name).id] for j in limb.joints], dtype=int
+        )
+        self._reach = model.geom_rbound[self.pairs[:, 0]] + model.geom_rbound[self.pairs[:, 1]]
+        self._fromto = np.zeros(6)
+
+    def pose(self, data: mujoco.MjData, q: np.ndarray) -> None:
+        """Put ``data`` at joint vector ``q`` (``limb.joints`` order), kinematics done."""
+        data.qpos[self.qpos_adr] = q
+        mujoco.mj_kinematics(self.model, data)
+
+    def at(self, data: mujoco.MjData, pose: int = 0, first_only: bool = False) -> list[Overlap]:
+        """The pairs overlapping by more than the tolerance in ``data`` (kinematics
+        computed), reported as at pose number ``pose``. A pair is measured only where
+        their bounding spheres meet, so a pose costs a few microseconds per close pair."""
+        out: list[Overlap] = []
+        if len(self.pairs) == 0:
+            return out
+        a_pos, b_pos = data.geom_xpos[self.pairs[:, 0]], data.geom_xpos[self.pairs[:, 1]]
+        close = self.pairs[np.linalg.norm(a_pos - b_pos, axis=1) < self._reach]
+        for a, b in close:
+            d = mujoco.mj_geomDistance(
+                self.model, data, int(a), int(b), self.tolerance, self._fromto
+            )
+            if d < -self.tolerance:
+                names = self.model.geom(int(a)).name, self.model.geom(int(b)).name
+                out.append(Overlap(pose, *names, -d))
+                if first_only:
+                    break
+        return out
+
+    def over(self, poses: np.ndarray, first_only: bool = False) -> list[Overlap]:
+        """:meth:`at` each of ``poses`` (joint vectors); ``first_only`` stops at the
+        first overlap found."""
+        out: list[Overlap] = []
+        if len(self.pairs) == 0:
+            return out
+        data = mujoco.MjData(self.model)
+        for k, q in enumerate(np.atleast_2d(poses)):
+            self.pose(data, q)
+            out += self.at(data, k, first_only)
+            if first_only and out:
+                break
+        return out
+
+
 def overlaps(
     limb: Limb,
     model: mujoco.MjModel,
@@ -99,35 +164,9 @@ def overlaps(
     tolerance: float = OVERLAP_TOLERANCE,
     first_only: bool = False,
     prefix: str = "",
-    pairs: np.ndarray | None = None,
 ) -> list[Overlap]:
     """Every pair of parts overlapping by more than ``tolerance`` m at each of ``poses``
     (joint vectors in ``limb.joints`` order, rad or m), in ``model``: the limb alone or
-    worn by a carrier (its names prefixed with ``prefix``).
-
-    A pair is measured only where their bounding spheres meet, so a pose costs a few
-    microseconds per close pair. ``first_only`` stops at the first overlap found;
-    ``pairs``: :func:`checked_pairs` of the same model, when already made.
-    """
-    if pairs is None:
-        pairs = checked_pairs(limb, model, prefix)
-    out: list[Overlap] = []
-    if len(pairs) == 0:
-        return out
-    data = mujoco.MjData(model)
-    adr = np.array(
-        [model.jnt_qposadr[model.joint(prefix + j.name).id] for j in limb.joints], dtype=int
-    )
-    reach = model.geom_rbound[pairs[:, 0]] + model.geom_rbound[pairs[:, 1]]
-    fromto = np.zeros(6)
-    for k, q in enumerate(np.atleast_2d(poses)):
-        data.qpos[adr] = q
-        mujoco.mj_kinematics(model, data)
-        gap = np.linalg.norm(data.geom_xpos[pairs[:, 0]] - data.geom_xpos[pairs[:, 1]], axis=1)
-        for a, b in pairs[gap < reach]:
-            d = mujoco.mj_geomDistance(model, data, int(a), int(b), tolerance, fromto)
-            if d < -tolerance:
-                out.append(Overlap(k, model.geom(int(a)).name, model.geom(int(b)).name, -d))
-                if first_only:
-                    return out
-    return out
+    worn by a carrier (its names prefixed with ``prefix``); see :class:`OverlapCheck`.
+    ``first_only`` stops at the first overlap found."""
+    return OverlapCheck(limb, model, prefix, tolerance).over(poses, first_only)

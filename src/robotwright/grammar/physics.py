@@ -26,7 +26,7 @@ import numpy as np
 from robotwright._bounds import Bound
 from robotwright._names import shown
 from robotwright.grammar.build import Limb
-from robotwright.grammar.overlap import checked_pairs, hidden_pairs, overlaps
+from robotwright.grammar.overlap import OverlapCheck
 
 #: The limb's z axis (its base normal) along the site's -x: worn on the back, pointing
 #: backwards. Rotation of -90 deg about y, as (w, x, y, z).
@@ -193,7 +193,7 @@ class Mounted:
         return data.xpos[b] + data.xmat[b].reshape(3, 3) @ np.asarray(point, dtype=float)
 
     def is_limb_geom(self, geom: int) -> bool:
-        return int(self.model.geom_bodyid[geom]) in self.limb_bodies
+        return bool(self.limb_geoms[geom])
 
     @cached_property
     def limb_geoms(self) -> np.ndarray:
@@ -719,8 +719,8 @@ def track(
     path[-1] = data.site_xpos[m.sites[0]]
     err = np.linalg.norm(path - ref, axis=1)
     # MuJoCo's contacts above watched every other pair at every step.
-    hidden = hidden_pairs(model, checked_pairs(limb, model, m.prefix))
-    found = overlaps(limb, model, qpos, first_only=True, prefix=m.prefix, pairs=hidden)
+    check = OverlapCheck(limb, model, m.prefix, hidden_only=True)
+    found = check.over(qpos, first_only=True)
     overlap = (found[0].pose * dt, found[0].a, found[0].b, found[0].depth) if found else None
     return TrackResult(
         float(np.sqrt(np.mean(err**2))),
