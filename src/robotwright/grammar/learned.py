@@ -124,14 +124,15 @@ def learned_search(
         stalls = 0
         while ev.left > 0 and stalls < 50:
             size = min(ev.left, warmup if not value.trained else batch)
-            seen = {e.design.hash() for e in ev.order}
+            seen = set(ev.cache)  # the hashes of the designs evaluated so far
             designs: list[Design] = []
             for _ in range(size):
                 d = grow()
                 tries = 0
-                while (d.hash() in seen or d in designs) and tries < 20:
+                while d.hash() in seen and tries < 20:
                     d = grow() if tries < 5 else sample(grammar, max_links, rng, counter)
                     tries += 1
+                seen.add(d.hash())
                 designs.append(d)
             before = len(ev.order)
             ev.run(designs)

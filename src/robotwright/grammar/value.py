@@ -137,30 +137,39 @@ class PrefixValue:
         self.features = FeatureMap(grammar)
         self.net = ValueNet(self.features.size, hidden=hidden, seed=seed)
         self._x: dict[tuple[Step, ...], np.ndarray] = {}
+        #: The best raw score through each prefix, prefixes in the order first met.
+        self._best: dict[tuple[Step, ...], float] = {}
+        self._lo, self._hi = math.inf, -math.inf  # the range of feasible scores
+        self._absorbed = 0
         self.trained = False
 
     def learn(self, evaluations: Sequence[Evaluation]) -> None:
         """Fit the network to every prefix of ``evaluations`` (nothing to learn while no
-        design is feasible)."""
-        finite = [e.score for e in evaluations if math.isfinite(e.score)]
-        if not finite:
-            return
-        lo, hi = min(finite), max(finite)
-        targets: dict[tuple[Step, ...], float] = {}
-        for e in evaluations:
-            value = _normalised(e.score, lo, hi)
+        design is feasible). ``evaluations`` is a search's evaluation order, which only
+        grows: the designs already taken in are not walked again. Normalising is
+        monotonic, so the best normalised score through a prefix is that of its best
+        raw score."""
+        for e in evaluations[self._absorbed :]:
+            if math.isfinite(e.score):
+                self._lo, self._hi = min(self._lo, e.score), max(self._hi, e.score)
             steps = e.design.steps
             for k in range(len(steps) + 1):
                 key = steps[:k]
-                if key not in self._x:
+                if key not in self._best:
                     self._x[key] = self.features(key)
-                targets[key] = max(targets.get(key, 0.0), value)
-        keys = list(targets)
+                    self._best[key] = e.score
+                elif e.score > self._best[key]:
+                    self._best[key] = e.score
+        self._absorbed = len(evaluations)
+        if self._hi < self._lo:
+            return
+        keys = list(self._best)
+        targets = [_normalised(self._best[k], self._lo, self._hi) for k in keys]
         # 20 epochs while the prefixes are few; then a fixed number of rows a round, so
         # that a long search's training grows with its length, not with its square.
         epochs = max(2, min(20, TRAIN_ROWS // len(keys)))
         x = np.stack([self._x[k] for k in keys])
-        self.net.fit(x, np.array([targets[k] for k in keys]), epochs=epochs)
+        self.net.fit(x, np.array(targets), epochs=epochs)
         self.trained = True
 
     def rate(self, partials: Sequence[Partial]) -> np.ndarray:
