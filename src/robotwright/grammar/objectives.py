@@ -11,9 +11,9 @@ worn by its carrier (:mod:`robotwright.grammar.physics`).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import mujoco
 import numpy as np
@@ -115,6 +115,18 @@ class WorkspaceVolume:
         return hull_volume(pts)
 
 
+def _point(owner: object, field_name: str) -> tuple[float, float, float]:
+    """``owner``'s ``field_name``, a point [m], checked: 3 finite numbers within +-10 m,
+    returned as a tuple (a list from Python or tyro is kept hashable)."""
+    value = getattr(owner, field_name)
+    if len(value) != 3 or not all(isinstance(v, (int, float)) and abs(v) <= 10.0 for v in value):
+        raise ValueError(
+            f"{type(owner).__name__}: {field_name} expected 3 finite numbers [m] within "
+            f"+-10, got {value!r}"
+        )
+    return tuple(float(v) for v in value)  # type: ignore[return-value]
+
+
 #: The built-in workspace to cover (mount frame, m): a 0.4 m cube about the tracking
 #: target's centre, in 5 cm cells.
 COVERAGE_LOW: tuple[float, float, float] = (0.2, -0.2, 0.2)
@@ -142,22 +154,22 @@ class Coverage:
     def __post_init__(self) -> None:
         check_settings("Coverage", samples=self.samples, seed=self.seed, voxel=self.voxel)
         for which in ("low", "high"):
-            v = getattr(self, which)
-            if len(v) != 3 or not all(isinstance(x, (int, float)) and abs(x) <= 10 for x in v):
-                raise ValueError(
-                    f"Coverage: {which} expected 3 finite numbers [m] within +-10, got {v!r}"
-                )
-            object.__setattr__(self, which, tuple(float(x) for x in v))
-        cells = np.ceil((np.array(self.high) - np.array(self.low)) / self.voxel - 1e-9)
+            object.__setattr__(self, which, _point(self, which))
+        cells = self._cells()
         if not (cells >= 1).all() or cells.prod() > MAX_COVERAGE_CELLS:
             raise ValueError(
                 f"Coverage: high must exceed low on every axis, in at most "
                 f"{MAX_COVERAGE_CELLS} cells of {self.voxel} m; got {self.low} to {self.high}"
             )
 
+    def _cells(self) -> np.ndarray:
+        """Cells of the box along x, y and z."""
+        span = np.array(self.high) - np.array(self.low)
+        return np.ceil(span / self.voxel - 1e-9).astype(np.int64)
+
     def __call__(self, ctx: EvalContext) -> float:
         low, high = np.array(self.low), np.array(self.high)
-        shape = np.ceil((high - low) / self.voxel - 1e-9).astype(np.int64)
+        shape = self._cells()
         pts = ctx.tool_points(self.samples, self.seed)
         if not len(pts):
             return 0.0
@@ -347,16 +359,8 @@ class _TrackingRun:
         check_settings(type(self).__name__, duration=self.duration, scale=self.scale)
         if self.radius is not None:
             check_settings(type(self).__name__, radius=self.radius)
-        if self.center is not None and (
-            len(self.center) != 3
-            or not all(isinstance(v, (int, float)) and abs(v) <= 10.0 for v in self.center)
-        ):
-            raise ValueError(
-                f"{type(self).__name__}: center expected 3 finite numbers [m] within +-10, "
-                f"got {self.center!r}"
-            )
-        if self.center is not None:  # a list from Python or tyro: kept hashable
-            object.__setattr__(self, "center", tuple(float(v) for v in self.center))
+        if self.center is not None:
+            object.__setattr__(self, "center", _point(self, "center"))
 
     def run(self, ctx: EvalContext) -> TrackResult:
         """The tracking run these settings ask for, made once per design in ``ctx``."""
@@ -670,25 +674,26 @@ def make_constraint(text: str) -> Constraint:
         if eq:
             raise ValueError(f"constraint {text!r}: {name} takes no value")
         return _FLAGS[name]()
-    if name not in ("max-mass", "max-track-error", "max-dof", "min-dof"):
+    if name not in _VALUED:
         raise ValueError(f"unknown constraint {text!r}: expected {_EXPECTED}")
-    real = name in ("max-mass", "max-track-error")
+    kind, expected, example, make = _VALUED[name]
     try:
-        number = float(value) if real else int(value)
+        number = kind(value)
     except ValueError:
         number = None
     if number is None or not math.isfinite(number) or number < 0:
-        unit = "kg" if name == "max-mass" else "m"
-        raise ValueError(
-            f"constraint {text!r}: {name} needs a "
-            f"{f'finite number >= 0 ({unit})' if real else 'whole number >= 0'}, "
-            f"e.g. {name}={'0.01' if name == 'max-track-error' else '2'}"
-        )
-    if name == "max-mass":
-        return MaxMass(float(number))
-    if name == "max-track-error":
-        return TracksWithin(limit=float(number))
-    return DoFRange(high=int(number)) if name == "max-dof" else DoFRange(low=int(number))
+        raise ValueError(f"constraint {text!r}: {name} needs a {expected}, e.g. {name}={example}")
+    return make(number)
+
+
+#: The constraints that take a value: its type, what it must be, an example, the
+#: constraint made of it.
+_VALUED: dict[str, tuple[type, str, str, Callable[[Any], Constraint]]] = {
+    "max-mass": (float, "finite number >= 0 (kg)", "2", MaxMass),
+    "max-track-error": (float, "finite number >= 0 (m)", "0.01", lambda v: TracksWithin(limit=v)),
+    "max-dof": (int, "whole number >= 0", "2", lambda v: DoFRange(high=v)),
+    "min-dof": (int, "whole number >= 0", "2", lambda v: DoFRange(low=v)),
+}
 
 
 @dataclass(frozen=True)

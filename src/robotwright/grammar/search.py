@@ -283,13 +283,18 @@ def expansions(p: Partial, grammar: Grammar, counter: Counter, max_links: int) -
     """Every next partial derivation of ``p`` (one decision at its current node: a rule
     with each of its choices, or stopping) that can still complete within
     ``max_links``."""
-    out = []
-    for rule, n in options(p):
-        if rule is None:
-            out.append(p.stop())
-        else:
-            out += [p.apply(rule, choices_at(grammar, rule, i)) for i in range(n)]
+    out = [
+        decide(p, grammar, rule, i)
+        for rule, n in options(p)
+        for i in (range(n) if rule is not None else (0,))
+    ]
     return [c for c in out if counter.completions(c, max_links) > 0]
+
+
+def decide(p: Partial, grammar: Grammar, rule: Rule | None, i: int) -> Partial:
+    """``p`` after one decision at its current node: ``rule`` with its ``i``-th choices,
+    or stopping when ``rule`` is None."""
+    return p.stop() if rule is None else p.apply(rule, choices_at(grammar, rule, i))
 
 
 def beam_search(
@@ -456,13 +461,10 @@ def mcts_search(
     if guided:
         header["guided"] = True
 
-    def expand(p: Partial, rule: Rule | None, i: int) -> Partial:
-        return p.stop() if rule is None else p.apply(rule, choices_at(grammar, rule, i))
-
     def next_decision(node: _Node) -> tuple:
         if prior is None or not prior.trained or len(node.untried) == 1:
             return node.untried.pop()
-        rated = prior.rate([expand(node.partial, r, i) for r, i in node.untried])
+        rated = prior.rate([decide(node.partial, grammar, r, i) for r, i in node.untried])
         return node.untried.pop(int(np.argmax(rated)))
 
     def norm(score: float) -> float:
@@ -501,7 +503,7 @@ def mcts_search(
                     path.append(node)
                 while node.untried:
                     rule, i = next_decision(node)
-                    child_p = expand(node.partial, rule, i)
+                    child_p = decide(node.partial, grammar, rule, i)
                     if counter.feasible(child_p, max_links):
                         child = _Node(child_p, _decisions(child_p, rng))
                         node.children.append(child)

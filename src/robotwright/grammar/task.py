@@ -105,18 +105,12 @@ class Task:
         from robotwright.grammar.objectives import OBJECTIVES, WorstPosture
 
         cls = OBJECTIVES[name]
-        if name == "payload":
-            settings = self.payload
-        elif name in ("track", "energy"):
-            settings = self.track
-        elif name == "coverage":
-            settings = self.coverage
-            if not self.worn:
-                return cls(**settings)
-        elif name == "reach" and self.worn:
-            settings = {}
-        else:
-            return cls()
+        sections = {"payload": self.payload, "track": self.track, "energy": self.track}
+        settings = {**sections, "coverage": self.coverage}.get(name, {})
+        # The physics objectives are always worn; reach and coverage when the task file
+        # names a carrier; the others never.
+        if not (name in sections or self.worn and name in ("reach", "coverage")):
+            return cls(**settings)
         if not self.postures:
             return cls(carrier=self.carrier, **settings)
         return WorstPosture(
@@ -336,30 +330,24 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
         where = f"{key}.{shown_key(name)}"
         if name not in _SECTIONS[key]:
             bad(where, f"unknown key; expected {', '.join(_SECTIONS[key])}")
-        elif name in ("low", "high"):
-            corner = _vector(value, 3)
-            if corner is None or any(abs(v) > MAX_OFFSET for v in corner):
+        elif name in ("low", "high", "center"):
+            if name == "center" and value == "display":
+                out[name] = None
+                continue
+            point = _point(value)
+            if point is None:
+                display = (
+                    ", or display (the tool point at the design's display pose)"
+                    if name == "center"
+                    else ""
+                )
                 bad(
                     where,
                     f"expected [x, y, z] of finite numbers [m] in the mount frame, each "
-                    f"within +-{MAX_OFFSET:g}",
+                    f"within +-{MAX_OFFSET:g}{display}",
                 )
             else:
-                out[name] = corner
-        elif name == "center":
-            if value == "display":
-                out[name] = None
-            else:
-                center = _vector(value, 3)
-                if center is None or any(abs(v) > MAX_OFFSET for v in center):
-                    bad(
-                        where,
-                        f"expected [x, y, z] of finite numbers [m] in the mount frame, each "
-                        f"within +-{MAX_OFFSET:g}, or display (the tool point at the "
-                        "design's display pose)",
-                    )
-                else:
-                    out[name] = center
+                out[name] = point
         elif name == "path":
             waypoints = _waypoints(value)
             if waypoints is None:
@@ -382,10 +370,18 @@ def _section(key: str, raw: Any, bad: Any) -> dict[str, Any]:
     return out
 
 
+def _point(value: Any) -> tuple[float, float, float] | None:
+    """A point [m]: 3 finite numbers, each within +-:data:`MAX_OFFSET`; else None."""
+    point = _vector(value, 3)
+    if point is None or any(abs(v) > MAX_OFFSET for v in point):
+        return None
+    return point  # type: ignore[return-value]
+
+
 def _waypoints(value: Any) -> tuple[tuple[float, float, float], ...] | None:
     if not isinstance(value, list) or not 2 <= len(value) <= MAX_WAYPOINTS:
         return None
-    points = [_vector(p, 3) for p in value]
-    if any(p is None or any(abs(v) > MAX_OFFSET for v in p) for p in points):
+    points = [_point(p) for p in value]
+    if any(p is None for p in points):
         return None
     return tuple(points)  # type: ignore[arg-type]
