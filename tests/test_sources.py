@@ -134,8 +134,10 @@ def test_root_body_picks_the_mjcf_robot(tmp_path, capsys):
         '<body name="other" pos="1 0 0.5"><geom type="box" size="0.1 0.1 0.1"/></body></worldbody>',
     )
     (tmp_path / "w.xml").write_text(two)
-    assert main(["info", str(tmp_path / "w.xml")]) == 2
-    assert "--root-body" in capsys.readouterr().err
+    # The whole world is a scene of two roots; --root-body takes one robot out of it.
+    assert main(["info", str(tmp_path / "w.xml")]) == 0
+    whole = capsys.readouterr().out
+    assert "a scene of 2 roots: " in whole and "other (fixed)" in whole
     assert main(["info", str(tmp_path / "w.xml"), "--root-body", "other"]) == 0
     out = capsys.readouterr().out
     assert "robot " in out and " 0 joints" in out

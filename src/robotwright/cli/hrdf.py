@@ -90,6 +90,14 @@ def format_info(hrdf: HRDF) -> str:
         f"{s['actuators']} actuators, {s['dof']} DoF, total mass {s['total_mass']:.3f} kg, "
         f"{'floating' if s['floating_base'] else 'fixed'} base"
     )
+    roots = hrdf.root_indices
+    if len(roots) > 1:
+        free = {j.body for j in hrdf.joints if j.type == "free"}
+        listed = ", ".join(
+            f"{hrdf.bodies[i].name} ({'free' if hrdf.bodies[i].name in free else 'fixed'})"
+            for i in roots
+        )
+        head += f"; a scene of {len(roots)} roots: {listed}"
     bodies = [
         [
             b.name,

@@ -4,10 +4,10 @@ The robot goes out as our MJCF (robot only: no floor, light or sky), which
 ``mujoco-usd-converter`` (the library behind Isaac Lab 3's kit-less MJCF importer) turns
 into USD; then usd-core's API authors what the converter leaves out:
 
-* joint drives (``UsdPhysics.DriveAPI``, ``angular`` or ``linear``) from the HRDF
-  actuators: stiffness from ``p_gain`` and damping from ``d_gain`` (USD's angular drive
-  units are per degree: N m/deg, N m s/deg), max force from ``peak_torque`` (else the
-  force range);
+* joint drives (``UsdPhysics.DriveAPI``, ``angular`` or ``linear``) from MuJoCo's
+  compile of the robot's actuators (:mod:`robotwright.generators.usd_drives`: gains and
+  max force in joint units, gear included; USD's angular drive units are per degree:
+  N m/deg, N m s/deg), and a note naming each actuator no drive can hold;
 * the velocity limit MJCF cannot hold, ``peak_velocity``, as Newton's
   ``newton:velocityLimit`` (deg/s or m/s) and PhysX's ``physxJoint:maxJointVelocity``
   (deg/s);
@@ -156,16 +156,6 @@ def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple
     return path, lost
 
 
-def _joint_kinds(model: mujoco.MjModel) -> dict[str, str]:
-    """Joint name -> "angular" (hinge) or "linear" (slide), from MuJoCo's compile."""
-    kind = {int(mujoco.mjtJoint.mjJNT_HINGE): "angular", int(mujoco.mjtJoint.mjJNT_SLIDE): "linear"}
-    return {
-        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j): kind[int(model.jnt_type[j])]
-        for j in range(model.njnt)
-        if int(model.jnt_type[j]) in kind
-    }
-
-
 def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
     """Bodies with mass but an all-zero inertia: USD reads a zero ``diagonalInertia`` as
     "not given" and readers compute one from the colliders instead."""
@@ -176,71 +166,69 @@ def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
     ]
 
 
-def _unheld_in_usd(model: mujoco.MjModel) -> list[str]:
-    """Notes for what the robot's MJCF holds that no USD joint drive or state carries:
-    keyframes, and actuators whose transmission is not a joint (a tendon, a site, a
-    body), each named."""
-    notes = []
-    if model.nkey:
-        names = [model.key(k).name or f"#{k}" for k in range(model.nkey)]
-        more = ", ..." if len(names) > 5 else ""
-        notes.append(
-            f"{model.nkey} keyframe(s) not carried ({', '.join(names[:5])}{more}): the USD "
-            "holds no keyframes; it starts in the model's reference pose"
-        )
-    joint_kinds = (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT)
-    for a in range(model.nu):
-        trn = mujoco.mjtTrn(int(model.actuator_trntype[a]))
-        if trn not in joint_kinds:
-            name = model.actuator(a).name or f"#{a}"
-            what = trn.name.removeprefix("mjTRN_").lower()
-            notes.append(
-                f"actuator {name!r} drives a {what}, not a joint: no USD joint drive carries it"
-            )
-    return notes
+def _keyframe_notes(model: mujoco.MjModel) -> list[str]:
+    """A note for the keyframes, which no USD joint state carries, each named."""
+    if not model.nkey:
+        return []
+    names = [model.key(k).name or f"#{k}" for k in range(model.nkey)]
+    more = ", ..." if len(names) > 5 else ""
+    return [
+        f"{model.nkey} keyframe(s) not carried ({', '.join(names[:5])}{more}): the USD "
+        "holds no keyframes; it starts in the model's reference pose"
+    ]
 
 
-def _author_drives(stage, hrdf: HRDF, kinds: dict[str, str], out: UsdExport) -> None:
+def _author_drives(stage, hrdf: HRDF, model: mujoco.MjModel, out: UsdExport) -> None:
+    """One ``UsdPhysics.DriveAPI`` per actuated hinge or slide joint, as
+    :func:`~robotwright.generators.usd_drives.joint_drives` derives it from MuJoCo's
+    compile, and each joint's rated velocity (the HRDF's ``peak_velocity``, which MJCF
+    cannot hold); a note for each actuator no drive holds."""
     from pxr import Sdf, UsdPhysics
 
-    joints = {p.GetName(): p for p in stage.Traverse() if p.IsA(UsdPhysics.Joint)}
+    from robotwright._usd_names import display_names
+    from robotwright.generators.usd_drives import joint_drives
+
+    shown = display_names(stage)
+    joints = {shown[str(p.GetPath())]: p for p in stage.Traverse() if p.IsA(UsdPhysics.Joint)}
     out.joint_prims = {name: str(p.GetPath()) for name, p in joints.items()}
-    for act in hrdf.actuators:
-        prim = joints.get(act.joint)
-        kind = kinds.get(act.joint)
-        if prim is None or kind is None:
+    drives, lost = joint_drives(model)
+    out.notes += lost
+    for name, d in drives.items():
+        prim = joints.get(name)
+        if prim is None:
             out.notes.append(
-                f"actuator {act.name or act.joint!r}: joint {act.joint!r} is not a hinge or "
-                "slide joint prim of the USD; no drive written"
+                f"actuator(s) {', '.join(map(repr, d.actuators))}: joint {name!r} has no joint "
+                "prim in the USD; no drive written"
             )
             continue
-        per = math.pi / 180.0 if kind == "angular" else 1.0  # USD angular units: degrees
-        stiffness = (act.p_gain or 0.0) * per
-        damping = (act.d_gain or 0.0) * per
-        if act.peak_torque is not None:
-            max_force = float(act.peak_torque)
-        elif act.force_range is not None:
-            max_force = float(max(abs(act.force_range[0]), abs(act.force_range[1])))
-        else:
-            max_force = math.inf
-        drive = UsdPhysics.DriveAPI.Apply(prim, kind)
+        per = math.pi / 180.0 if d.axis == "angular" else 1.0  # USD angular units: degrees
+        drive = UsdPhysics.DriveAPI.Apply(prim, d.axis)
         drive.CreateTypeAttr("force")
-        drive.CreateStiffnessAttr(stiffness)
-        drive.CreateDampingAttr(damping)
-        drive.CreateMaxForceAttr(max_force)
-        out.drives[act.joint] = (stiffness, damping, max_force)
-        if act.peak_velocity is not None:
-            v = float(act.peak_velocity)
-            shown = v * 180.0 / math.pi if kind == "angular" else v
-            prim.CreateAttribute("newton:velocityLimit", Sdf.ValueTypeNames.Float).Set(shown)
-            prim.CreateAttribute("physxJoint:maxJointVelocity", Sdf.ValueTypeNames.Float).Set(shown)
-            out.velocity_limits[act.joint] = v
+        drive.CreateStiffnessAttr(d.stiffness * per)
+        drive.CreateDampingAttr(d.damping * per)
+        drive.CreateMaxForceAttr(d.max_force)
+        out.drives[name] = (d.stiffness * per, d.damping * per, d.max_force)
+    kinds = {name: d.axis for name, d in drives.items()}
+    for act in hrdf.actuators:
+        prim, axis = joints.get(act.joint), kinds.get(act.joint)
+        if act.peak_velocity is None or prim is None or axis is None:
+            continue
+        v = float(act.peak_velocity)
+        value = v * 180.0 / math.pi if axis == "angular" else v
+        prim.CreateAttribute("newton:velocityLimit", Sdf.ValueTypeNames.Float).Set(value)
+        prim.CreateAttribute("physxJoint:maxJointVelocity", Sdf.ValueTypeNames.Float).Set(value)
+        out.velocity_limits[act.joint] = v
 
 
 def _author_free_joint_names(stage, model: mujoco.MjModel) -> None:
     from pxr import Sdf, UsdPhysics
 
-    bodies = {p.GetName(): p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)}
+    from robotwright._usd_names import display_names
+
+    shown = display_names(stage)
+    bodies = {
+        shown[str(p.GetPath())]: p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)
+    }
     for j in range(model.njnt):
         name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
         if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE or not name:
@@ -384,8 +372,8 @@ def to_usd(
                 f"{', ...' if len(hrdf.sensors) > 5 else ''}): mujoco-usd-converter writes no "
                 "sensors; add Isaac Lab sensors in the scene config"
             )
-        result.notes += _unheld_in_usd(model)
-        _author_drives(stage, hrdf, _joint_kinds(model), result)
+        result.notes += _keyframe_notes(model)
+        _author_drives(stage, hrdf, model, result)
         _author_free_joint_names(stage, model)
         flat = stage.Flatten()
         if layout == "flat":

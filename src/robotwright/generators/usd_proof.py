@@ -1,12 +1,15 @@
 """The proof of a USD export: Newton's USD importer reads the file back, and every body
 and joint is compared with MuJoCo's compile of our MJCF of the same robot.
 
-Compared, by body and joint name (the last element of Newton's prim-path labels): body
-masses, centres of mass and inertia tensors (body frame, about the centre of mass), joint
-types and ranges, drives (stiffness, damping, max force, velocity limit against the HRDF
-actuators), and forward kinematics: the world pose of every body at random joint
+Compared, by the names the robot gave its bodies and joints (a prim's ``displayName``
+where the converter renamed the prim; each axis of a D6 joint Newton merged from
+several prims is the joint of that prim): body masses, centres of mass and inertia
+tensors (body frame, about the centre of mass), joint types and ranges, each hinge and
+slide's drive against MuJoCo's compiled actuators (mode, stiffness, damping, max force;
+the rated velocity against the HRDF's ``peak_velocity``; a joint without an actuator has
+no drive), and forward kinematics: the world pose of every body at random joint
 positions (within the joint ranges) and, for a free base, a random base pose. Each
-difference is one line naming the body or joint, the field and both values.
+difference is one line naming the body, joint or actuator, the field and both values.
 
 Needs Newton (Isaac Lab's environment).
 """
@@ -21,7 +24,6 @@ import mujoco
 import numpy as np
 
 from robotwright._rotations import quat_to_mat
-from robotwright._usd_format import prim_name
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["UsdProof", "prove_usd"]
@@ -48,6 +50,12 @@ class UsdProof:
     max_pose_error: float = 0.0
 
 
+# MuJoCo's enums as plain ints: a numpy integer read from a model is not ``in`` a tuple
+# of enum members under every numpy and MuJoCo pairing we support.
+_HINGE_SLIDE = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
+_FREE = int(mujoco.mjtJoint.mjJNT_FREE)
+
+
 def _rel(a: float, b: float) -> float:
     return abs(a - b) / max(1.0, abs(a), abs(b))
 
@@ -67,6 +75,86 @@ def _quat_angle(wxyz_a: np.ndarray, wxyz_b: np.ndarray) -> float:
     return 2.0 * math.atan2(float(np.linalg.norm(rel[1:])), abs(float(rel[0])))
 
 
+def _joint_dofs(model, found: dict, stage, names: dict[str, str]) -> dict[str, tuple[int, int]]:
+    """Joint name -> (Newton joint, degree of freedom within it): a joint prim of its
+    own, or one axis of a D6 joint Newton merged from several prims."""
+    from robotwright._usd_names import joint_dof_prims, name_of
+
+    where: dict[str, tuple[int, int]] = {}
+    for i, prims in joint_dof_prims(found.get("path_joint_map", {}), stage).items():
+        for k, path in enumerate(prims):
+            where.setdefault(name_of(names, path), (i, k))
+    for i, label in enumerate(model.joint_label):  # a floating base has no joint prim
+        where.setdefault(name_of(names, label), (i, 0))
+    return where
+
+
+def _axis_in_child(model_axes, x_c, qd: int, k: int, i: int) -> np.ndarray:
+    """Axis ``k`` of Newton joint ``i`` in its child body's frame."""
+    x, y, z, w = (float(v) for v in x_c[i][3:])
+    out = np.empty(3)
+    mujoco.mju_rotVecQuat(out, model_axes[qd + k].astype(np.float64), np.array([w, x, y, z]))
+    return out
+
+
+def _by_axis(mj: mujoco.MjModel, model, where: dict[str, tuple[int, int]]) -> list[str]:
+    """Match the joints Newton merged into one D6 joint to its axes by direction, in
+    place: each MuJoCo joint gets the axis (of its kind) nearest its own, both in the
+    child body's frame. Returns a line for each body whose hinges Newton turns in
+    another order than MuJoCo (rotations do not commute: the body's pose differs)."""
+    axes, x_c = model.joint_axis.numpy(), model.joint_X_c.numpy()
+    dof_dim, qd_start = model.joint_dof_dim.numpy(), model.joint_qd_start.numpy()
+    merged: dict[int, list[int]] = {}
+    for j in range(mj.njnt):
+        at = where.get(mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_JOINT, j) or "")
+        if at is not None and int(dof_dim[at[0]].sum()) > 1 and int(mj.jnt_type[j]) in _HINGE_SLIDE:
+            merged.setdefault(at[0], []).append(j)
+    out = []
+    for i, joints in merged.items():
+        lin = int(dof_dim[i][0])
+        pools = {True: set(range(lin)), False: set(range(lin, int(dof_dim[i].sum())))}
+        turns: list[tuple[int, str]] = []  # (Newton's axis, joint) of the hinges
+        for j in joints:
+            name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_JOINT, j)
+            slide = int(mj.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_SLIDE)
+            pool = pools[slide]
+            if not pool:
+                continue
+            own = np.asarray(mj.jnt_axis[j], dtype=np.float64)
+            k = max(
+                sorted(pool),
+                key=lambda k: abs(float(_axis_in_child(axes, x_c, qd_start[i], k, i) @ own)),
+            )
+            pool.discard(k)
+            where[name] = (i, k)
+            if not slide:
+                turns.append((k, name))
+        if [n for _, n in sorted(turns)] != [n for _, n in turns]:
+            body = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_BODY, int(mj.jnt_bodyid[joints[0]]))
+            out.append(
+                f"body {body!r}: Newton reads its hinges {', '.join(repr(n) for _, n in turns)} "
+                f"as one D6 joint turning them in the order "
+                f"{', '.join(repr(n) for _, n in sorted(turns))}; MuJoCo turns them in the "
+                "order written, so the body's pose differs wherever two of them are not zero"
+            )
+    return out
+
+
+def _same_kind(mj_type: int, newton_type: int, k: int, dof_dim: tuple[int, int], JT) -> bool:
+    """Whether MuJoCo joint type ``mj_type`` is degree of freedom ``k`` of a Newton
+    joint of ``newton_type`` (a D6's linear axes come first, then its angular ones)."""
+    hinge, slide = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
+    if newton_type == int(JT.D6):
+        return (mj_type == slide and k < dof_dim[0]) or (mj_type == hinge and k >= dof_dim[0])
+    single = {
+        hinge: int(JT.REVOLUTE),
+        slide: int(JT.PRISMATIC),
+        int(mujoco.mjtJoint.mjJNT_FREE): int(JT.FREE),
+        int(mujoco.mjtJoint.mjJNT_BALL): int(JT.BALL),
+    }
+    return k == 0 and single.get(mj_type) == newton_type
+
+
 def prove_usd(
     usd: str | Path,
     mjcf_model: mujoco.MjModel,
@@ -78,28 +166,43 @@ def prove_usd(
 ) -> UsdProof:
     """Compare the USD file ``usd`` (read by Newton) with ``mjcf_model``.
 
+    Bodies and joints are matched by the names the robot gave them (a prim's
+    ``displayName`` where the converter had to rename the prim); MuJoCo's several
+    hinges or slides on one body are matched to the axes of the D6 joint Newton makes of
+    them. Each hinge and slide joint's drive is compared with the one MuJoCo's
+    actuators define (:func:`~robotwright.generators.usd_drives.joint_drives`): a joint
+    no actuator drives must have none.
+
     Args:
         usd: the exported file.
         mjcf_model: MuJoCo's compile of our MJCF of the robot (no scene).
-        hrdf: the robot, for the drives (``None``: drives are not compared).
+        hrdf: the robot, for the rated joint velocities (``peak_velocity``), which MJCF
+            cannot hold (``None``: not compared).
         poses: random joint configurations compared by forward kinematics.
-        tol: relative tolerance of masses/inertias, absolute of positions [m], angles [rad].
+        tol: relative tolerance of masses/inertias and drives, absolute of positions
+            [m] and angles [rad].
         seed: seed of the random poses.
     """
+    from pxr import Usd
+
+    from robotwright._usd_names import display_names, name_of
     from robotwright._warp import quiet_warp
+    from robotwright.generators.usd_drives import joint_drives
 
     wp = quiet_warp()  # before Newton initialises warp
     import newton
 
     builder = newton.ModelBuilder()
-    builder.add_usd(str(usd))
+    found = builder.add_usd(str(usd)) or {}
     model = builder.finalize(device="cpu")
+    stage = Usd.Stage.Open(str(usd))
+    names = display_names(stage)
     proof = UsdProof()
     diff = proof.differences
     mj = mjcf_model
 
     # -- bodies ---------------------------------------------------------------------
-    nb = {prim_name(lb): i for i, lb in enumerate(model.body_label)}
+    nb = {name_of(names, lb): i for i, lb in enumerate(model.body_label)}
     mass = model.body_mass.numpy()
     com = model.body_com.numpy()
     inertia = model.body_inertia.numpy()
@@ -128,37 +231,37 @@ def prove_usd(
         diff.append(f"body {name!r}: in the USD, not in the MJCF")
 
     # -- joints ---------------------------------------------------------------------
-    nj = {prim_name(lb): i for i, lb in enumerate(model.joint_label)}
+    JT = newton.JointType
+    where = _joint_dofs(model, found, stage, names)
+    diff += _by_axis(mj, model, where)
     q_start = model.joint_q_start.numpy()
     qd_start = model.joint_qd_start.numpy()
     jtype = model.joint_type.numpy()
+    dof_dim = model.joint_dof_dim.numpy()
     lower = model.joint_limit_lower.numpy()
     upper = model.joint_limit_upper.numpy()
-    kinds = {
-        int(mujoco.mjtJoint.mjJNT_HINGE): int(newton.JointType.REVOLUTE),
-        int(mujoco.mjtJoint.mjJNT_SLIDE): int(newton.JointType.PRISMATIC),
-        int(mujoco.mjtJoint.mjJNT_FREE): int(newton.JointType.FREE),
-        int(mujoco.mjtJoint.mjJNT_BALL): int(newton.JointType.BALL),
-    }
-    matched: dict[int, int] = {}
+    matched: dict[int, tuple[int, int]] = {}  # MuJoCo joint -> (q index, dof index)
     for j in range(mj.njnt):
         name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint{j}"
-        i = nj.get(name)
-        if i is None and mj.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
-            free = [k for k in range(model.joint_count) if jtype[k] == int(newton.JointType.FREE)]
-            i = free[0] if len(free) == 1 else None
-        if i is None:
+        at = where.get(name)
+        if at is None and int(mj.jnt_type[j]) == _FREE:
+            free = [k for k in range(model.joint_count) if jtype[k] == int(JT.FREE)]
+            at = (free[0], 0) if len(free) == 1 else None
+        if at is None:
             diff.append(f"joint {name!r}: not in the USD")
             continue
+        i, k = at
         proof.joints += 1
-        matched[j] = i
-        if kinds.get(int(mj.jnt_type[j])) != int(jtype[i]):
+        dims = (int(dof_dim[i][0]), int(dof_dim[i][1]))
+        if not _same_kind(int(mj.jnt_type[j]), int(jtype[i]), k, dims, JT):
             diff.append(
-                f"joint {name!r}: type {mj.jnt_type[j]} in MJCF, Newton type {jtype[i]} in USD"
+                f"joint {name!r}: type {mujoco.mjtJoint(int(mj.jnt_type[j])).name} in MJCF, "
+                f"Newton {JT(int(jtype[i])).name} (axis {k}) in USD"
             )
             continue
-        if mj.jnt_type[j] in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
-            d = qd_start[i]
+        matched[j] = (int(q_start[i]) + k, int(qd_start[i]) + k)
+        if int(mj.jnt_type[j]) in _HINGE_SLIDE:
+            d = matched[j][1]
             if mj.jnt_limited[j]:
                 lo, hi = mj.jnt_range[j]
                 if abs(lo - lower[d]) > tol or abs(hi - upper[d]) > tol:
@@ -167,55 +270,67 @@ def prove_usd(
                         f"[{lower[d]:.9g}, {upper[d]:.9g}] in USD"
                     )
 
-    # -- drives ---------------------------------------------------------------------
-    if hrdf is not None:
-        ke, kd = model.joint_target_ke.numpy(), model.joint_target_kd.numpy()
-        effort, vel = model.joint_effort_limit.numpy(), model.joint_velocity_limit.numpy()
-        for act in hrdf.actuators:
-            i = nj.get(act.joint)
-            if i is None:
+    # -- drives: every hinge and slide, against MuJoCo's actuators --------------------
+    drives, _ = joint_drives(mj)  # what no drive holds is a note of the export
+    rated = {a.joint: a.peak_velocity for a in (hrdf.actuators if hrdf is not None else ())}
+    ke, kd = model.joint_target_ke.numpy(), model.joint_target_kd.numpy()
+    effort, vel = model.joint_effort_limit.numpy(), model.joint_velocity_limit.numpy()
+    mode = model.joint_target_mode.numpy() if model.joint_target_mode is not None else None
+    modes = newton.JointTargetMode
+    for j, (_, d) in matched.items():
+        if int(mj.jnt_type[j]) not in _HINGE_SLIDE:
+            continue
+        name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint{j}"
+        got_mode = modes(int(mode[d])) if mode is not None else None
+        want = drives.get(name)
+        if want is None:
+            if ke[d] != 0 or kd[d] != 0 or got_mode not in (None, modes.NONE):
+                diff.append(
+                    f"joint {name!r}: no actuator in MJCF, a drive in USD (stiffness "
+                    f"{ke[d]:.9g}, damping {kd[d]:.9g}, mode {got_mode.name if got_mode else '?'})"
+                )
+            continue
+        proof.drives += 1
+        who = f"joint {name!r} ({' + '.join(want.kinds)} actuator {', '.join(map(repr, want.actuators))})"  # fmt: skip
+        if want.stiffness:
+            kinds = (modes.POSITION, modes.POSITION_VELOCITY)
+        elif want.damping:
+            kinds = (modes.VELOCITY,)
+        else:
+            kinds = (modes.EFFORT,)
+        if got_mode is not None and got_mode not in kinds:
+            diff.append(f"{who}: drive mode {got_mode.name} in USD, expected {kinds[0].name}")
+        checks = {
+            "stiffness": (want.stiffness, float(ke[d])),
+            "damping": (want.damping, float(kd[d])),
+            "max force": (want.max_force, float(effort[d])),
+        }
+        if rated.get(name) is not None:
+            checks["velocity limit"] = (float(rated[name]), float(vel[d]))
+        for key, (w, g) in checks.items():
+            if math.isinf(w) and math.isinf(g):
                 continue
-            d = qd_start[i]
-            proof.drives += 1
-            want = {
-                "stiffness": act.p_gain or 0.0,
-                "damping": act.d_gain or 0.0,
-                "max force": act.peak_torque
-                if act.peak_torque is not None
-                else (max(abs(v) for v in act.force_range) if act.force_range else math.inf),
-                "velocity limit": act.peak_velocity,
-            }
-            got = {
-                "stiffness": ke[d],
-                "damping": kd[d],
-                "max force": effort[d],
-                "velocity limit": vel[d],
-            }
-            for key, w in want.items():
-                if w is None or (math.isinf(w) and math.isinf(got[key])):
-                    continue
-                if _rel(float(w), float(got[key])) > max(tol, 1e-6):
-                    diff.append(
-                        f"joint {act.joint!r}: drive {key} {w:.9g} in HRDF, {got[key]:.9g} in USD"
-                    )
+            if _rel(w, g) > max(tol, 1e-6):
+                diff.append(f"{who}: drive {key} {w:.9g} in MJCF, {g:.9g} in USD")
 
     # -- forward kinematics at random poses -----------------------------------------
     rng = np.random.default_rng(seed)
     data = mujoco.MjData(mj)
     state = model.state()
+    worst: dict[str, tuple[float, float, int]] = {}  # body -> (metres, radians, poses)
     for _ in range(poses):
         qpos = mj.qpos0.copy()
         joint_q = model.joint_q.numpy().copy()
-        for j, i in matched.items():
-            a, s = mj.jnt_qposadr[j], q_start[i]
-            t = mj.jnt_type[j]
-            if t == mujoco.mjtJoint.mjJNT_FREE:
+        for j, (s, _) in matched.items():
+            a = mj.jnt_qposadr[j]
+            t = int(mj.jnt_type[j])
+            if t == _FREE:
                 pos = rng.uniform(-1.0, 1.0, 3)
                 quat = rng.normal(size=4)
                 quat /= np.linalg.norm(quat)  # w, x, y, z
                 qpos[a : a + 7] = [*pos, *quat]
                 joint_q[s : s + 7] = [*pos, quat[1], quat[2], quat[3], quat[0]]
-            elif t in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+            elif t in _HINGE_SLIDE:
                 lo, hi = mj.jnt_range[j] if mj.jnt_limited[j] else (-math.pi, math.pi)
                 v = rng.uniform(lo, hi)
                 qpos[a] = v
@@ -240,9 +355,11 @@ def prove_usd(
             x, y, z, w = body_q[i][3:]
             ang = _quat_angle(data.xquat[b], np.array([w, x, y, z]))
             if err > max(tol, 2e-6) or ang > max(tol, 2e-6):
-                diff.append(
-                    f"body {name!r}: world pose differs by {err:.3g} m, {ang:.3g} rad at a "
-                    "random configuration"
-                )
-                break
+                m, r, n = worst.get(name, (0.0, 0.0, 0))
+                worst[name] = (max(m, err), max(r, ang), n + 1)
+    for name, (m, r, n) in worst.items():
+        diff.append(
+            f"body {name!r}: world pose differs by up to {m:.3g} m, {r:.3g} rad (at {n} of "
+            f"{proof.poses} random configurations)"
+        )
     return proof

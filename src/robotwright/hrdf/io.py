@@ -156,7 +156,7 @@ def collect_hrdf_dir(
         floating = False
     root_name = None
     roots = [b for b in bodies if b is not None and b.parent == -1]
-    if len(roots) == 1:
+    if roots:  # a scene's first root is the one meta.yaml's floating_base is of
         root_name = roots[0].name
     if floating and root_name is not None:
         joints.insert(

@@ -578,11 +578,28 @@ class HRDF:
     # -- queries ------------------------------------------------------------------------
     @property
     def root_index(self) -> int:
-        """Index of the root body (parent -1)."""
+        """Index of the root body (parent -1): the first one where a scene holds several
+        (a robot and its objects: see :attr:`root_indices`)."""
         for i, body in enumerate(self.bodies):
             if body.parent == -1:
                 return i
         raise ValueError(f"robot '{self.name}' has no root body")
+
+    @property
+    def root_indices(self) -> list[int]:
+        """Indices of every root body (parent -1), in table order: one for a robot, one
+        per top-level body for a scene read whole (each fixed in the world or free)."""
+        return [i for i, body in enumerate(self.bodies) if body.parent == -1]
+
+    @property
+    def base_joint(self) -> Joint | None:
+        """The free joint of the (first) root body, which ``meta.yaml`` holds as
+        ``floating_base``; None for a fixed base. Other roots' free joints are rows of
+        ``joint.csv``."""
+        if not self.bodies or not any(b.parent == -1 for b in self.bodies):
+            return None
+        root = self.root_body.name
+        return next((j for j in self.joints if j.type == "free" and j.body == root), None)
 
     @property
     def root_body(self) -> Body:
@@ -595,9 +612,8 @@ class HRDF:
 
     @property
     def floating_base(self) -> bool:
-        """True when the root body carries a free joint."""
-        root = self.root_body.name
-        return any(j.type == "free" and j.body == root for j in self.joints)
+        """True when the (first) root body carries a free joint."""
+        return self.base_joint is not None
 
     @property
     def total_mass(self) -> float:

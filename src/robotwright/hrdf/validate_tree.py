@@ -31,16 +31,7 @@ def _check_tree(hrdf: HRDF) -> list[Problem]:
     roots = [i for i, b in enumerate(hrdf.bodies) if b.parent == -1]
     if not roots:
         out.append(
-            Problem("meta.yaml", "no root body: expected one entry -1", column="body_parent_id")
-        )
-    elif len(roots) > 1:
-        names = [hrdf.bodies[i].name for i in roots]
-        out.append(
-            Problem(
-                "meta.yaml",
-                f"several root bodies {names}: expected exactly one entry -1",
-                column="body_parent_id",
-            )
+            Problem("meta.yaml", "no root body: expected at least one entry -1", column="body_parent_id")
         )
     bad_parent = False
     for i, b in enumerate(hrdf.bodies):
@@ -201,17 +192,17 @@ def _carries_mass(hrdf: HRDF, index: int, moving: set[str]) -> bool:
 
 def _check_joints(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
     out: list[Problem] = []
-    root = hrdf.bodies[hrdf.root_index].name if any(b.parent == -1 for b in hrdf.bodies) else None
+    roots = {hrdf.bodies[i].name for i in hrdf.root_indices}
     for name in sorted(_duplicates(j.name for j in hrdf.joints)):
         out.append(Problem("joint.csv", f"duplicate joint name '{name}'", column="name"))
     row = -1
     for j in hrdf.joints:
         if j.type == "free":
-            if j.body != root:
+            if j.body not in roots:
                 out.append(
                     Problem(
                         "joint.csv",
-                        f"free joint '{j.name}' on body '{j.body}': only the root body may float",
+                        f"free joint '{j.name}' on body '{j.body}': only a root body may float",
                         column="type",
                     )
                 )
@@ -255,7 +246,7 @@ def _check_joints(hrdf: HRDF, body_names: set[str]) -> list[Problem]:
             out.append(
                 Problem("joint.csv", f"unknown body '{j.body}'", row=row, column="body_name")
             )
-        elif j.body == root and j.type != "free":
+        elif j.body in roots and j.type != "free":
             pass  # a joint on the root is allowed (e.g. a slide rail base)
         if j.type in ("hinge", "slide"):
             norm = math.sqrt(sum(v * v for v in j.axis))

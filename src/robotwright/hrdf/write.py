@@ -31,12 +31,13 @@ from robotwright.hrdf.tables import (
 
 
 def table_rows(hrdf: HRDF, stem: str) -> list[Any]:
-    """The records of table ``stem`` in CSV row order (``joint``: the free joint is in
-    ``meta.yaml``, not a row)."""
+    """The records of table ``stem`` in CSV row order (``joint``: the root's free joint
+    is in ``meta.yaml``, not a row; another root's, in a scene, is a row)."""
     if stem == "body":
         return list(hrdf.bodies)
     if stem == "joint":
-        return [j for j in hrdf.joints if j.type != "free"]
+        base = hrdf.base_joint
+        return [j for j in hrdf.joints if j is not base]
     return list(
         {
             "actuator": hrdf.actuators,
@@ -144,7 +145,7 @@ def meta_dict(hrdf: HRDF) -> dict[str, Any]:
         ]
     out["format_version"] = FORMAT_VERSION
     out["floating_base"] = hrdf.floating_base
-    free = [j for j in hrdf.joints if j.type == "free"]
+    free = [hrdf.base_joint] if hrdf.base_joint is not None else []
     if free and free[0].name is not None:
         out["base_joint_name"] = free[0].name
     if free:

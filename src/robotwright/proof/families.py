@@ -54,15 +54,18 @@ def _contacts(src: _Side, res: _Side, maps: dict[str, dict[int, int]]) -> list[D
             f"contact pair of {_object_text(src, 'geom', g1)} and {_object_text(src, 'geom', g2)}"
         )
 
-    theirs = {}
+    # A file may name the same two geoms in several pairs (OpenAI's Shadow hand does):
+    # each is a pair of its own, matched to the result's in the order both are listed.
+    theirs: dict[frozenset, list[int]] = {}
     for p in range(r.npair):
         key = (geoms.get(int(r.pair_geom1[p]), -1), geoms.get(int(r.pair_geom2[p]), -1))
-        theirs.setdefault(frozenset(key), p)
+        theirs.setdefault(frozenset(key), []).append(p)
     for p in range(s.npair):
         g1, g2 = int(s.pair_geom1[p]), int(s.pair_geom2[p])
         text = pair_text(g1, g2)
         labels = (*_labels(src, "geom", g1), *_labels(src, "geom", g2), "pair")
-        q = theirs.pop(frozenset((g1, g2)), None)
+        listed = theirs.get(frozenset((g1, g2)))
+        q = listed.pop(0) if listed else None
         if q is None:
             out.append(Difference("(object)", "pair", text, "present", "absent", labels))
             continue
@@ -70,7 +73,7 @@ def _contacts(src: _Side, res: _Side, maps: dict[str, dict[int, int]]) -> list[D
             a, b = getattr(s, field)[p], getattr(r, field)[q]
             if not _same_values(a, b):
                 out.append(Difference(field, "pair", text, _fmt(a), _fmt(b), labels))
-    for q in theirs.values():
+    for q in sorted(q for listed in theirs.values() for q in listed):
         out.append(
             Difference(
                 "(object)", "pair", f"contact pair #{q} of the result", "absent", "present", ()

@@ -184,6 +184,15 @@ def _hrdf_tree(robot: H.HRDF) -> tuple[Body, list[Problem]]:
             sensor = S.SENSOR_CLASSES[_IMU_SENSORS[value]](f"{name}_{value}")
             sensor.extras["hrdf_imu"] = True
             sites[name].attach(sensor)
+    for extra in robot.root_indices[1:]:
+        problems.append(
+            Problem(
+                "meta.yaml",
+                f"body '{robot.bodies[extra].name}' is another root of the scene: a Things "
+                "tree holds one robot, so it and its subtree are dropped",
+                column="body_parent_id",
+            )
+        )
     named: dict[tuple[str, str], BaseThing] = {}
     for thing in bodies[robot.root_index].walk():
         if thing._NAMESPACE and thing._name:

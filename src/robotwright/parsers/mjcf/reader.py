@@ -144,15 +144,15 @@ def _from_compiled(
 ) -> ParseResult:
     """The HRDF of a compiled spec (the body of :func:`parse_mjcf`; ``sub_dirs``: the
     folders of its sub-models, from the containment check)."""
-    root_id, keep = _select_robot(model, path, opt, rep)
+    roots, keep = _select_robot(model, path, opt, rep)
     kept = set(keep)
-    frames = _frames_as_sites(model, keep, root_id, opt)
-    bodies = _bodies(model, keep, root_id, frames, rep)
-    joints = _joints(model, kept, root_id, path, rep)
+    frames = _frames_as_sites(model, keep, roots, opt)
+    bodies = _bodies(model, keep, roots, frames, rep)
+    joints = _joints(model, kept, roots, path, rep)
     store = mesh_store(opt.work_dir, opt.join_obj_objects)
     trusted = trusted_roots(opt.asset_roots)
     meshes, simple = _geoms(model, spec, kept, path, store, frames, rep, sub_dirs or [], trusted)
-    sites = _sites(model, kept, frames, root_id, rep)
+    sites = _sites(model, kept, frames, roots, rep)
     names = {
         "joint": {j.name for j in joints if j.name},
         "tendon": {model.tendon(t).name for t in range(model.ntendon) if model.tendon(t).name},

@@ -102,8 +102,10 @@ def _keyframes(
 
 def _select_robot(
     model: mujoco.MjModel, path: Path, opt: MJCFOptions, rep: Reporter
-) -> tuple[int, list[int]]:
-    """The robot's root body id and its subtree's body ids (model order)."""
+) -> tuple[list[int], list[int]]:
+    """The root body ids and the body ids they hold (model order): the subtree of
+    ``root_body`` when one is named, else every top-level body of the world (a scene:
+    a robot and its objects, or several robots, each a root of the HRDF)."""
     top = [i for i in range(1, model.nbody) if model.body_parentid[i] == 0]
     if opt.root_body is not None:
         # By the name the refusal lists: an unnamed body is 'body_<id>'.
@@ -113,34 +115,22 @@ def _select_robot(
             raise ConversionError(
                 [Problem(str(path), f"root_body '{opt.root_body}' is not a top-level body {names}")]
             )
-        root_id = ids[0]
-    elif len(top) == 1:
-        root_id = top[0]
+        roots = ids[:1]
     elif not top:
         raise ConversionError(
             [Problem(str(path), "the world holds no bodies: no robot to convert")]
         )
     else:
-        names = [body_name(model, i) for i in top]
-        raise ConversionError(
-            [
-                Problem(
-                    str(path),
-                    f"the world holds {len(top)} top-level bodies {names}: an HRDF is one "
-                    "robot; choose one with root_body=<name> (command line: --root-body NAME)",
-                )
-            ]
-        )
+        roots = top
     for i in top:
-        if i != root_id:
+        if i not in roots:
             rep.warn(
-                f"top-level body '{body_name(model, i)}' and its subtree dropped (not the robot)"
+                f"top-level body '{body_name(model, i)}' and its subtree dropped (not the "
+                "robot: root_body names another)"
             )
-    keep = [root_id]
-    for i in range(root_id + 1, model.nbody):
-        if model.body_rootid[i] == root_id:
-            keep.append(i)
-    return root_id, keep
+    chosen = set(roots)
+    keep = [i for i in range(1, model.nbody) if int(model.body_rootid[i]) in chosen]
+    return roots, keep
 
 
 def _named_bodies(model: mujoco.MjModel) -> set[int]:
@@ -166,17 +156,17 @@ def _named_bodies(model: mujoco.MjModel) -> set[int]:
 
 
 def _frames_as_sites(
-    model: mujoco.MjModel, keep: list[int], root_id: int, opt: MJCFOptions
+    model: mujoco.MjModel, keep: list[int], roots: list[int], opt: MJCFOptions
 ) -> set[int]:
     """Bodies that become sites under ``massless_frames="site"``."""
     if opt.massless_frames != "site":
         return set()
-    parents = {int(model.body_parentid[b]) for b in keep if b != root_id}
+    parents = {int(model.body_parentid[b]) for b in keep if b not in roots}
     named = _named_bodies(model)
     return {
         b
         for b in keep
-        if b != root_id
+        if b not in roots
         and model.body_mass[b] == 0
         and model.body_jntnum[b] == 0
         and b not in parents
@@ -185,7 +175,7 @@ def _frames_as_sites(
 
 
 def _bodies(
-    model: mujoco.MjModel, keep: list[int], root_id: int, frames: set[int], rep: Reporter
+    model: mujoco.MjModel, keep: list[int], roots: list[int], frames: set[int], rep: Reporter
 ) -> list[Body]:
     """Body records, frames and inertias as compiled (``frames`` are left out)."""
     bodies_ids = [b for b in keep if b not in frames]
@@ -199,7 +189,7 @@ def _bodies(
         bodies.append(
             Body(
                 name=body_name(model, b),
-                parent=-1 if b == root_id else index[int(model.body_parentid[b])],
+                parent=-1 if b in roots else index[int(model.body_parentid[b])],
                 pos=_t3(model.body_pos[b]),
                 quat=_t4(model.body_quat[b]),
                 mass=float(model.body_mass[b]),
@@ -215,7 +205,7 @@ def _bodies(
 
 
 def _joints(
-    model: mujoco.MjModel, kept: set[int], root_id: int, path: Path, rep: Reporter
+    model: mujoco.MjModel, kept: set[int], roots: list[int], path: Path, rep: Reporter
 ) -> list[Joint]:
     """Joint records; fields HRDF has no column for are reported once per field."""
     joints: list[Joint] = []
@@ -227,12 +217,12 @@ def _joints(
         jt = _JOINT[int(model.jnt_type[j])]
         name = model.joint(j).name or None
         where = f'<joint name="{name}">' if name else f"joint #{j}"
-        if jt == "free" and b != root_id:
+        if jt == "free" and b not in roots:
             raise ConversionError(
                 [
                     Problem(
                         str(path),
-                        "free joint below the root: HRDF allows one on the root only",
+                        "free joint below a root: HRDF allows one on a root body only",
                         element=where,
                     )
                 ]
@@ -311,7 +301,7 @@ def _routing_sites(model: mujoco.MjModel) -> set[int]:
 
 
 def _sites(
-    model: mujoco.MjModel, kept: set[int], frames: set[int], root_id: int, rep: Reporter
+    model: mujoco.MjModel, kept: set[int], frames: set[int], roots: list[int], rep: Reporter
 ) -> list[Site]:
     """Sites of the robot's bodies, and one per frame body turned into a site. A site of
     the world (an IMU frame, a muscle origin) stays a site of the world (``body`` is
@@ -319,6 +309,7 @@ def _sites(
     the world: that one is kept on the root body (the same place, as it never moves)."""
     sites: list[Site] = []
     routing = _routing_sites(model) if model.site_bodyid.size else set()
+    root_id = roots[0]
     fixed_root = int(model.body_jntnum[root_id]) == 0 and model.body_parentid[root_id] == 0
     for s in range(model.nsite):
         b = int(model.site_bodyid[s])
