@@ -31,7 +31,9 @@ def _check_tree(hrdf: HRDF) -> list[Problem]:
     roots = [i for i, b in enumerate(hrdf.bodies) if b.parent == -1]
     if not roots:
         out.append(
-            Problem("meta.yaml", "no root body: expected at least one entry -1", column="body_parent_id")
+            Problem(
+                "meta.yaml", "no root body: expected at least one entry -1", column="body_parent_id"
+            )
         )
     bad_parent = False
     for i, b in enumerate(hrdf.bodies):
