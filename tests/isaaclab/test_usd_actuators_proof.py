@@ -130,11 +130,15 @@ def test_humanoid_multi_hinge_bodies_are_matched_axis_by_axis(tmp_path):
     # Every hinge is found (none "not in the USD"), as an axis of Newton's D6 joints.
     assert proof.joints == src.njnt and proof.drives == src.nu == 17
     assert not any("not in the USD" in d or "type" in d for d in proof.differences)
-    # Gear 100 on a ctrlrange of 0.4: each motor's effort limit is 40 N m, read back so.
+    # Each motor's effort limit is its gear times its control bound (25-300 x 0.4 N m),
+    # read back so; the free base's six axes keep Newton's default.
     assert not any("drive" in d for d in proof.differences)
     model, _ = _newton(tmp_path / "h.usda")
-    limits = model.joint_effort_limit.numpy()
-    assert np.isclose(limits, 40.0).sum() == 17
+    limits = sorted(float(v) for v in model.joint_effort_limit.numpy() if v < 1e5)
+    want = sorted(
+        float(src.actuator_gear[a, 0] * abs(src.actuator_ctrlrange[a]).max()) for a in range(src.nu)
+    )
+    assert len(set(want)) > 1 and np.allclose(limits, want, rtol=1e-6)
     # Newton turns a merged joint's hinges in its own order: the proof names each body
     # where that order is not MuJoCo's, and the poses that follow differ.
     order = [d for d in proof.differences if "as one D6 joint turning them" in d]
@@ -147,3 +151,26 @@ def test_humanoid_multi_hinge_bodies_are_matched_axis_by_axis(tmp_path):
     assert not any("as one D6 joint" in d for d in sorted_done.proof.differences)
     assert sorted_done.proof.max_pose_error < 1e-4
     assert math.isfinite(sorted_done.proof.max_pose_error)
+
+
+def test_renamed_prims_and_merged_joints_read_back_under_the_source_names(tmp_path):
+    """USD in (issue 40, item 3): the hand's renamed prims read back as ``robot0:...``,
+    the humanoid's merged hinges as their own joints (not ``lwaist_0``, ``lwaist_1``),
+    each actuator on its joint."""
+    from robotwright.parsers.api import usd_to_hrdf_with_warnings
+
+    source = _need(HAND_ASSETS / "hand" / "reach.xml")
+    hand = load_robot(str(source), asset_roots=[HAND_ASSETS], root_body="robot0:hand mount")
+    to_usd(hand, tmp_path / "hand.usda")
+    back, _ = usd_to_hrdf_with_warnings(tmp_path / "hand.usda")
+    assert sorted(b.name for b in back.bodies) == sorted(b.name for b in hand.bodies)
+    assert sorted(a.joint for a in back.actuators) == sorted(a.joint for a in hand.actuators)
+    humanoid = load_robot(str(_need(HUMANOID)))
+    to_usd(humanoid, tmp_path / "h.usda")
+    back, _ = usd_to_hrdf_with_warnings(tmp_path / "h.usda")
+    assert sorted(j.name for j in back.joints) == sorted(j.name for j in humanoid.joints)
+    assert sorted(a.joint for a in back.actuators) == sorted(a.joint for a in humanoid.actuators)
+    # Read in Newton's order (the order it turns them in), each hinge on its own axis.
+    waist = [(j.name, j.axis) for j in back.joints if j.body == "lwaist"]
+    assert [n for n, _ in waist] == ["abdomen_y", "abdomen_z"]
+    assert np.allclose([a for _, a in waist], [(0, 1, 0), (0, 0, 1)], atol=1e-6)

@@ -49,6 +49,7 @@ from robotwright._paths import check_regular
 from robotwright._rotations import compose_pose
 from robotwright._temporaries import prefix
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES, prim_name
+from robotwright._usd_names import display_names, joint_dof_prims, name_of
 from robotwright.errors import ConversionError, InputFileError, Problem, UnsafePathError
 from robotwright.parsers.report import ParseResult, Reporter
 
@@ -166,14 +167,17 @@ def check_usd_dependencies(path: Path, roots: list[Path]) -> None:
 
 
 class _Names:
-    """Unique MJCF names per kind from prim names (a repeat gets ``_2``, ``_3``...)."""
+    """Unique MJCF names per kind from the names prims show (their ``displayName``
+    where one is authored, as converters keep a name a prim cannot have, else the prim's
+    name; a repeat gets ``_2``, ``_3``...)."""
 
-    def __init__(self) -> None:
+    def __init__(self, shown: dict[str, str] | None = None) -> None:
+        self.shown = shown or {}
         self.used: dict[str, Counter[str]] = {}
         self.renamed: dict[str, list[tuple[str, str]]] = {}
 
     def __call__(self, kind: str, label: str) -> str:
-        base = prim_name(label) or kind
+        base = name_of(self.shown, label) or kind
         used = self.used.setdefault(kind, Counter())
         used[base] += 1
         if used[base] == 1:
@@ -193,7 +197,7 @@ class _Names:
             if kind in ("body", "joint", "actuator"):
                 for label, name in pairs:
                     rep.warn(
-                        f"{kind} name {shown(prim_name(label))} is used by several prims; {label} "
+                        f"{kind} name {shown(name_of(self.shown, label))} is used by several prims; {label} "
                         f"becomes {shown(name)}"
                     )
             elif kind != "mesh":
@@ -226,11 +230,16 @@ def _rotate(quat: np.ndarray, v: Any) -> np.ndarray:
 class _Builder:
     """Newton's builder of one USD file -> an MjSpec (bodies, joints, geoms, sites)."""
 
-    def __init__(self, newton: Any, nb: Any, stage: Any, rep: Reporter, mesh_dir: Path) -> None:
+    def __init__(
+        self, newton: Any, nb: Any, stage: Any, rep: Reporter, mesh_dir: Path, found: dict
+    ) -> None:
         self.newton, self.nb, self.stage, self.rep, self.mesh_dir = newton, nb, stage, rep, mesh_dir
         self.order = {str(p.GetPath()): i for i, p in enumerate(stage.Traverse())}
         self.unread: Counter[str] = Counter()
-        self.names = _Names()
+        self.names = _Names(display_names(stage))
+        # Newton joint -> the prim of each of its axes (a D6 merged from several prims).
+        self.dof_prims = joint_dof_prims(found.get("path_joint_map", {}), stage)
+        self.prim_joint: dict[str, str] = {}  # joint prim -> MJCF joint
         self.spec = mujoco.MjSpec()
         self.spec.compiler.autolimits = True
         self.spec.compiler.degree = False  # Newton gives radians
@@ -328,9 +337,16 @@ class _Builder:
                     )
                 ]
             )
+        prims = self.dof_prims.get(j, [])
         for k, kind in enumerate(kinds):
             d = d0 + k
-            name = self.names("joint", label if len(kinds) == 1 else f"{prim_name(label)}_{k}")
+            if len(kinds) == 1:
+                name = self.names("joint", label)
+            elif len(prims) == len(kinds):  # each axis after the prim it was authored on
+                name = self.names("joint", prims[k])
+                self.prim_joint[prims[k]] = name
+            else:  # one multi-axis prim: its axes numbered
+                name = self.names("joint", f"{name_of(self.names.shown, label)}_{k}")
             self.joint_names.setdefault(j, name)
             joint = body.add_joint(name=name, type=kind, pos=anchor[0])
             if kind != mujoco.mjtJoint.mjJNT_BALL:
@@ -529,10 +545,10 @@ def _attr(prim: Any, name: str) -> Any:
 
 def _actuators(stage: Any, b: _Builder, rep: Reporter) -> list[str]:
     """``MjcActuator`` prims -> MjSpec actuators, in prim order; the names written."""
-    joints = {}
+    joints = dict(b.prim_joint)  # the axes of merged joints, by their own prims
     for j, label in enumerate(b.nb.joint_label):
         if j in b.joint_names:
-            joints[label] = b.joint_names[j]
+            joints.setdefault(label, b.joint_names[j])
     names = []
     for prim in stage.Traverse():
         if prim.GetTypeName() != "MjcActuator":
@@ -621,7 +637,7 @@ def parse_usd(
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            nb.add_usd(str(path), skip_mesh_approximation=True)  # the meshes as authored
+            found = nb.add_usd(str(path), skip_mesh_approximation=True) or {}  # meshes as authored
     except Exception as exc:  # noqa: BLE001 - Newton's reason, with the file's name
         raise InputFileError(path, f"Newton's USD importer refused it: {exc}") from None
     for w in caught:  # Newton's remarks on the file are notes of this read
@@ -631,9 +647,10 @@ def parse_usd(
     stage = Usd.Stage.Open(str(path))
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         folder = Path(tmp)
-        builder = _Builder(newton, nb, stage, rep, folder)
+        builder = _Builder(newton, nb, stage, rep, folder, found)
         spec = builder.build()
-        spec.modelname = prim_name(str(stage.GetDefaultPrim().GetPath())) or path.stem
+        default = str(stage.GetDefaultPrim().GetPath())
+        spec.modelname = name_of(builder.names.shown, default) or path.stem
         if not _actuators(stage, builder, rep):
             _drive_actuators(builder, rep)
         _note_unread(stage, rep)
