@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
+import numpy as np
 
 from robotwright._atomic import copy_file_atomic
 from robotwright._names import file_stem
@@ -69,8 +70,9 @@ class UsdExport:
         notes: what was not carried, one line each.
         proof: the read-back comparison (:class:`~robotwright.generators.usd_proof.UsdProof`),
             ``None`` when not asked for.
-        mjcf_model: MuJoCo's compile of the MJCF the USD was converted from (what the
-            proof compares against).
+        mjcf_model: MuJoCo's compile of the MJCF the USD was converted from, its mesh
+            geoms left out (what the proof compares against: bodies, inertias, joints,
+            actuators, poses).
     """
 
     path: Path
@@ -156,6 +158,24 @@ def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple
     return path, lost
 
 
+def _kinematic_model(mjcf: Path) -> mujoco.MjModel:
+    """MuJoCo's compile of our MJCF without its mesh geoms: the same bodies, masses,
+    inertias (each body's is explicit in our MJCF, so no geom contributes), joints,
+    actuators and keyframes, without reading or hulling a mesh (the G1's 35 meshes took
+    0.3-1.1 s of a 2 s export). Nothing the export or its proof reads is in a mesh. A
+    model in which something refers to a mesh geom (a contact pair, a sensor) is
+    compiled whole."""
+    spec = mujoco.MjSpec.from_file(str(mjcf))
+    for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
+        spec.delete(geom)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    try:
+        return spec.compile()
+    except ValueError:
+        return mujoco.MjModel.from_xml_path(str(mjcf))
+
+
 def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
     """Bodies with mass but an all-zero inertia: USD reads a zero ``diagonalInertia`` as
     "not given" and readers compute one from the colliders instead."""
@@ -218,6 +238,70 @@ def _author_drives(stage, hrdf: HRDF, model: mujoco.MjModel, out: UsdExport) -> 
         prim.CreateAttribute("newton:velocityLimit", Sdf.ValueTypeNames.Float).Set(value)
         prim.CreateAttribute("physxJoint:maxJointVelocity", Sdf.ValueTypeNames.Float).Set(value)
         out.velocity_limits[act.joint] = v
+
+
+def _angle(a, b) -> float:
+    """Angle [rad] between two rotations given as Gf quaternions."""
+    qa = [a.GetReal(), *a.GetImaginary()]
+    qb = [b.GetReal(), *b.GetImaginary()]
+    dot = abs(sum(float(x) * float(y) for x, y in zip(qa, qb, strict=True)))
+    return 2.0 * math.acos(min(1.0, dot))
+
+
+def _exact_frames(stage, model: mujoco.MjModel) -> None:
+    """Each body's orientation and each joint's frame in its parent body, from MuJoCo's
+    compile in double precision, where the converter's values are the same rotation
+    rounded: it passes them through a 32-bit ``Gf.Rotation``, which for a slightly
+    tilted body (Gymnasium's humanoid's 0.004 rad) is off by ~3e-5 rad. Only a body
+    whose prim sits in its parent body's prim, and a joint between a body and its
+    parent, is set; each must already be within 1e-3 rad and 1e-4 m of the compile."""
+    from pxr import UsdGeom, UsdPhysics
+
+    from robotwright._usd_names import display_names
+
+    shown = display_names(stage)
+
+    def body_of(prim) -> int:
+        if prim is None or not prim.IsValid():
+            return -1
+        if not prim.HasAPI(UsdPhysics.RigidBodyAPI):
+            return 0  # the world, or the scope the root body's prim sits in
+        return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, shown[str(prim.GetPath())])
+
+    for prim in stage.Traverse():
+        if prim.HasAPI(UsdPhysics.RigidBodyAPI):
+            b = body_of(prim)
+            if b <= 0 or body_of(prim.GetParent()) != int(model.body_parentid[b]):
+                continue
+            w, x, y, z = (float(v) for v in model.body_quat[b])
+            for op in UsdGeom.Xformable(prim).GetOrderedXformOps():
+                if op.GetOpType() != UsdGeom.XformOp.TypeOrient:
+                    continue
+                exact = type(op.Get())(w, x, y, z)
+                if _angle(op.Get(), exact) < 1e-3:
+                    op.Set(exact)
+        elif prim.IsA(UsdPhysics.Joint):
+            joint = UsdPhysics.Joint(prim)
+            t0, t1 = joint.GetBody0Rel().GetTargets(), joint.GetBody1Rel().GetTargets()
+            if len(t0) != 1 or len(t1) != 1:
+                continue
+            c = body_of(stage.GetPrimAtPath(t1[0]))
+            if c <= 0 or body_of(stage.GetPrimAtPath(t0[0])) != int(model.body_parentid[c]):
+                continue
+            rot1, pos1 = joint.GetLocalRot1Attr().Get(), joint.GetLocalPos1Attr().Get()
+            rot0, pos0 = joint.GetLocalRot0Attr().Get(), joint.GetLocalPos0Attr().Get()
+            if None in (rot1, pos1, rot0, pos0):
+                continue
+            q1 = np.array([rot1.GetReal(), *rot1.GetImaginary()], dtype=np.float64)
+            q0, p0 = np.empty(4), np.empty(3)
+            mujoco.mju_mulQuat(q0, model.body_quat[c], q1)
+            mujoco.mju_rotVecQuat(p0, np.array([float(v) for v in pos1]), model.body_quat[c])
+            p0 += model.body_pos[c]
+            exact = type(rot0)(*(float(v) for v in q0))
+            near = max(abs(float(a) - float(b)) for a, b in zip(pos0, p0, strict=True)) < 1e-4
+            if near and _angle(rot0, exact) < 1e-3:
+                joint.GetLocalRot0Attr().Set(exact)
+                joint.GetLocalPos0Attr().Set(type(pos0)(*(float(v) for v in p0)))
 
 
 def _author_free_joint_names(stage, model: mujoco.MjModel) -> None:
@@ -358,7 +442,7 @@ def to_usd(
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
             root.SetDisplayName(hrdf.name)
-        model = mujoco.MjModel.from_xml_path(str(mjcf))
+        model = _kinematic_model(mjcf)
         result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost, mjcf_model=model)
         for body in _zero_inertia_bodies(model):
             result.notes.append(
@@ -374,6 +458,7 @@ def to_usd(
             )
         result.notes += _keyframe_notes(model)
         _author_drives(stage, hrdf, model, result)
+        _exact_frames(stage, model)
         _author_free_joint_names(stage, model)
         flat = stage.Flatten()
         if layout == "flat":
