@@ -196,11 +196,13 @@ def test_a_robot_deeper_than_mjcf_nests_converts_to_flat_formats(tmp_path: Path,
 
 
 def test_error_lines_are_capped(tmp_path: Path, capsys) -> None:
-    """A message built from a file (a world of 5,000 bodies, each named in it) stays one
-    line of at most about 1 KB, saying how much was left out."""
+    """A message built from a file (a world of 5,000 bodies, each named in it when the
+    robot asked for is not one of them) stays one line of at most about 1 KB, saying
+    how much was left out."""
     bodies = "".join(f'<body name="b{k}"><geom size=".1"/></body>' for k in range(5000))
     text = f"<mujoco><worldbody>{bodies}</worldbody></mujoco>"
-    code = main(["convert", str(_file(tmp_path, text)), "-o", str(tmp_path / "o.xml")])
+    src = str(_file(tmp_path, text))
+    code = main(["convert", src, "--root-body", "robot", "-o", str(tmp_path / "o.xml")])
     err = capsys.readouterr().err
     assert code == 2
     assert err.count("\n") == 1 and len(err) < 1200, len(err)

@@ -170,10 +170,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--simulate",
-        action="store_true",
+        action=argparse.BooleanOptionalAction,
+        default=True,
         help="the proof also steps source and output side by side for 200 steps (zero and "
         "a fixed pseudo-random control, contacts on, the robot alone) and reports a "
-        "divergence the source's own sensitivity does not explain (MJCF sources)",
+        "divergence neither the source's own sensitivity nor its round-off explains (MJCF "
+        "sources; on by default, --no-simulate compares the compiled models only)",
     )
     add_overwrite_flag(p)
     _repair_args(p)
@@ -207,10 +209,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--simulate",
-        action="store_true",
-        help="one more row: the source and our MJCF stepped side by side for 200 steps "
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="the row of the source and our MJCF stepped side by side for 200 steps "
         "(zero and pseudo-random control, contacts on), flagging joint positions that "
-        "differ by more than 1e-6 and more than the source's own sensitivity",
+        "differ by more than 1e-6 and more than the source's own sensitivity and "
+        "round-off (on by default; --no-simulate leaves it out)",
     )
     _source_args(p)
     p.add_argument(

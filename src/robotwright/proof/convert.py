@@ -91,7 +91,7 @@ def convert(
     overwrite: bool = False,
     proof: bool = True,
     scene: bool = False,
-    simulate: bool = False,
+    simulate: bool = True,
     **options: Any,
 ) -> list[str]:
     """Convert ``src`` to ``dst``; returns every warning (parser and writer) as text.
@@ -102,9 +102,10 @@ def convert(
     With ``proof`` (the default), an MJCF or URDF source that MuJoCo compiles is compared
     with the output, compiled, field by field (:mod:`robotwright.proof.compare`): each
     difference no warning reports becomes one; under ``strict`` any fails the conversion
-    before anything is written. ``simulate``: the proof also steps the source and the
-    output side by side (:mod:`robotwright.proof.rollout`; MJCF sources) and reports a
-    divergence the source's own sensitivity does not explain.
+    before anything is written. ``simulate`` (the default): the proof also steps the
+    source and the output side by side (:mod:`robotwright.proof.rollout`; MJCF sources)
+    and reports a divergence neither the source's own sensitivity nor its round-off
+    twin explains; ``simulate=False`` compares the compiled models only.
 
     ``options`` go to the parser (see ``URDFOptions`` / ``MJCFOptions``), except
     ``collision_max_faces`` and ``convex_decomposition``, which repair the collision

@@ -58,14 +58,14 @@ def roundtrip(
     configs: int = 50,
     urdf: bool = True,
     reference: str = "auto",
-    simulate: bool = False,
+    simulate: bool = True,
     **options: Any,
 ) -> RoundTripReport:
     """The fidelity table of one MJCF or URDF file (see the module docstring).
 
     ``reference``: ``"auto"`` (MuJoCo's import; yourdfpy for a URDF MuJoCo refuses),
-    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``simulate``: one more row, the source
-    and our MJCF stepped side by side (:mod:`robotwright.proof.rollout`: 200 steps with
+    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``simulate`` (the default): one more
+    row, the source and our MJCF stepped side by side (:mod:`robotwright.proof.rollout`: 200 steps with
     zero and with pseudo-random control, contacts on; MuJoCo references only). ``options``
     go to the parser. Staged
     meshes live in a temporary folder removed at the end (unless ``work_dir`` is given).
