@@ -221,9 +221,12 @@ def _lose_shoulder_damping(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_a_silent_loss_becomes_a_note(tmp_path: Path, monkeypatch) -> None:
     _lose_shoulder_damping(monkeypatch)
     messages = convert(_write(tmp_path, ROBOT), tmp_path / "out")
-    lost = [m for m in messages if "proof:" in m]
+    lost = [m for m in messages if "proof:" in m and "simulation," not in m]
     assert len(lost) == 1 and "dof_damping" in lost[0] and "'shoulder'" in lost[0], messages
     assert "source 0.5" in lost[0] and "result 0.0" in lost[0]
+    # and what it does: the arm swings otherwise (the proof simulates by default)
+    moved = [m for m in messages if "proof: simulation," in m]
+    assert moved and all("(joint 'shoulder'" in m or "(joint 'elbow'" in m for m in moved)
 
 
 def test_strict_fails_on_a_silent_loss_and_writes_nothing(tmp_path: Path, monkeypatch) -> None:

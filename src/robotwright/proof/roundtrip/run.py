@@ -64,8 +64,9 @@ def roundtrip(
     """The fidelity table of one MJCF or URDF file (see the module docstring).
 
     ``reference``: ``"auto"`` (MuJoCo's import; yourdfpy for a URDF MuJoCo refuses),
-    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``simulate`` (the default): one more
-    row, the source and our MJCF stepped side by side (:mod:`robotwright.proof.rollout`: 200 steps with
+    ``"mujoco"`` or ``"yourdfpy"`` (URDF only). ``simulate`` (the default; MJCF sources
+    read whole, without ``root_body``, as ``convert``): one more row, the source and our
+    MJCF stepped side by side (:mod:`robotwright.proof.rollout`: 200 steps with
     zero and with pseudo-random control, contacts on; MuJoCo references only). ``options``
     go to the parser. Staged
     meshes live in a temporary folder removed at the end (unless ``work_dir`` is given).
@@ -82,7 +83,12 @@ def roundtrip(
         with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
             work = {**options, "work_dir": tmp}
             report = _roundtrip(Path(source), configs, urdf, reference, work)
-    if simulate and not report.error:
+    # As in convert, an MJCF source read whole: a URDF's reference is MuJoCo's own import
+    # of it, with its conventions; a robot taken out of a larger world (root_body) has a
+    # reference that still holds the rest of that world.
+    whole = options.get("root_body") is None
+    mjcf = Path(source).suffix.lower() in (".xml", ".mjcf")
+    if simulate and mjcf and whole and not report.error:
         report.rows.insert(_after_mjcf_rows(report), simulation_row(report))
     return report
 
