@@ -155,3 +155,24 @@ def test_massless_frame_becomes_site(tmp_path: Path) -> None:
     assert all(r.ok for r in rows), rows
     with pytest.raises(ValueError, match="massless_frames"):
         mjcf_to_hrdf(path, massless_frames="merge")
+
+
+def test_a_frame_a_sensor_or_weld_names_stays_a_body(tmp_path: Path) -> None:
+    """massless_frames='site' turns a massless leaf body into a site, except one that a
+    body sensor or a weld names (MuJoCo's object types read as numpy integers, compared
+    as plain ints: never ``in`` a tuple of enum members)."""
+    path = tmp_path / "frames.xml"
+    path.write_text(
+        """<mujoco><worldbody><body name="base"><joint name="j" axis="0 0 1"/>
+        <geom size=".1" mass="1"/>
+        <body name="camera_frame" pos="0 0 .2"/>
+        <body name="sensed" pos="0 0 .3"/>
+        <body name="welded" pos="0 0 .4"/>
+        </body><body name="anchor" pos="1 0 0"><geom size=".1" mass="1"/></body></worldbody>
+        <equality><weld body1="welded" body2="anchor"/></equality>
+        <sensor><framepos objtype="body" objname="sensed"/></sensor></mujoco>"""
+    )
+    hrdf = mjcf_to_hrdf(path, massless_frames="site")
+    bodies = {b.name for b in hrdf.bodies}
+    assert {"sensed", "welded"} <= bodies
+    assert "camera_frame" not in bodies and "camera_frame" in {s.name for s in hrdf.sites}

@@ -136,19 +136,22 @@ def _select_robot(
 def _named_bodies(model: mujoco.MjModel) -> set[int]:
     """Bodies other elements refer to (sensors, actuators, equality, excludes)."""
     out: set[int] = set()
-    body_types = (mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_XBODY)
+    # Plain ints: a numpy integer read from a model is never ``in`` a tuple of MuJoCo's
+    # enum members (the members' own comparison refuses it).
+    body_types = (int(mujoco.mjtObj.mjOBJ_BODY), int(mujoco.mjtObj.mjOBJ_XBODY))
     for s in range(model.nsensor):
-        if model.sensor_objtype[s] in body_types:
+        if int(model.sensor_objtype[s]) in body_types:
             out.add(int(model.sensor_objid[s]))
-        if model.sensor_reftype[s] in body_types:
+        if int(model.sensor_reftype[s]) in body_types:
             out.add(int(model.sensor_refid[s]))
     for a in range(actuator_count(model)):
         if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_BODY:
             out.add(int(model.actuator_trnid[a, 0]))
     for e in range(model.neq):
-        if model.eq_type[e] in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD) and (
-            model.eq_objtype[e] != mujoco.mjtObj.mjOBJ_SITE
-        ):
+        if int(model.eq_type[e]) in (
+            int(mujoco.mjtEq.mjEQ_CONNECT),
+            int(mujoco.mjtEq.mjEQ_WELD),
+        ) and (model.eq_objtype[e] != mujoco.mjtObj.mjOBJ_SITE):
             out.update((int(model.eq_obj1id[e]), int(model.eq_obj2id[e])))
     for sig in model.exclude_signature:
         out.update((int(sig) >> 16, int(sig) & 0xFFFF))
@@ -290,7 +293,10 @@ def _routing_sites(model: mujoco.MjModel) -> set[int]:
     for w in range(model.nwrap):
         if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_SITE:
             out.add(int(model.wrap_objid[w]))
-        elif model.wrap_type[w] in (mujoco.mjtWrap.mjWRAP_SPHERE, mujoco.mjtWrap.mjWRAP_CYLINDER):
+        elif int(model.wrap_type[w]) in (
+            int(mujoco.mjtWrap.mjWRAP_SPHERE),
+            int(mujoco.mjtWrap.mjWRAP_CYLINDER),
+        ):
             side = int(model.wrap_prm[w])
             if side >= 0:
                 out.add(side)
