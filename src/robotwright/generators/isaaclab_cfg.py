@@ -213,7 +213,15 @@ def write_articulation_cfg(
     from robotwright.generators.usd import to_usd
 
     out, usd = module_outputs(output, ".usd", overwrite)
-    done = to_usd(hrdf, usd, overwrite=overwrite, strict=strict, layout=layout, root_at_origin=True)
+    done = to_usd(
+        hrdf,
+        usd,
+        overwrite=overwrite,
+        strict=strict,
+        layout=layout,
+        root_at_origin=True,
+        geometry=True,  # the standing height comes from the collision geometry
+    )
     # The initial state comes from the MJCF the USD was made from.
     write_module_beside(
         out, usd, lambda: articulation_cfg_source(hrdf, done.mjcf_model, usd.name, joint_pos)[0]

@@ -70,9 +70,9 @@ class UsdExport:
         notes: what was not carried, one line each.
         proof: the read-back comparison (:class:`~robotwright.generators.usd_proof.UsdProof`),
             ``None`` when not asked for.
-        mjcf_model: MuJoCo's compile of the MJCF the USD was converted from, its mesh
-            geoms left out (what the proof compares against: bodies, inertias, joints,
-            actuators, poses).
+        mjcf_model: MuJoCo's compile of the MJCF the USD was converted from (what the
+            proof compares against: bodies, inertias, joints, actuators, poses); its mesh
+            geoms are left out unless :func:`to_usd` was asked for ``geometry``.
     """
 
     path: Path
@@ -392,6 +392,7 @@ def to_usd(
     strict: bool = False,
     layout: str = "nested",
     root_at_origin: bool = False,
+    geometry: bool = False,
 ) -> UsdExport:
     """Write ``hrdf`` as one USD file (see the module docstring for what is authored).
 
@@ -411,6 +412,10 @@ def to_usd(
     does). Isaac Lab places the prim at the config's initial position when it spawns and
     the root body there when it resets, so an offset of the body inside its prim would
     count twice at spawn.
+
+    ``geometry``: ``mjcf_model`` is compiled with its mesh geoms (what a standing height
+    or a sensor mount needs); by default they are left out, which the export and its
+    proof do not need and which costs the hull of every collision mesh.
 
     Raises:
         GeneratorError: the converter is missing, the suffix is not a USD one, the
@@ -442,7 +447,7 @@ def to_usd(
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
             root.SetDisplayName(hrdf.name)
-        model = _kinematic_model(mjcf)
+        model = mujoco.MjModel.from_xml_path(str(mjcf)) if geometry else _kinematic_model(mjcf)
         result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost, mjcf_model=model)
         for body in _zero_inertia_bodies(model):
             result.notes.append(

@@ -92,7 +92,9 @@ def _go2_usd() -> tuple[str, tuple[float, ...], dict[str, float], tuple[float, f
 
     folder = Path(tempfile.mkdtemp(prefix=prefix("semantic-nav")))
     atexit.register(shutil.rmtree, folder, ignore_errors=True)
-    done = to_usd(go2_robot(), folder / "go2.usd", layout="flat", root_at_origin=True)
+    done = to_usd(
+        go2_robot(), folder / "go2.usd", layout="flat", root_at_origin=True, geometry=True
+    )
     pos, joint_pos, _ = initial_state(done.mjcf_model, GO2_JOINT_POS)
     return str(done.path), tuple(pos), dict(joint_pos), lidar_mount(done.mjcf_model)
 
