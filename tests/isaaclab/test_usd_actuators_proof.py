@@ -47,9 +47,14 @@ def _newton(usd: Path):
     return builder.finalize(device="cpu"), found
 
 
-def test_shadow_hand_drives_every_actuated_joint_under_its_own_name(tmp_path):
+def _hand():
+    """OpenAI's Shadow hand (its source file and its HRDF), without the reach scene."""
     source = _need(HAND_ASSETS / "hand" / "reach.xml")
-    hrdf = load_robot(str(source), asset_roots=[HAND_ASSETS], root_body="robot0:hand mount")
+    return source, load_robot(str(source), asset_roots=[HAND_ASSETS], root_body="robot0:hand mount")
+
+
+def test_shadow_hand_drives_every_actuated_joint_under_its_own_name(tmp_path):
+    source, hrdf = _hand()
     out = tmp_path / "hand.usda"
     done = to_usd(hrdf, out)
     # The source's own compile: 20 position actuators, one per joint, kp and force range.
@@ -83,8 +88,7 @@ def test_shadow_hand_drives_every_actuated_joint_under_its_own_name(tmp_path):
 def test_proof_names_an_edited_drive_and_a_drive_without_actuator(tmp_path):
     from robotwright.generators.usd_proof import prove_usd
 
-    source = _need(HAND_ASSETS / "hand" / "reach.xml")
-    hrdf = load_robot(str(source), asset_roots=[HAND_ASSETS], root_body="robot0:hand mount")
+    _, hrdf = _hand()
     out = tmp_path / "hand.usda"
     done = to_usd(hrdf, out)
     stage = Usd.Stage.Open(str(out))
@@ -158,8 +162,7 @@ def test_renamed_prims_and_merged_joints_read_back_under_the_source_names(tmp_pa
     each actuator on its joint."""
     from robotwright.parsers.api import usd_to_hrdf_with_warnings
 
-    source = _need(HAND_ASSETS / "hand" / "reach.xml")
-    hand = load_robot(str(source), asset_roots=[HAND_ASSETS], root_body="robot0:hand mount")
+    _, hand = _hand()
     to_usd(hand, tmp_path / "hand.usda")
     back, _ = usd_to_hrdf_with_warnings(tmp_path / "hand.usda")
     assert sorted(b.name for b in back.bodies) == sorted(b.name for b in hand.bodies)
