@@ -178,6 +178,13 @@ def _hull(model: mujoco.MjModel, g: int) -> tuple[int, np.ndarray] | None:
     return nface, vert @ rot.reshape(3, 3).T + model.geom_pos[g]
 
 
+def _hull_polygons(model: mujoco.MjModel, g: int) -> int:
+    """How many polygons MuJoCo merged mesh geom ``g``'s hull faces into (0 where the
+    model does not hold them)."""
+    polynum = getattr(model, "mesh_polynum", None)
+    return 0 if polynum is None else int(polynum[int(model.geom_dataid[g])])
+
+
 #: Points of one set compared with the whole other set at a time: a hull of thousands of
 #: vertices stays a few MB of distances, also in a confined reader's memory budget.
 _CHUNK = 256
@@ -223,15 +230,18 @@ def _collision_hulls(src: _Side, res: _Side, geom_map: dict[int, int]) -> list[D
                 out.append(_diff(src, "geom", "collision hull", g, *shown))
             continue
         (fa, va), (fb, vb) = a, b
-        if (len(va), fa) != (len(vb), fb):
+        # The polygons MuJoCo merges the hull's coplanar triangles into (what its convex
+        # collision walks): the same points in another order can merge otherwise.
+        pa, pb = _hull_polygons(s, g), _hull_polygons(r, h)
+        if (len(va), fa, pa) != (len(vb), fb, pb):
             out.append(
                 _diff(
                     src,
                     "geom",
                     "collision hull",
                     g,
-                    f"{len(va)} vertices, {fa} faces",
-                    f"{len(vb)} vertices, {fb} faces",
+                    f"{len(va)} vertices, {fa} faces, {pa} polygons",
+                    f"{len(vb)} vertices, {fb} faces, {pb} polygons",
                 )  # fmt: skip
             )
             continue
