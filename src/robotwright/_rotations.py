@@ -3,6 +3,7 @@ functions. Quaternions are (w, x, y, z); angles in radians; positions in metres.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import mujoco
@@ -10,7 +11,14 @@ import numpy as np
 
 Quat = tuple[float, float, float, float]
 
-__all__ = ["compose_pose", "mat_to_quat", "mul_quat", "quat_to_mat", "rpy_to_quat"]
+__all__ = [
+    "compose_pose",
+    "mat_to_quat",
+    "mul_quat",
+    "quat_angle",
+    "quat_to_mat",
+    "rpy_to_quat",
+]
 
 
 def quat_to_mat(quat: Sequence[float]) -> np.ndarray:
@@ -64,3 +72,12 @@ def compose_pose(
         np.asarray(quat_b, dtype=float),
     )
     return pos, quat
+
+
+def quat_angle(a: Sequence[float], b: Sequence[float]) -> float:
+    """Angle [rad] of the rotation between two unit quaternions (w, x, y, z): atan2, not
+    acos, so that it is exact near zero, where float32 poses live."""
+    inv, rel = np.empty(4), np.empty(4)
+    mujoco.mju_negQuat(inv, np.asarray(a, dtype=np.float64))
+    mujoco.mju_mulQuat(rel, inv, np.asarray(b, dtype=np.float64))
+    return 2.0 * math.atan2(float(np.linalg.norm(rel[1:])), abs(float(rel[0])))

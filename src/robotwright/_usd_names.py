@@ -49,14 +49,10 @@ def joint_dof_prims(path_joint_map: Mapping[str, int], stage: Any) -> dict[int, 
     grouped: dict[int, list[str]] = {}
     for path, index in path_joint_map.items():
         grouped.setdefault(int(index), []).append(str(path))
-    out: dict[int, list[str]] = {}
-    for index, paths in grouped.items():
-        if len(paths) == 1:
-            out[index] = paths
-            continue
-
-        def angular(path: str) -> bool:
-            return stage.GetPrimAtPath(path).IsA(UsdPhysics.RevoluteJoint)
-
-        out[index] = [p for p in paths if not angular(p)] + [p for p in paths if angular(p)]
-    return out
+    # A stable sort: the linear axes keep their order, then the angular ones theirs.
+    return {
+        index: sorted(paths, key=lambda p: stage.GetPrimAtPath(p).IsA(UsdPhysics.RevoluteJoint))
+        if len(paths) > 1
+        else paths
+        for index, paths in grouped.items()
+    }

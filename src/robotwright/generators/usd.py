@@ -37,8 +37,10 @@ import numpy as np
 
 from robotwright._atomic import copy_file_atomic
 from robotwright._names import file_stem
+from robotwright._rotations import quat_angle
 from robotwright._temporaries import prefix
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES
+from robotwright._usd_names import display_names
 from robotwright.errors import ConversionWarning, GeneratorError
 from robotwright.hrdf.model import HRDF
 
@@ -198,17 +200,17 @@ def _keyframe_notes(model: mujoco.MjModel) -> list[str]:
     ]
 
 
-def _author_drives(stage, hrdf: HRDF, model: mujoco.MjModel, out: UsdExport) -> None:
+def _author_drives(
+    stage, shown: dict[str, str], hrdf: HRDF, model: mujoco.MjModel, out: UsdExport
+) -> None:
     """One ``UsdPhysics.DriveAPI`` per actuated hinge or slide joint, as
     :func:`~robotwright.generators.usd_drives.joint_drives` derives it from MuJoCo's
     compile, and each joint's rated velocity (the HRDF's ``peak_velocity``, which MJCF
     cannot hold); a note for each actuator no drive holds."""
     from pxr import Sdf, UsdPhysics
 
-    from robotwright._usd_names import display_names
     from robotwright.generators.usd_drives import joint_drives
 
-    shown = display_names(stage)
     joints = {shown[str(p.GetPath())]: p for p in stage.Traverse() if p.IsA(UsdPhysics.Joint)}
     out.joint_prims = {name: str(p.GetPath()) for name, p in joints.items()}
     drives, lost = joint_drives(model)
@@ -242,13 +244,10 @@ def _author_drives(stage, hrdf: HRDF, model: mujoco.MjModel, out: UsdExport) -> 
 
 def _angle(a, b) -> float:
     """Angle [rad] between two rotations given as Gf quaternions."""
-    qa = [a.GetReal(), *a.GetImaginary()]
-    qb = [b.GetReal(), *b.GetImaginary()]
-    dot = abs(sum(float(x) * float(y) for x, y in zip(qa, qb, strict=True)))
-    return 2.0 * math.acos(min(1.0, dot))
+    return quat_angle([a.GetReal(), *a.GetImaginary()], [b.GetReal(), *b.GetImaginary()])
 
 
-def _exact_frames(stage, model: mujoco.MjModel) -> None:
+def _exact_frames(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
     """Each body's orientation and each joint's frame in its parent body, from MuJoCo's
     compile in double precision, where the converter's values are the same rotation
     rounded: it passes them through a 32-bit ``Gf.Rotation``, which for a slightly
@@ -256,10 +255,6 @@ def _exact_frames(stage, model: mujoco.MjModel) -> None:
     whose prim sits in its parent body's prim, and a joint between a body and its
     parent, is set; each must already be within 1e-3 rad and 1e-4 m of the compile."""
     from pxr import UsdGeom, UsdPhysics
-
-    from robotwright._usd_names import display_names
-
-    shown = display_names(stage)
 
     def body_of(prim) -> int:
         if prim is None or not prim.IsValid():
@@ -304,12 +299,9 @@ def _exact_frames(stage, model: mujoco.MjModel) -> None:
                 joint.GetLocalPos0Attr().Set(type(pos0)(*(float(v) for v in p0)))
 
 
-def _author_free_joint_names(stage, model: mujoco.MjModel) -> None:
+def _author_free_joint_names(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
     from pxr import Sdf, UsdPhysics
 
-    from robotwright._usd_names import display_names
-
-    shown = display_names(stage)
     bodies = {
         shown[str(p.GetPath())]: p for p in stage.Traverse() if p.HasAPI(UsdPhysics.RigidBodyAPI)
     }
@@ -462,9 +454,10 @@ def to_usd(
                 "sensors; add Isaac Lab sensors in the scene config"
             )
         result.notes += _keyframe_notes(model)
-        _author_drives(stage, hrdf, model, result)
-        _exact_frames(stage, model)
-        _author_free_joint_names(stage, model)
+        shown = display_names(stage)  # prim path -> the robot's name for it
+        _author_drives(stage, shown, hrdf, model, result)
+        _exact_frames(stage, shown, model)
+        _author_free_joint_names(stage, shown, model)
         flat = stage.Flatten()
         if layout == "flat":
             from pxr import UsdPhysics

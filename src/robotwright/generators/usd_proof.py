@@ -23,7 +23,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from robotwright._rotations import quat_to_mat
+from robotwright._rotations import quat_angle, quat_to_mat
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["UsdProof", "prove_usd"]
@@ -64,15 +64,6 @@ def _mj_inertia(model: mujoco.MjModel, b: int) -> np.ndarray:
     """Body ``b``'s inertia tensor about its centre of mass, in the body frame."""
     r = quat_to_mat(model.body_iquat[b])
     return r @ np.diag(model.body_inertia[b]) @ r.T
-
-
-def _quat_angle(wxyz_a: np.ndarray, wxyz_b: np.ndarray) -> float:
-    """Angle [rad] of the rotation between two unit quaternions (atan2, not acos: exact
-    near zero, where float32 poses live)."""
-    inv, rel = np.empty(4), np.empty(4)
-    mujoco.mju_negQuat(inv, np.asarray(wxyz_a, dtype=np.float64))
-    mujoco.mju_mulQuat(rel, inv, np.asarray(wxyz_b, dtype=np.float64))
-    return 2.0 * math.atan2(float(np.linalg.norm(rel[1:])), abs(float(rel[0])))
 
 
 def _joint_dofs(model, found: dict, stage, names: dict[str, str]) -> dict[str, tuple[int, int]]:
@@ -356,7 +347,7 @@ def prove_usd(
             err = float(np.abs(data.xpos[b] - body_q[i][:3]).max())
             proof.max_pose_error = max(proof.max_pose_error, err)
             x, y, z, w = body_q[i][3:]
-            ang = _quat_angle(data.xquat[b], np.array([w, x, y, z]))
+            ang = quat_angle(data.xquat[b], np.array([w, x, y, z]))
             if err > max(tol, 2e-6) or ang > max(tol, 2e-6):
                 m, r, n = worst.get(name, (0.0, 0.0, 0))
                 worst[name] = (max(m, err), max(r, ang), n + 1)

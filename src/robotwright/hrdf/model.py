@@ -596,9 +596,10 @@ class HRDF:
         """The free joint of the (first) root body, which ``meta.yaml`` holds as
         ``floating_base``; None for a fixed base. Other roots' free joints are rows of
         ``joint.csv``."""
-        if not self.bodies or not any(b.parent == -1 for b in self.bodies):
+        roots = self.root_indices
+        if not roots:
             return None
-        root = self.root_body.name
+        root = self.bodies[roots[0]].name
         return next((j for j in self.joints if j.type == "free" and j.body == root), None)
 
     @property

@@ -87,11 +87,20 @@ def round_off_twin(source: mujoco.MjModel, result: mujoco.MjModel) -> tuple[mujo
 
 
 def _steps(
-    models: tuple[mujoco.MjModel, ...], ctrl: np.ndarray, actuators: tuple[np.ndarray, ...]
+    models: tuple[mujoco.MjModel, ...],
+    ctrl: np.ndarray,
+    actuators: tuple[np.ndarray, ...],
+    moved: tuple[bool, ...] | None = None,
 ) -> list[np.ndarray]:
     """Each model stepped from its reference pose under ``ctrl`` (the source's actuator
-    columns, given to each model's own actuators): its joint positions at every step."""
+    columns, given to each model's own actuators): its joint positions after every
+    step. ``moved``: per model, whether its start is moved by :data:`PERTURBATION` in
+    every joint position first."""
     datas = [mujoco.MjData(m) for m in models]
+    for m, d, move in zip(models, datas, moved or (False,) * len(models), strict=True):
+        if move:
+            d.qpos[:] += PERTURBATION
+            mujoco.mj_normalizeQuat(m, d.qpos)
     out = [np.empty((len(ctrl), m.nq)) for m in models]
     for t in range(len(ctrl)):
         for k, (m, d) in enumerate(zip(models, datas, strict=True)):
@@ -99,6 +108,16 @@ def _steps(
             mujoco.mj_step(m, d)
             out[k][t] = d.qpos
     return out
+
+
+def _largest_gaps(gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per step of ``gap`` (steps x coordinates): its largest value and that value's
+    coordinate (a step whose largest is not a number counts as ``-inf``)."""
+    if not gap.size:
+        return np.full(len(gap), -np.inf), np.zeros(len(gap), dtype=int)
+    column = gap.argmax(axis=1)
+    per_step = gap[np.arange(len(gap)), column]
+    return np.where(np.isnan(per_step), -np.inf, per_step), column
 
 
 def _controls(model: mujoco.MjModel, steps: int) -> np.ndarray:
@@ -159,36 +178,30 @@ def rollout_differences(
     res_q = np.fromiter(qpos_map.values(), dtype=int)
     src_u = np.fromiter(actuator_map.keys(), dtype=int)
     res_u = np.fromiter(actuator_map.values(), dtype=int)
-    out = []
     source, result = _robot_alone(source), _robot_alone(result)
     zero = np.zeros((steps, source.nu))
+    twin: tuple[mujoco.MjModel, int] | None = None
     out = []
     for what, ctrl in (("zero control", zero), ("pseudo-random control", _controls(source, steps))):
-        a, b, c = mujoco.MjData(source), mujoco.MjData(result), mujoco.MjData(source)
-        c.qpos[:] += PERTURBATION
-        mujoco.mj_normalizeQuat(source, c.qpos)
-        worst, where, first, own = 0.0, 0, -1, 0.0
-        for t in range(steps):
-            a.ctrl[src_u] = ctrl[t, src_u]
-            c.ctrl[src_u] = ctrl[t, src_u]
-            b.ctrl[res_u] = ctrl[t, src_u]
-            for model, data in ((source, a), (result, b), (source, c)):
-                mujoco.mj_step(model, data)
-            gap = np.abs(a.qpos[src_q] - b.qpos[res_q])
-            own = max(own, float(np.abs(a.qpos - c.qpos).max(initial=0.0)))
-            k = int(gap.argmax()) if len(gap) else 0
-            if len(gap) and gap[k] > worst:
-                worst, where = float(gap[k]), int(src_q[k])
-            if first < 0 and worst > ROLLOUT_TOL:
-                first = t + 1
+        mine, theirs, moved = _steps(
+            (source, result, source), ctrl, (src_u, res_u, src_u), (False, False, True)
+        )
+        per_step, column = _largest_gaps(np.abs(mine[:, src_q] - theirs[:, res_q]))
+        t = int(per_step.argmax())  # the first step reaching the largest
+        worst = max(float(per_step[t]), 0.0)
+        where = int(src_q[column[t]]) if len(src_q) else 0
+        over = np.flatnonzero(per_step > ROLLOUT_TOL)
+        first = int(over[0]) + 1 if len(over) else -1
+        own_steps = np.abs(mine - moved).max(axis=1, initial=0.0)
+        own = float(np.max(own_steps[~np.isnan(own_steps)], initial=0.0))
         if worst > ROLLOUT_TOL and worst > CHAOS_MARGIN * own:
             # The source with the result's values wherever the two differ by round-off
             # only: where it moves as the result does, the divergence is the model's
             # sensitivity to its last digits, not a change the conversion made.
-            twin, taken = round_off_twin(source, result)
-            if taken:
-                mine, theirs = _steps((twin, result), ctrl, (src_u, res_u))
-                if np.abs(mine[:, src_q] - theirs[:, res_q]).max(initial=0.0) <= ROLLOUT_TOL:
+            twin = twin or round_off_twin(source, result)
+            if twin[1]:
+                like, them = _steps((twin[0], result), ctrl, (src_u, res_u))
+                if np.abs(like[:, src_q] - them[:, res_q]).max(initial=0.0) <= ROLLOUT_TOL:
                     continue
             out.append(
                 Difference(
