@@ -97,6 +97,25 @@ def test_valid_mesh_with_scale_compiles(arm: Path) -> None:
     np.testing.assert_allclose(np.ptp(model.mesh_vert, axis=0), [0.1, 0.1, 0.1], rtol=1e-6)
 
 
+def test_negative_mesh_scale_mirrors_and_out_of_range_scales_are_located(arm: Path) -> None:
+    header = MESH_HEADER + ",scale0,scale1,scale2"
+    (arm / "meshes").mkdir()
+    mesh = _box()
+    mesh.apply_translation((0.1, 0.2, 0.3))
+    mesh.export(str(arm / "meshes" / "part.stl"), file_type="stl")
+    (arm / "mesh.csv").write_text(f"{header}\n{MESH_ROW.format(name='part')},1,-2,1\n")
+    assert _errors(arm) == []
+    model = MJCFHumanoidGenerator.from_hrdf(HRDF.from_dir(arm)).to_model()
+    # mirrored on y and stretched: the mesh's centre goes to y = -0.4 in the geom frame
+    np.testing.assert_allclose(model.mesh_scale[0], [1, -2, 1])
+    assert model.geom_pos[model.geom_dataid.tolist().index(0)][1] < 0
+    for bad in ("0,1,1", "1,1,2000000", "1,-1e-9,1"):
+        (arm / "mesh.csv").write_text(f"{header}\n{MESH_ROW.format(name='part')},{bad}\n")
+        errors = _errors(arm)
+        assert [(p.file, p.row, p.column) for p in errors] == [("mesh.csv", 0, "scale0")], bad
+        assert "between 1e-06 and 1e+06" in errors[0].message
+
+
 @pytest.mark.parametrize(
     ("extra", "words"),
     [

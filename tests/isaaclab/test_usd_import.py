@@ -13,6 +13,7 @@ import re
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
 import pytest
 
@@ -202,3 +203,46 @@ def test_a_layer_outside_the_folder_is_refused(tmp_path, how):
     assert "outside.usda" in run.stderr and "outside the file's folder" in run.stderr
     assert "Traceback" not in run.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_mirrored_mesh_reads_back_mirrored_with_its_hull(tmp_path):
+    """A negatively scaled mesh (talos' ``arm_6`` collision mesh, ``scale="1 -1 1"``)
+    goes to USD as the prim's scale and comes back as the mesh's scale, not as mirrored
+    points: the compiled mesh, its place and its hull (200 polygons; a mirrored copy of
+    the points gets 198) are the source's."""
+    from robotwright.catalog import find_entry
+    from robotwright.parsers.api import mjcf_to_hrdf
+
+    entry = find_entry("talos")
+    if entry is None:
+        pytest.skip("talos comes from example-robot-data (not installed)")
+    stl = Path(entry.path).resolve().parents[1] / "meshes" / "arm" / "arm_6_collision.STL"
+    (tmp_path / "arm_6.stl").write_bytes(stl.read_bytes())
+    src = tmp_path / "mirrored.xml"
+    src.write_text(
+        '<mujoco><asset><mesh name="m" file="arm_6.stl" scale="1 -1 1"/></asset><worldbody>'
+        '<body name="base"><geom type="box" size=".05 .05 .05"/><body name="arm" pos="0 0 .1">'
+        '<joint name="j" axis="0 1 0"/><geom name="gm" type="mesh" mesh="m"/></body></body>'
+        "</worldbody></mujoco>"
+    )
+    hrdf = mjcf_to_hrdf(src)
+    with warnings.catch_warnings(record=True):
+        warnings.simplefilter("always")
+        to_usd(hrdf, tmp_path / "mirrored.usda")
+    back, _ = usd_to_hrdf_with_warnings(tmp_path / "mirrored.usda", work_dir=tmp_path / "work")
+    # Newton reads it as -1 -1 -1 turned half a turn; the prim's own scale is kept
+    assert [m.scale for m in back.meshes] == [(1.0, -1.0, 1.0)]
+    source = mujoco.MjModel.from_xml_path(str(src))
+    result = _compiled(back, tmp_path / "b")
+    assert result.mesh_polynum.tolist() == source.mesh_polynum.tolist() == [200]
+
+    def world_vertices(model):
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        g = model.geom("gm")
+        v = model.mesh_vert[model.mesh_vertadr[0] : model.mesh_vertadr[0] + model.mesh_vertnum[0]]
+        return v @ data.geom_xmat[g.id].reshape(3, 3).T + data.geom_xpos[g.id]
+
+    a, b = world_vertices(source), world_vertices(result)
+    nearest = np.linalg.norm(a[:, None] - b[None], axis=2).min(axis=1)
+    assert nearest.max() < 1e-6  # float32 points

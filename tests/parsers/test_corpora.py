@@ -123,24 +123,7 @@ def test_corpus_file_roundtrips(
     # compared MjModel field that no note reports, on the same parse.
     kind = "urdf" if path.suffix == ".urdf" else "mjcf"
     found = prove(path, kind, report.parse.hrdf, "hrdf", report.warnings, options=options)
-    # A mirrored copy of a mesh (negative scale) can merge its hull's coplanar faces into
-    # other polygons (MuJoCo hulls the file's own vertices, then mirrors): the proof
-    # names each such geom, which is what it must do; nothing else may be found.
-    mirrored = {
-        str(w).split('name="', 1)[1].split('"', 1)[0]
-        for w in report.warnings
-        if "mirrored copy written" in str(w) and 'name="' in str(w)
-    }
-    found = [p for p in found if not _mirrored_hull(p, mirrored)]
     assert not found, [str(p) for p in found]
-
-
-def _mirrored_hull(problem, mirrored: set[str]) -> bool:
-    """Whether ``problem`` is the proof naming the changed hull of a mirrored mesh geom
-    (its element reads ``geom 'NAME'``)."""
-    element = problem.element or ""
-    quoted = element.split("'")
-    return "collision hull" in problem.message and len(quoted) > 1 and quoted[1] in mirrored
 
 
 def test_expected_failures_exist() -> None:

@@ -222,11 +222,17 @@ def test_link_named_world_inside_the_tree_is_renamed(tmp_path: Path) -> None:
 
 # -- 5. negative mesh scale ----------------------------------------------------------------
 @pytest.mark.realdata
-def test_negative_mesh_scale_mirrored_robosuite_tiago() -> None:
+def test_negative_mesh_scale_kept_robosuite_tiago() -> None:
+    """tiago's arms use their meshes at negative scales (``"-1 -1 -1"``, ``"1 -1 -1"``...): the rows keep
+    the negative scale and the file itself (no copy, no note), and the round trip,
+    hulls included, is exact."""
     path = _need(RS / "robots" / "tiago" / "robot.xml")
     result = mjcf_to_hrdf_with_warnings(path)
-    assert all(min(m.scale) > 0 for m in result.hrdf.meshes)
-    assert any("negative scale" in w and "mirrored copy" in w for w in _warnings(result))
+    mirrored = [m for m in result.hrdf.meshes if min(m.scale) < 0]
+    assert mirrored, "tiago's mirrored arm meshes"
+    assert {m.file for m in mirrored} >= {"meshes/arm_1.stl", "meshes/arm_6-wrist-2017.stl"}
+    assert {m.scale for m in mirrored} >= {(1.0, -1.0, -1.0), (-1.0, -1.0, -1.0)}
+    assert not any("negative scale" in w or "mirrored" in w for w in _warnings(result))
     report = roundtrip(path, configs=20)
     assert report.ok, report.table()
 

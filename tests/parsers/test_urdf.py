@@ -228,10 +228,10 @@ def test_actuators_motor_option_keeps_effort(arm: Path) -> None:
     assert (rail.peak_torque, rail.ctrl_range, rail.peak_velocity) == (10.0, (-10.0, 10.0), 1.0)
 
 
-def test_negative_scale_mirrored_copy_matches_mujoco(arm: Path, write_tet) -> None:
-    """MuJoCo mirrors a mesh with a negative scale itself; our mirrored copy (positive
-    scale) must give the same compiled collision geom (MuJoCo re-centres each mesh on its
-    own volume centroid, so the geom pose checks the mirrored triangles)."""
+def test_negative_scale_kept_matches_mujoco(arm: Path, write_tet) -> None:
+    """MuJoCo mirrors a mesh with a negative scale itself; the row keeps that scale and
+    the file, and must give the same compiled collision geom (MuJoCo re-centres each mesh
+    on its own volume centroid, so the geom pose checks the mirrored triangles)."""
     write_tet(arm.parent.parent / "meshes" / "tetb.stl")  # MuJoCo reads binary STL only
     text = ARM.replace(
         '<collision><geometry><box size="0.2 0.2 0.1"/>',
@@ -241,8 +241,8 @@ def test_negative_scale_mirrored_copy_matches_mujoco(arm: Path, write_tet) -> No
     path.write_text(text)
     hrdf, warnings = urdf_to_hrdf_with_warnings(path, fixed_joints="site")
     mirrored = [m for m in hrdf.meshes if m.group == 3]
-    assert mirrored[0].scale == (1.0, 2.0, 1.0) and "mirrored" in mirrored[0].file
-    assert any("negative scale" in str(w) for w in warnings)
+    assert mirrored[0].scale == (1.0, -2.0, 1.0) and mirrored[0].file.endswith("tetb.stl")
+    assert not any("negative scale" in str(w) for w in warnings)
     ref = urdf_mujoco_view(path)
     ours = view_from_model(our_mjcf_model(hrdf))
     row = next(

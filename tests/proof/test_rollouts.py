@@ -188,3 +188,68 @@ def test_round_off_alone_is_no_simulation_difference(tmp_path) -> None:
     geared = spec.compile()
     found = rollout.rollout_differences(geared, ours, qmap, amap)
     assert "simulation, pseudo-random control, 200 steps" in [d.field for d in found]
+
+
+_BODY = """<mujoco><worldbody><body name="b" pos="0 0 1"><freejoint/>
+  <geom type="box" size="0.1 0.2 0.3" contype="0" conaffinity="0"/>
+  <inertial pos="0 0 0" mass="2" {inertia}/></body></worldbody></mujoco>"""
+
+
+def test_an_inertia_in_other_principal_axes_is_the_same_body() -> None:
+    """One tensor, written once as its principal moments in MuJoCo's order and once in
+    another order with the axes turned to match: the round-off twin takes the result's
+    axes (with the body's bounding volumes, built in them); a tensor 1 % larger stays
+    the source's."""
+    from robotwright.proof.rollout import round_off_twin
+
+    full = mujoco.MjModel.from_xml_string(
+        _BODY.format(inertia='fullinertia="0.4 0.35 0.3 0.01 0.02 0.03"')
+    )
+    moments, quat = full.body_inertia[1], full.body_iquat[1]
+    # the same axes listed y, z, x: turn the frame so that its x is the old y, and so on
+    turn = np.zeros(4)
+    mujoco.mju_mat2Quat(turn, np.array([[0, 0, 1], [1, 0, 0], [0, 1, 0]], float).reshape(-1))
+    turned = np.zeros(4)
+    mujoco.mju_mulQuat(turned, quat, turn)
+    other = mujoco.MjModel.from_xml_string(
+        _BODY.format(
+            inertia=f'diaginertia="{moments[1]:.17g} {moments[2]:.17g} {moments[0]:.17g}" '
+            f'quat="{" ".join(f"{v:.17g}" for v in turned)}"'
+        )
+    )
+    assert not np.allclose(other.body_inertia[1], full.body_inertia[1])
+    twin, taken = round_off_twin(full, other)
+    assert taken >= 1
+    assert np.array_equal(twin.body_iquat[1], other.body_iquat[1])
+    assert np.array_equal(twin.body_inertia[1], other.body_inertia[1])
+    larger = mujoco.MjModel.from_xml_string(
+        _BODY.format(inertia='fullinertia="0.404 0.3535 0.303 0.0101 0.0202 0.0303"')
+    )
+    kept, _ = round_off_twin(full, larger)
+    assert np.array_equal(kept.body_inertia[1], full.body_inertia[1])
+
+
+def test_a_urdf_source_is_simulated_against_mujocos_import(tmp_path) -> None:
+    """A URDF source is stepped beside MuJoCo's import of it (visual geoms left out of
+    ours as that import leaves them). Unitree's A1 with its fixed links merged: MuJoCo's
+    ``fusestatic`` and our merge give each merged body's tensor in other principal axes,
+    and on MuJoCo 4.0 a leg-to-leg mesh contact at zero depth then comes and goes
+    with the last digits: the twin that takes those axes moves as ours does."""
+    import pytest
+
+    from robotwright.catalog import find_entry
+    from robotwright.proof.roundtrip.run import SIMULATION_CHECK, roundtrip
+
+    entry = find_entry("a1")
+    if entry is None or Path(entry.path).suffix != ".urdf":
+        pytest.skip("a1 comes from example-robot-data (not installed)")
+    report = roundtrip(Path(entry.path), configs=3, urdf=False, fixed_joints="merge")
+    row = {r.check: r for r in report.rows}[SIMULATION_CHECK]
+    assert row.ok and row.compared == 1, row
+    assert report.simulated_model.ngeom < report.mjcf_model.ngeom  # no visual geoms
+    # the proof of convert simulates it too: no note
+    messages = convert(Path(entry.path), tmp_path / "a1", fixed_joints="merge", simulate=True)
+    assert not [m for m in messages if "simulation," in m], messages
+    # and a sitting robot is not a URDF's (its massless links have no match): no row
+    sites = roundtrip(Path(entry.path), configs=3, urdf=False, fixed_joints="site")
+    assert SIMULATION_CHECK not in {r.check for r in sites.rows}

@@ -324,7 +324,9 @@ class MeshGeom(Geom):
         name: mesh asset name; the file is ``meshes/<name>.<mesh_file_type>`` unless
             ``file`` is set. Several rows may share one mesh (e.g. visual + collision).
         file: mesh file path relative to the HRDF folder, or ``None`` for the default.
-        scale: per-axis scale applied to the mesh vertices.
+        scale: per-axis scale applied to the mesh vertices (unitless); a negative factor
+            mirrors the mesh on that axis, as MuJoCo does: it hulls the file's own
+            vertices and mirrors the hull, which no mirrored copy of the file reproduces.
         inertia: MuJoCo's mesh inertia mode (one of :data:`MESH_INERTIA_MODES`: how it
             computes the mesh's volume, centre and inertia; ``"shell"`` for open or flat
             meshes), or ``None`` for MuJoCo's default (legacy).

@@ -28,6 +28,10 @@ from robotwright.hrdf.validate_common import (
     _quat_problem,
 )
 
+#: Smallest and largest size of a mesh scale factor; a factor's sign is free (negative
+#: mirrors the mesh on that axis, as in MuJoCo, which hulls and weighs it mirrored).
+MESH_SCALE = (1e-6, 1e6)
+
 
 def _mesh_file(hrdf: HRDF, mesh: MeshGeom) -> str:
     # Plain strings: this runs for every mesh row on every load.
@@ -123,9 +127,15 @@ def _check_geoms(hrdf: HRDF, body_names: set[str], check_files: bool) -> list[Pr
         if not m.name:
             out.append(Problem("mesh.csv", "empty mesh name", row=i, column="name"))
             continue
-        if m.scale != unit and any(not s > 0 for s in m.scale):
+        if m.scale != unit and any(not MESH_SCALE[0] <= abs(s) <= MESH_SCALE[1] for s in m.scale):
             out.append(
-                Problem("mesh.csv", f"scale {m.scale}: expected > 0", row=i, column="scale0")
+                Problem(
+                    "mesh.csv",
+                    f"scale {m.scale}: expected each between {MESH_SCALE[0]:g} and "
+                    f"{MESH_SCALE[1]:g} in size (a negative one mirrors the mesh on that axis)",
+                    row=i,
+                    column="scale0",
+                )
             )
         if m.inertia is not None and m.inertia not in MESH_INERTIA_MODES:
             out.append(

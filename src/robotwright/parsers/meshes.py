@@ -33,8 +33,6 @@ import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from robotwright._atomic import atomic_path
 from robotwright._temporaries import prefix
 
@@ -60,7 +58,7 @@ class StagedMesh:
         source: the original file.
         rel: path relative to the staging folder (``meshes/<name>.<ext>``).
         converted: why the file was rewritten (``"format"``, ``"ascii-stl"``,
-            ``"heavy-stl"``, ``"obj-objects"``, ``"mirrored"``), or ``None`` for a
+            ``"heavy-stl"``, ``"obj-objects"``), or ``None`` for a
             link/copy of the source.
         faces: face count when known (converted files and binary STL headers), else None.
         obj_objects: faces per object of an OBJ holding several (see
@@ -113,7 +111,7 @@ def _adopt_temp_folder(path: str) -> TempFolder:
 
 @dataclass
 class MeshStore:
-    """Stages mesh files into ``root/meshes``; one entry per distinct source (and mirror).
+    """Stages mesh files into ``root/meshes``; one entry per distinct source.
 
     ``join_obj_objects``: convert OBJ files holding several objects into one mesh with
     all their triangles (MuJoCo reads the first object only)."""
@@ -184,20 +182,6 @@ class MeshStore:
         self.staged[key] = entry
         return entry
 
-    def add_mirrored(self, source: Path, signs: tuple[float, float, float]) -> StagedMesh:
-        """Stage ``source`` mirrored by the per-axis ``signs`` (each +1 or -1): vertices
-        are multiplied by the signs; trimesh reverses the face winding of a reflection so
-        that normals still point outwards."""
-        key = f"{source.resolve()}#mirror{signs}"
-        if key in self.staged:
-            return self.staged[key]
-        mesh = load_triangles(source)
-        mesh.apply_transform(np.diag([*signs, 1.0]))
-        rel, faces = self._write(mesh, _safe_stem(source) + "_mirrored")
-        entry = StagedMesh(source, rel, "mirrored", faces)
-        self.staged[key] = entry
-        return entry
-
 
 def rewrite_staged(store: MeshStore, rel: str) -> str:
     """Rewrite the staged file ``rel`` with trimesh (triangles unchanged; normals and
@@ -234,7 +218,6 @@ def conversion_note(staged: StagedMesh) -> str | None:
         "obj-objects": f"{len(staged.obj_objects)} objects (faces {list(staged.obj_objects)}), "
         f"of which MuJoCo reads the first only: joined into one {target} ({staged.rel}); "
         "triangles unchanged, the file's normals/texture coordinates dropped",
-        "mirrored": None,
     }.get(staged.converted or "")
 
 

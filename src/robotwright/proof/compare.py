@@ -301,8 +301,9 @@ def prove(
     robot holds), and MuJoCo's import of our URDF against that MJCF
     (:func:`robotwright.proof.urdf_output.prove_urdf_output`: what a URDF holds).
 
-    ``simulate``: an MJCF source and the output are also stepped side by side
-    (:mod:`robotwright.proof.rollout`; not with ``root_body``)."""
+    ``simulate``: the source and the output are also stepped side by side
+    (:mod:`robotwright.proof.rollout`; not with ``root_body``; a URDF source as MuJoCo
+    imports it, the output without its visual geoms, as that import leaves them out)."""
     options = dict(options or {})
     from robotwright.generators.compiles import too_deep_for_mjcf
 
@@ -343,7 +344,7 @@ def prove(
         options=families is None,
         geom_order=kind != "urdf",
     )
-    if simulate and kind == "mjcf" and root is None:
+    if simulate and root is None:
         diffs += _rollouts(src, res) or []
     return found + as_problems(str(source), uncovered(diffs, [*notes, *written]))
 

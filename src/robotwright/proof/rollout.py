@@ -66,8 +66,9 @@ ROUND_OFF = 1e-12
 
 def round_off_twin(source: mujoco.MjModel, result: mujoco.MjModel) -> tuple[mujoco.MjModel, int]:
     """A copy of ``source`` in which each numeric array that differs from the result's
-    by round-off only (:data:`ROUND_OFF`; same shape) takes the result's values, and how
-    many arrays that was. Every other array stays the source's: a value changed beyond
+    by round-off only (:data:`ROUND_OFF`; same shape) takes the result's values, as does
+    each body whose inertia tensor is the result's written in other principal axes
+    (:func:`_same_inertias`), and how many arrays and bodies that was. Every other array stays the source's: a value changed beyond
     round-off, a mesh hull of another size, objects in another order."""
     twin = copy.copy(source)
     taken = 0
@@ -83,7 +84,44 @@ def round_off_twin(source: mujoco.MjModel, result: mujoco.MjModel) -> tuple[mujo
         if np.isfinite(scale) and np.all(np.abs(a - b) <= ROUND_OFF * max(scale, 1.0)):
             getattr(twin, name)[...] = b
             taken += 1
-    return twin, taken
+    return twin, taken + _same_inertias(twin, result)
+
+
+def _same_inertias(twin: mujoco.MjModel, result: mujoco.MjModel) -> int:
+    """Give ``twin`` the result's principal moments and axes of each body whose inertia
+    tensor (in the body frame) is the twin's within round-off, with the body's part of
+    the bounding volume tree, which MuJoCo builds in those axes: one tensor written as
+    other principal axes (a fixed link merged by another route, its axes found in another
+    order) is the same body. Returns how many bodies took them."""
+    if twin.nbody != result.nbody or twin.nbvh != result.nbvh:
+        return 0
+
+    def tensors(model: mujoco.MjModel) -> np.ndarray:
+        rot = np.empty((model.nbody, 9))
+        for b in range(model.nbody):
+            mujoco.mju_quat2Mat(rot[b], model.body_iquat[b])
+        rot = rot.reshape(-1, 3, 3)
+        return rot @ (model.body_inertia[:, :, None] * rot.transpose(0, 2, 1))
+
+    mine, theirs = tensors(twin), tensors(result)
+    taken = 0
+    for b in range(twin.nbody):
+        same_tree = (twin.body_bvhadr[b], twin.body_bvhnum[b]) == (
+            result.body_bvhadr[b],
+            result.body_bvhnum[b],
+        )
+        if not same_tree or np.array_equal(twin.body_iquat[b], result.body_iquat[b]):
+            continue
+        scale = max(float(np.abs(mine[b]).max()), 1e-300)
+        if np.abs(mine[b] - theirs[b]).max() > ROUND_OFF * scale:
+            continue
+        twin.body_inertia[b] = result.body_inertia[b]
+        twin.body_iquat[b] = result.body_iquat[b]
+        nodes = slice(twin.body_bvhadr[b], twin.body_bvhadr[b] + twin.body_bvhnum[b])
+        for name in ("bvh_aabb", "bvh_child", "bvh_nodeid", "bvh_depth"):
+            getattr(twin, name)[nodes] = getattr(result, name)[nodes]
+        taken += 1
+    return taken
 
 
 def _steps(

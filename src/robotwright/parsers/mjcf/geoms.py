@@ -174,18 +174,10 @@ def _geoms(
                         where,
                     )
                 src = _mesh_source(m_spec, spec, base_dir, sub_dirs, trusted)
-                signs = tuple(-1.0 if v < 0 else 1.0 for v in m_spec.scale)
                 try:
-                    if -1.0 in signs:
-                        # HRDF scales are positive: the reflection goes into a mirrored copy.
-                        staged = store.add_mirrored(src, signs)
-                        rep.warn(
-                            f"mesh '{m_spec.file}' with negative scale {tuple(m_spec.scale.tolist())}: "
-                            f"mirrored copy written ({staged.rel}), scale made positive",
-                            where,
-                        )
-                    else:
-                        staged = store.add(src)
+                    # A negative scale stays in the row: MuJoCo mirrors the hull it made
+                    # of the file's own vertices, which a mirrored copy would not give.
+                    staged = store.add(src)
                 except (MeshConversionError, OSError) as exc:
                     raise ConversionError([Problem(str(path), str(exc), element=where)]) from exc
                 note = conversion_note(staged)
@@ -216,7 +208,7 @@ def _geoms(
                 MeshGeom(
                     name=mname,
                     file=rel,
-                    scale=_t3(np.abs(m_spec.scale)),
+                    scale=_t3(m_spec.scale),
                     inertia=None if mode == "legacy" else mode,
                     pos=pos,
                     quat=quat,

@@ -169,17 +169,8 @@ class _URDFReader:
             scale = _t(_floats(shape.get("scale"), 3, (1, 1, 1), where, "<mesh scale>", self.rep))
             try:
                 path = resolve_uri(uri, self.path, self.opt.package_map, self.opt.mesh_root)
-                if any(v < 0 for v in scale):
-                    signs = tuple(-1.0 if v < 0 else 1.0 for v in scale)
-                    staged = self.store.add_mirrored(path, signs)
-                    scale = tuple(abs(v) for v in scale)
-                    self.rep.warn(
-                        f"mesh '{uri}' with negative scale: mirrored copy written "
-                        f"({staged.rel}), scale {scale} kept",
-                        where,
-                    )
-                else:
-                    staged = self.store.add(path)
+                # A negative scale (a mirrored mesh) is kept as MuJoCo reads it.
+                staged = self.store.add(path)
             except UnresolvedMesh as exc:
                 self.unresolved.append(Problem(self.rep.file, str(exc), element=where))
                 return None

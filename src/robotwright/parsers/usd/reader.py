@@ -234,6 +234,7 @@ class _Builder:
         self, newton: Any, nb: Any, stage: Any, rep: Reporter, mesh_dir: Path, found: dict
     ) -> None:
         self.newton, self.nb, self.stage, self.rep, self.mesh_dir = newton, nb, stage, rep, mesh_dir
+        self._xforms: Any = None  # pxr's cache of world transforms, made when first needed
         self.order = {str(p.GetPath()): i for i, p in enumerate(stage.Traverse())}
         self.unread: Counter[str] = Counter()
         self.names = _Names(display_names(stage))
@@ -391,6 +392,8 @@ class _Builder:
             site.size[: len(size)] = size
             self._mjc(site, label, _SITE_ATTRS)
             return
+        if size is None:
+            scale, quat = self._mirror_kept(s, scale, quat)
         geom = body.add_geom(name=self.names("geom", label), type=kind, pos=pos, quat=quat)
         if size is not None:
             geom.size[: len(size)] = size
@@ -449,6 +452,49 @@ class _Builder:
         for name, n in sorted(self.unread.items()):
             self.rep.warn(f"{name} on {n} prim(s): not carried")
 
+    def _mirror_kept(self, s: int, scale: np.ndarray, quat: np.ndarray):
+        """A mesh shape's scale and orientation in its body, its mirror kept as authored.
+
+        Newton folds a collision mesh's mirror into its scale and rotation (``1 -1 1``
+        reads as ``-1 -1 -1`` turned half a turn: the same mesh, another frame), and
+        splits a visual mesh's transform into a rotation and positive scales, which loses
+        the mirror. Where the prim's transform in its body is a rotation times its own
+        authored scale, that scale and rotation are taken (the source's, as written);
+        otherwise, where the prim mirrors and Newton's scale does not, the scale is
+        negated and the rotation taken from the USD to match."""
+        label = self.nb.shape_label[s]
+        prim = self.stage.GetPrimAtPath(label) if label.startswith("/") else None
+        if not prim:
+            return scale, quat
+        from pxr import UsdGeom
+
+        authored = np.ones(3)
+        for op in UsdGeom.Xformable(prim).GetOrderedXformOps():
+            if op.GetOpType() == UsdGeom.XformOp.TypeScale:
+                authored = authored * np.asarray(op.Get(), dtype=float)
+        if np.all(authored > 0) and np.prod(scale) > 0:
+            return scale, quat  # no mirror anywhere: Newton's reading as it is
+        if self._xforms is None:
+            self._xforms = UsdGeom.XformCache()
+        # Gf matrices act on row vectors: the transpose is the usual linear map.
+        linear = np.array(self._xforms.GetLocalToWorldTransform(prim), dtype=float)[:3, :3].T
+        b = int(self.nb.shape_body[s])
+        body_prim = self.stage.GetPrimAtPath(self.nb.body_label[b]) if b >= 0 else None
+        if body_prim:
+            frame = np.array(self._xforms.GetLocalToWorldTransform(body_prim), dtype=float)
+            frame = frame[:3, :3].T
+            linear = (frame / np.linalg.norm(frame, axis=0)).T @ linear
+        for factors in (authored, -np.abs(scale)):
+            rotation = linear @ np.diag(1.0 / factors)
+            if (
+                np.abs(rotation.T @ rotation - np.eye(3)).max() < 1e-5
+                and np.linalg.det(rotation) > 0
+            ):
+                turned = np.zeros(4)
+                mujoco.mju_mat2Quat(turned, rotation.reshape(-1))
+                return factors, turned
+        return scale, quat
+
     def _mesh(self, s: int, scale: np.ndarray) -> str:
         import trimesh
 
@@ -457,16 +503,19 @@ class _Builder:
         points = _mesh_prim(self.stage, label)
         if points is None:  # Newton's copy
             points = (src.vertices, np.asarray(src.indices).reshape(-1, 3))
-        vertices = np.asarray(points[0], dtype=np.float64) * scale
+        vertices = np.asarray(points[0], dtype=np.float64)
         faces = np.asarray(points[1], dtype=np.int64)
+        # The scale stays the mesh's, not the file's: a negative one mirrors the mesh,
+        # and MuJoCo mirrors the hull it made of the points as authored.
+        scale = np.asarray(scale, dtype=np.float64)
         # One asset per distinct mesh: a flattened USD repeats the points of each use.
-        key = (hashlib.sha1(vertices.tobytes() + faces.tobytes()).hexdigest(),)
+        key = (hashlib.sha1(vertices.tobytes() + faces.tobytes() + scale.tobytes()).hexdigest(),)
         if key in self.meshes:
             return self.meshes[key]
         name = self.names("mesh", label)
         file = f"{file_stem(name, 'mesh')}.stl"  # prim names are identifiers: unique still
         trimesh.Trimesh(vertices, faces, process=False).export(self.mesh_dir / file)
-        self.spec.add_mesh(name=name, file=file)
+        self.spec.add_mesh(name=name, file=file, scale=scale.tolist())
         self.meshes[key] = name
         return name
 

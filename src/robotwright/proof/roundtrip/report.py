@@ -54,6 +54,9 @@ class RoundTripReport:
     parse: ParseResult | None = field(default=None, repr=False)
     #: MuJoCo's compile of our MJCF of that robot (None when not written or refused).
     mjcf_model: mujoco.MjModel | None = field(default=None, repr=False)
+    #: Our MJCF as the simulation row steps it: ``mjcf_model``, or for a URDF source the
+    #: same compiled without visual geoms, as MuJoCo's import of the source leaves them.
+    simulated_model: mujoco.MjModel | None = field(default=None, repr=False)
     #: MuJoCo's model of the source (None when the reference is not MuJoCo's).
     reference_model: mujoco.MjModel | None = field(default=None, repr=False)
 

@@ -83,12 +83,11 @@ def roundtrip(
         with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
             work = {**options, "work_dir": tmp}
             report = _roundtrip(Path(source), configs, urdf, reference, work)
-    # As in convert, an MJCF source read whole: a URDF's reference is MuJoCo's own import
-    # of it, with its conventions; a robot taken out of a larger world (root_body) has a
-    # reference that still holds the rest of that world.
-    whole = options.get("root_body") is None
-    mjcf = Path(source).suffix.lower() in (".xml", ".mjcf")
-    if simulate and mjcf and whole and not report.error:
+    # As in convert, a source read whole: a robot taken out of a larger world (root_body)
+    # has a reference that still holds the rest of that world; a URDF's massless leaf
+    # links made sites have no counterpart in MuJoCo's import (which keeps them bodies).
+    whole = options.get("root_body") is None and options.get("fixed_joints") != "site"
+    if simulate and whole and not report.error:
         report.rows.insert(_after_mjcf_rows(report), simulation_row(report))
     return report
 
@@ -109,14 +108,21 @@ def simulation_row(report: RoundTripReport) -> Row:
 
     source = report.reference_model
     ours = report.mjcf_model
-    if source is None or ours is None:
+    if source is None or ours is None or not report.reference.startswith("mujoco"):
         return Row(SIMULATION_CHECK, "no MuJoCo model of the source", True, compared=0)
+    ours = report.simulated_model or ours
     found = _rollouts(source, ours)
     if found is None:
         return Row(SIMULATION_CHECK, "not comparable one to one", True, compared=0)
     if not found:
         return Row(SIMULATION_CHECK, "the same motion (within 1e-6)", True, compared=1)
     return Row(SIMULATION_CHECK, "; ".join(d.result for d in found), False, compared=1)
+
+
+def _without_visuals(mjcf_text: str) -> mujoco.MjModel:
+    spec = mujoco.MjSpec.from_string(mjcf_text)
+    spec.compiler.discardvisual = True
+    return spec.compile()
 
 
 def _check_input(path: Path, configs: int) -> None:
@@ -202,6 +208,9 @@ def _roundtrip_on(
     # MuJoCo; a fallback runs only if needed.
     ref_job = pool.submit(loader.started())
     mjcf_job = pool.submit(lambda: mujoco.MjSpec.from_string(mjcf_text).compile())
+    # The simulation row's model of a URDF source: without the visual geoms that MuJoCo's
+    # import of the source leaves out (compiled while the staged meshes are there).
+    sim_job = pool.submit(_without_visuals, mjcf_text) if source_kind(path) != "mjcf" else None
     ours_urdf: OurURDF | Exception | None = None
     urdf_job = None
     if urdf:
@@ -223,6 +232,7 @@ def _roundtrip_on(
     report.reference_model = ref.model
     try:
         report.mjcf_model = mjcf_job.result()
+        report.simulated_model = sim_job.result() if sim_job else report.mjcf_model
         ours = view_from_model(report.mjcf_model)
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
