@@ -68,8 +68,9 @@ def round_off_twin(source: mujoco.MjModel, result: mujoco.MjModel) -> tuple[mujo
     """A copy of ``source`` in which each numeric array that differs from the result's
     by round-off only (:data:`ROUND_OFF`; same shape) takes the result's values, as does
     each body whose inertia tensor is the result's written in other principal axes
-    (:func:`_same_inertias`), and how many arrays and bodies that was. Every other array stays the source's: a value changed beyond
-    round-off, a mesh hull of another size, objects in another order."""
+    (:func:`_same_inertias`), and how many arrays and bodies that was. Every other array
+    stays the source's: a value changed beyond round-off, a mesh hull of another size,
+    objects in another order."""
     twin = copy.copy(source)
     taken = 0
     for name in dir(source):

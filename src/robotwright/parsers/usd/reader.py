@@ -452,7 +452,9 @@ class _Builder:
         for name, n in sorted(self.unread.items()):
             self.rep.warn(f"{name} on {n} prim(s): not carried")
 
-    def _mirror_kept(self, s: int, scale: np.ndarray, quat: np.ndarray):
+    def _mirror_kept(
+        self, s: int, scale: np.ndarray, quat: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         """A mesh shape's scale and orientation in its body, its mirror kept as authored.
 
         Newton folds a collision mesh's mirror into its scale and rotation (``1 -1 1``
