@@ -174,8 +174,11 @@ def test_random_urdf_changed_mass_is_found(tmp_path, monkeypatch, seed: int) -> 
     src = tmp_path / "r.urdf"
     src.write_text(_urdf(seed))
     lost = [m for m in convert(src, tmp_path / "out") if "proof:" in m]
-    assert lost and all(f"'{target}'" in m for m in lost), lost
-    assert any("body_mass" in m for m in lost), lost
+    # each static note names the body; the simulation (URDF sources are stepped beside
+    # MuJoCo's import) may show the motion that follows, named by its joint
+    static = [m for m in lost if "proof: simulation," not in m]
+    assert static and all(f"'{target}'" in m for m in static), lost
+    assert any("body_mass" in m for m in static), lost
 
 
 @pytest.mark.parametrize("seed", range(30))

@@ -73,7 +73,7 @@ def test_the_round_trip_legs_agree_with_one_at_a_time(tmp_path: Path) -> None:
 
     path = tmp_path / "tree.urdf"
     path.write_text(tree_urdf(40, branching=3))
-    report = roundtrip(path, configs=3)
+    report = roundtrip(path, configs=3, simulate=False)  # the static legs only
     hrdf = parse_source(path).hrdf
     ref, ours = reference_view(path), view_from_model(our_mjcf_model(hrdf))
     alone = [

@@ -57,6 +57,11 @@ class RoundTripReport:
     #: Our MJCF as the simulation row steps it: ``mjcf_model``, or for a URDF source the
     #: same compiled without visual geoms, as MuJoCo's import of the source leaves them.
     simulated_model: mujoco.MjModel | None = field(default=None, repr=False)
+    #: The source as the simulation row steps it: ``reference_model``, or for a URDF
+    #: read with ``fixed_joints="merge"`` MuJoCo's import with its fixed links fused
+    #: (``fusestatic``), as ``convert``'s proof steps it (kept apart, their geoms would
+    #: touch geoms that the merged robot holds in one body, which MuJoCo never collides).
+    simulated_reference: mujoco.MjModel | None = field(default=None, repr=False)
     #: MuJoCo's model of the source (None when the reference is not MuJoCo's).
     reference_model: mujoco.MjModel | None = field(default=None, repr=False)
 

@@ -106,11 +106,10 @@ def simulation_row(report: RoundTripReport) -> Row:
     one, more than :data:`~robotwright.proof.rollout.MAX_ROLLOUT_DOFS` DoF)."""
     from robotwright.proof.compare import _rollouts
 
-    source = report.reference_model
-    ours = report.mjcf_model
+    source = report.simulated_reference
+    ours = report.simulated_model
     if source is None or ours is None or not report.reference.startswith("mujoco"):
         return Row(SIMULATION_CHECK, "no MuJoCo model of the source", True, compared=0)
-    ours = report.simulated_model or ours
     found = _rollouts(source, ours)
     if found is None:
         return Row(SIMULATION_CHECK, "not comparable one to one", True, compared=0)
@@ -233,6 +232,12 @@ def _roundtrip_on(
     try:
         report.mjcf_model = mjcf_job.result()
         report.simulated_model = sim_job.result() if sim_job else report.mjcf_model
+        report.simulated_reference = ref.model
+        if source_kind(path) != "mjcf" and options.get("fixed_joints") == "merge":
+            from robotwright.proof.models import source_model
+
+            given = {k: v for k, v in options.items() if k != "work_dir"}
+            report.simulated_reference = source_model(path, "urdf", given)
         ours = view_from_model(report.mjcf_model)
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
