@@ -253,3 +253,23 @@ def test_a_urdf_source_is_simulated_against_mujocos_import(tmp_path) -> None:
     # and a sitting robot is not a URDF's (its massless links have no match): no row
     sites = roundtrip(Path(entry.path), configs=3, urdf=False, fixed_joints="site")
     assert SIMULATION_CHECK not in {r.check for r in sites.rows}
+
+
+def test_a_free_base_asked_for_is_in_the_roundtrip_reference_too() -> None:
+    """``--floating-base`` on a URDF: the round trip's reference (MuJoCo's import) gets
+    the same free joint, as ``convert``'s proof does; the joints then match one to one
+    and the robot, free, is simulated beside ours (before: ``joints 12/13``, FAIL)."""
+    import pytest
+
+    from robotwright.catalog import find_entry
+    from robotwright.proof.roundtrip.run import SIMULATION_CHECK, roundtrip
+
+    entry = find_entry("go2")
+    if entry is None or Path(entry.path).suffix != ".urdf":
+        pytest.skip("go2 comes from example-robot-data (not installed)")
+    report = roundtrip(Path(entry.path), configs=3, floating_base=True)
+    rows = {r.check: r for r in report.rows}
+    assert report.ok, report.table()
+    assert rows["MJCF: joints (ref/ours)"].value == "13/13"
+    assert rows[SIMULATION_CHECK].compared == 1 and rows[SIMULATION_CHECK].ok
+    assert report.simulated_reference.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE

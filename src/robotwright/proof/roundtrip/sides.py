@@ -242,9 +242,13 @@ def reference_loader(path: Path, reference: str = "auto", **options: Any) -> Ref
             raise
         return ReferenceLoader(functools.partial(fallback, exc))  # yourdfpy's from the start
     density = options.get("density")  # of links without <inertial>, as the parser's
+    # The free base the user asked for, as the parser gives it: not a difference.
+    floating = bool(options.get("floating_base"))
 
     def start_urdf() -> Callable[[], RobotView]:
-        call = start_confined(compile_urdf, text, density, roots=roots, what=str(path))
+        call = start_confined(
+            compile_urdf, text, density, floating=floating, roots=roots, what=str(path)
+        )
         return lambda: view_from_model(call(), "mujoco")
 
     return ReferenceLoader(lambda: start_urdf()(), fallback, start=start_urdf)
