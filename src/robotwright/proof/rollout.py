@@ -94,8 +94,9 @@ def _same_inertias(twin: mujoco.MjModel, result: mujoco.MjModel) -> int:
     the bounding volume tree, which MuJoCo builds in those axes: one tensor written as
     other principal axes (a fixed link merged by another route, its axes found in another
     order) is the same body. Returns how many bodies took them."""
-    # (Per body: MuJoCo 3.11 keeps more nodes after the bodies' trees, for meshes.)
-    if twin.nbody != result.nbody:
+    # The trees' leaves name geoms: taken only where each geom is on the same body in
+    # both. (Per body: MuJoCo 3.11 keeps more nodes after the bodies' trees, for meshes.)
+    if twin.nbody != result.nbody or not np.array_equal(twin.geom_bodyid, result.geom_bodyid):
         return 0
 
     def tensors(model: mujoco.MjModel) -> np.ndarray:
