@@ -5,7 +5,7 @@ so that MuJoCo's processing of a mesh cannot differ between the two."""
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -23,7 +23,15 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
     import, as the round trip's reference), or None when MuJoCo refuses it (nothing to
     prove against). The parser has checked the file's paths already; MuJoCo reads the
     file in a confined reader (:mod:`robotwright._confine`)."""
-    from robotwright._confine import run_confined
+    return start_source_model(path, kind, options)()
+
+
+def start_source_model(path: Path, kind: str, options: dict) -> Callable[[], mujoco.MjModel | None]:
+    """:func:`source_model` in two halves: the confined reader starts now, and the
+    returned call waits for the model. For a caller about to run MuJoCo on other
+    threads: a reader started while another thread holds one of MuJoCo's locks would
+    wait for it for ever (:func:`robotwright._confine.start_confined`)."""
+    from robotwright._confine import start_confined
     from robotwright.parsers.packages import source_read_roots
 
     # MuJoCo caches the meshes it decodes by file name, in the process that decodes
@@ -37,23 +45,31 @@ def source_model(path: Path, kind: str, options: dict) -> mujoco.MjModel | None:
             model, folder, meshdir, files = parsed
             if here:
                 _SOURCE_MESHES[id(model)] = _mesh_files(folder, meshdir, files)
-            return model
+            return lambda: model
     roots = source_read_roots(path, kind, options)
     from robotwright.parsers.api import prepare_read
 
     prepare_read()
     try:
-        compiled = run_confined(
+        call = start_confined(
             _compile_source, Path(path), kind, options, roots=roots, what=str(path)
         )
     except Exception:  # noqa: BLE001 - any refusal: MuJoCo has no model to compare with
-        return None
-    if compiled is None:
-        return None
-    model, meshes = compiled
-    if meshes is not None and here:
-        _SOURCE_MESHES[id(model)] = meshes
-    return model
+        return lambda: None
+
+    def finish() -> mujoco.MjModel | None:
+        try:
+            compiled = call()
+        except Exception:  # noqa: BLE001 - as above
+            return None
+        if compiled is None:
+            return None
+        model, meshes = compiled
+        if meshes is not None and here:
+            _SOURCE_MESHES[id(model)] = meshes
+        return model
+
+    return finish
 
 
 def _compiled_in_this_process() -> bool:

@@ -205,7 +205,16 @@ def _roundtrip_on(
         return report
     # MuJoCo's import, started in its confined reader before the pool's threads run
     # MuJoCo; a fallback runs only if needed.
-    ref_job = pool.submit(loader.started())
+    started = loader.started()
+    # A URDF merged: the simulation row steps it beside MuJoCo's fused import (see
+    # RoundTripReport.simulated_reference), started now for the same reason.
+    fused = None
+    if source_kind(path) != "mjcf" and options.get("fixed_joints") == "merge":
+        from robotwright.proof.models import start_source_model
+
+        given = {k: v for k, v in options.items() if k != "work_dir"}
+        fused = start_source_model(path, "urdf", given)
+    ref_job = pool.submit(started)
     mjcf_job = pool.submit(lambda: mujoco.MjSpec.from_string(mjcf_text).compile())
     # The simulation row's model of a URDF source: without the visual geoms that MuJoCo's
     # import of the source leaves out (compiled while the staged meshes are there).
@@ -226,18 +235,16 @@ def _roundtrip_on(
             ref = loader.instead(exc)
     except Exception as exc:
         report.error = f"no reference: {type(exc).__name__}: {exc}"
+        if fused:
+            fused()  # its reader waited for, not left behind
         return report
+    fused_model = fused() if fused else None
     report.reference = ref.kind
     report.reference_model = ref.model
     try:
         report.mjcf_model = mjcf_job.result()
         report.simulated_model = sim_job.result() if sim_job else report.mjcf_model
-        report.simulated_reference = ref.model
-        if source_kind(path) != "mjcf" and options.get("fixed_joints") == "merge":
-            from robotwright.proof.models import source_model
-
-            given = {k: v for k, v in options.items() if k != "work_dir"}
-            report.simulated_reference = source_model(path, "urdf", given)
+        report.simulated_reference = fused_model if fused else ref.model
         ours = view_from_model(report.mjcf_model)
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
