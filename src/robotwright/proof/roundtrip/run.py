@@ -77,17 +77,18 @@ def roundtrip(
             (parser, reference, compile) are reported in the table instead.
     """
     _check_input(Path(source), configs)
-    if "work_dir" in options:
-        report = _roundtrip(Path(source), configs, urdf, reference, options)
-    else:
-        with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
-            work = {**options, "work_dir": tmp}
-            report = _roundtrip(Path(source), configs, urdf, reference, work)
     # As in convert, a source read whole: a robot taken out of a larger world (root_body)
     # has a reference that still holds the rest of that world; a URDF's massless leaf
     # links made sites have no counterpart in MuJoCo's import (which keeps them bodies).
     whole = options.get("root_body") is None and options.get("fixed_joints") != "site"
-    if simulate and whole and not report.error:
+    stepped = simulate and whole
+    if "work_dir" in options:
+        report = _roundtrip(Path(source), configs, urdf, reference, options, stepped)
+    else:
+        with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
+            work = {**options, "work_dir": tmp}
+            report = _roundtrip(Path(source), configs, urdf, reference, work, stepped)
+    if stepped and not report.error:
         report.rows.insert(_after_mjcf_rows(report), simulation_row(report))
     return report
 
@@ -146,13 +147,18 @@ def _check_input(path: Path, configs: int) -> None:
 
 
 def _roundtrip(
-    path: Path, configs: int, urdf: bool, reference: str, options: dict[str, Any]
+    path: Path,
+    configs: int,
+    urdf: bool,
+    reference: str,
+    options: dict[str, Any],
+    stepped: bool = False,
 ) -> RoundTripReport:
     # The three MuJoCo imports (the source, our MJCF, our URDF) run on threads as soon as
     # each text is ready, beside the Python work that writes the next one: on a large
     # robot they are most of the time, and MuJoCo releases the interpreter while it works.
     with ThreadPoolExecutor(max_workers=3) as pool:
-        return _roundtrip_on(pool, path, configs, urdf, reference, options)
+        return _roundtrip_on(pool, path, configs, urdf, reference, options, stepped)
 
 
 def _roundtrip_on(
@@ -162,7 +168,10 @@ def _roundtrip_on(
     urdf: bool,
     reference: str,
     options: dict[str, Any],
+    stepped: bool = False,
 ) -> RoundTripReport:
+    """The table of :func:`roundtrip`; ``stepped``: the models its simulation row steps
+    are made too (see RoundTripReport.simulated_model and simulated_reference)."""
     report = RoundTripReport(str(path), "")
     try:
         # The parse reads the xacro itself (its messages name it); the references read
@@ -209,7 +218,8 @@ def _roundtrip_on(
     # A URDF merged: the simulation row steps it beside MuJoCo's fused import (see
     # RoundTripReport.simulated_reference), started now for the same reason.
     fused = None
-    if source_kind(path) != "mjcf" and options.get("fixed_joints") == "merge":
+    urdf_source = source_kind(path) != "mjcf"
+    if stepped and urdf_source and options.get("fixed_joints") == "merge":
         from robotwright.proof.models import start_source_model
 
         given = {k: v for k, v in options.items() if k != "work_dir"}
@@ -218,7 +228,7 @@ def _roundtrip_on(
     mjcf_job = pool.submit(lambda: mujoco.MjSpec.from_string(mjcf_text).compile())
     # The simulation row's model of a URDF source: without the visual geoms that MuJoCo's
     # import of the source leaves out (compiled while the staged meshes are there).
-    sim_job = pool.submit(_without_visuals, mjcf_text) if source_kind(path) != "mjcf" else None
+    sim_job = pool.submit(_without_visuals, mjcf_text) if stepped and urdf_source else None
     ours_urdf: OurURDF | Exception | None = None
     urdf_job = None
     if urdf:
