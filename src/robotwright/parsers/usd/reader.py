@@ -487,6 +487,8 @@ class _Builder:
             frame = frame[:3, :3].T
             linear = (frame / np.linalg.norm(frame, axis=0)).T @ linear
         for factors in (authored, -np.abs(scale)):
+            if not np.all(np.abs(factors) > 0):
+                continue  # a zero scale: no rotation to find (validation names it)
             rotation = linear @ np.diag(1.0 / factors)
             if (
                 np.abs(rotation.T @ rotation - np.eye(3)).max() < 1e-5
