@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotwright._rotations import compose_pose, mat_to_quat, mul_quat, quat_to_mat
+from robotwright._rotations import (
+    compose_pose,
+    mat_to_quat,
+    mul_quat,
+    quat_angle,
+    quat_angles,
+    quat_to_mat,
+)
 
 
 def _random_unit_quat(rng: np.random.Generator) -> np.ndarray:
@@ -34,3 +41,17 @@ def test_mat_to_quat_picks_nonnegative_w_and_round_trips() -> None:
         back = np.array(mat_to_quat(quat_to_mat(q)))
         assert back[0] >= 0.0
         assert np.abs(back - np.sign(q[0]) * q).max() < 1e-12
+
+
+def test_quat_angles_is_quat_angle_row_by_row() -> None:
+    rng = np.random.default_rng(5)
+    a = np.array([_random_unit_quat(rng) for _ in range(40)])
+    b = np.array([_random_unit_quat(rng) for _ in range(40)])
+    b[:10] = a[:10]  # no rotation between them
+    b[10:20] = -a[10:20]  # the same rotation, the other sign
+    b[20:25] = [mul_quat(q, (np.cos(1e-7), np.sin(1e-7), 0.0, 0.0)) for q in a[20:25]]
+    got = quat_angles(a, b)
+    want = np.array([quat_angle(x, y) for x, y in zip(a, b, strict=True)])
+    assert np.abs(got - want).max() < 1e-12
+    assert got[:20].max() < 1e-12
+    assert np.abs(got[20:25] - 2e-7).max() < 1e-15

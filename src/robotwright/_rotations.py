@@ -16,6 +16,7 @@ __all__ = [
     "mat_to_quat",
     "mul_quat",
     "quat_angle",
+    "quat_angles",
     "quat_to_mat",
     "rpy_to_quat",
 ]
@@ -81,3 +82,13 @@ def quat_angle(a: Sequence[float], b: Sequence[float]) -> float:
     mujoco.mju_negQuat(inv, np.asarray(a, dtype=np.float64))
     mujoco.mju_mulQuat(rel, inv, np.asarray(b, dtype=np.float64))
     return 2.0 * math.atan2(float(np.linalg.norm(rel[1:])), abs(float(rel[0])))
+
+
+def quat_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:func:`quat_angle` of each row pair of two ``(n, 4)`` arrays of unit quaternions
+    (w, x, y, z) [rad], at once."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    # conj(a) * b: its real part is the dot product, its vector part aw bv - bw av - av x bv
+    real = np.einsum("ni,ni->n", a, b)
+    vec = a[:, :1] * b[:, 1:] - b[:, :1] * a[:, 1:] - np.cross(a[:, 1:], b[:, 1:])
+    return 2.0 * np.arctan2(np.linalg.norm(vec, axis=1), np.abs(real))

@@ -9,6 +9,7 @@ import importlib.util
 import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -48,6 +49,8 @@ def test_export_carries_drives_and_proves_equal(name, tmp_path):
     # One self-contained layer: nothing refers back to the conversion's temporary folder.
     assert not stage.GetRootLayer().subLayerPaths
     assert all(len(layer.externalReferences) == 0 for layer in stage.GetUsedLayers())
+    assert "robotwright" in stage.GetRootLayer().documentation  # not the temporary folder
+    assert tempfile.gettempdir() not in stage.GetRootLayer().ExportToString()
     assert str(stage.GetDefaultPrim().GetPath()) == f"/{hrdf.name}"
     roots = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.ArticulationRootAPI)]
     assert len(roots) == 1
@@ -314,3 +317,91 @@ def test_keyframes_and_tendon_actuators_are_named_where_the_usd_cannot_hold_them
     assert "2 keyframe(s) not carried (bent, straight)" in notes
     assert "actuator 'tendon_motor' drives a tendon, not a joint" in notes
     assert "shoulder_servo" not in notes and "shoulder" in done.drives
+
+
+def _newton_reading(stage):
+    """Every array of Newton's reading the proof compares, and each body's shape count."""
+    import numpy as np
+
+    from robotwright._warp import quiet_warp
+
+    quiet_warp()
+    import newton
+
+    builder = newton.ModelBuilder()
+    found = builder.add_usd(stage, load_visual_shapes=False, skip_mesh_approximation=True)
+    model = builder.finalize(device="cpu")
+    arrays = {
+        key: getattr(model, key).numpy()
+        for key in (
+            "body_mass", "body_com", "body_inertia", "joint_type", "joint_dof_dim",
+            "joint_X_p", "joint_X_c", "joint_axis", "joint_limit_lower", "joint_limit_upper",
+            "joint_target_ke", "joint_target_kd", "joint_effort_limit",
+            "joint_velocity_limit", "joint_q", "joint_parent", "joint_child",
+        )
+    }  # fmt: skip
+    shapes = np.bincount(model.shape_body.numpy() + 1, minlength=model.body_count + 1)[1:]
+    labels = (list(model.body_label), list(model.joint_label), dict(found["path_joint_map"]))
+    return arrays, dict(zip(model.body_label, shapes.tolist(), strict=True)), labels
+
+
+@pytest.mark.parametrize("name", ["talos", "g1", "go2"])
+def test_the_shapes_the_proof_leaves_out_change_nothing_newton_reads(name, tmp_path):
+    """The proof has Newton skip the shapes of bodies whose mass, centre of mass and
+    inertia are authored whole (USD then takes the body's own values): everything the
+    proof compares reads the same as with every shape, and a body whose inertia USD
+    computes from its colliders (talos' zero-inertia F/T links) keeps its shapes."""
+    import numpy as np
+
+    from robotwright.generators.usd_proof import _leave_out_shapes_that_change_nothing
+
+    out = tmp_path / f"{name}.usdc"
+    done = to_usd(robot_named(name), out, prove=False)
+    whole, whole_shapes, whole_labels = _newton_reading(Usd.Stage.Open(str(out)))
+    stage = Usd.Stage.Open(str(out))
+    left_out = _leave_out_shapes_that_change_nothing(stage)
+    assert left_out > 0
+    trimmed, trimmed_shapes, trimmed_labels = _newton_reading(stage)
+    assert trimmed_labels == whole_labels
+    for key, value in whole.items():
+        assert np.array_equal(trimmed[key], value), key
+    zero = {n.split("'")[1] for n in done.notes if "zero inertia" in n}
+    assert (name == "talos") == bool(zero)
+    computed = 0  # bodies with shapes whose inertia comes from them
+    for body, count in whole_shapes.items():
+        kept = trimmed_shapes[body]
+        if body.rsplit("/", 1)[-1] in zero:
+            assert kept == count, body  # its colliders give it its inertia
+            computed += count > 0
+        else:
+            assert kept == 0, body
+    assert computed == (4 if name == "talos" else 0)
+    assert Usd.Stage.Open(str(out)).GetPrimAtPath(stage.GetPseudoRoot().GetPath())  # file unchanged
+    assert not Usd.Stage.Open(str(out)).GetSessionLayer().rootPrims
+
+
+def test_a_body_without_its_centre_of_mass_keeps_its_shapes_for_newton(tmp_path):
+    """USD computes a centre of mass not given from the body's colliders: a body whose
+    ``centerOfMass`` is blocked keeps its shapes, and Newton reads it as with every shape
+    (off the body's origin, where no shape would put it)."""
+    import numpy as np
+
+    from robotwright.generators.usd_proof import _leave_out_shapes_that_change_nothing
+
+    out = tmp_path / "arm6.usda"
+    to_usd(load_robot("arm6"), out, prove=False)
+    stage = Usd.Stage.Open(str(out))
+    prim = next(p for p in stage.Traverse() if p.GetName() == "forearm_link")
+    UsdPhysics.MassAPI(prim).GetCenterOfMassAttr().Block()
+    stage.Save()
+    whole, whole_shapes, _ = _newton_reading(Usd.Stage.Open(str(out)))
+    trimmed_stage = Usd.Stage.Open(str(out))
+    assert _leave_out_shapes_that_change_nothing(trimmed_stage) > 0
+    trimmed, trimmed_shapes, _ = _newton_reading(trimmed_stage)
+    forearm = next(b for b in whole_shapes if b.endswith("/forearm_link"))
+    assert trimmed_shapes[forearm] == whole_shapes[forearm] > 0
+    assert sum(trimmed_shapes.values()) == whole_shapes[forearm]
+    k = list(whole_shapes).index(forearm)
+    assert np.linalg.norm(whole["body_com"][k]) > 0.01
+    for key, value in whole.items():
+        assert np.array_equal(trimmed[key], value), key

@@ -435,7 +435,11 @@ def to_usd(
         # What the libraries said is passed on as notes, never as a difference: --strict
         # refuses what the proof finds, not another library's remarks.
         said = _library_notes(printed, "mujoco-usd-converter")
-        stage = Usd.Stage.Open(asset.path)
+        # Authored into the flattened layer, the file written: an edit of the converter's
+        # layered stage recomposes its payload, and the layers would be flattened anyway.
+        flat = Usd.Stage.Open(asset.path).Flatten()
+        flat.documentation = "Written by robotwright (to_usd) through mujoco-usd-converter"
+        stage = Usd.Stage.Open(flat)  # usd-core's note named the temporary folder
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
             root.SetDisplayName(hrdf.name)
@@ -458,22 +462,20 @@ def to_usd(
         _author_drives(stage, shown, hrdf, model, result)
         _exact_frames(stage, shown, model)
         _author_free_joint_names(stage, shown, model)
-        flat = stage.Flatten()
         if layout == "flat":
             from pxr import UsdPhysics
 
-            flat_stage = Usd.Stage.Open(flat)
-            _flatten_bodies(flat_stage)
+            _flatten_bodies(stage)
             result.joint_prims = {
                 p.GetName(): str(p.GetPath())
-                for p in flat_stage.Traverse()
+                for p in stage.Traverse()
                 if p.IsA(UsdPhysics.Joint) and p.GetName() in result.joint_prims
             }
         # Written and proven in the private temporary folder, then copied into place
         # through the output gate (a temporary of its own, renamed: nothing planted in
         # the user's folder is followed, and a refused proof leaves nothing there).
         written = Path(tmp) / f"robot{out_path.suffix.lower()}"
-        if not flat.Export(str(written)):
+        if not stage.GetRootLayer().Export(str(written)):
             raise GeneratorError(f"{out_path}: usd-core could not write the file")
         found = list(result.notes)
         if prove:

@@ -23,7 +23,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from robotwright._rotations import quat_angle, quat_to_mat
+from robotwright._rotations import quat_angles, quat_to_mat
 from robotwright.hrdf.model import HRDF
 
 __all__ = ["UsdProof", "prove_usd"]
@@ -146,6 +146,67 @@ def _same_kind(mj_type: int, newton_type: int, k: int, dof_dim: tuple[int, int],
     return k == 0 and single.get(mj_type) == newton_type
 
 
+def _mass_is_authored(prim) -> bool:
+    """Whether USD's rules take the body's mass, centre of mass and inertia from its own
+    ``MassAPI`` alone, its colliders adding nothing: a positive mass, a diagonal inertia
+    that is not all zero, and a finite centre of mass (a fallback value of the schema
+    means "not given", authored or not)."""
+    from pxr import UsdPhysics
+
+    api = UsdPhysics.MassAPI(prim)
+    if not api:
+        return False
+    mass = api.GetMassAttr().Get()
+    diag = api.GetDiagonalInertiaAttr().Get()
+    com = api.GetCenterOfMassAttr().Get()
+    return (
+        mass is not None
+        and math.isfinite(mass)
+        and mass > 0.0
+        and diag is not None
+        and any(v != 0.0 for v in diag)
+        and all(math.isfinite(v) and v >= 0.0 for v in diag)
+        and com is not None
+        and all(math.isfinite(v) for v in com)
+    )
+
+
+def _leave_out_shapes_that_change_nothing(stage) -> int:
+    """Deactivate, in the stage's session layer (the file is not changed), each geometry
+    prim whose body's mass is authored whole (:func:`_mass_is_authored`). Nothing the
+    proof compares lies in such a shape: the body's mass, centre of mass and inertia are
+    its ``MassAPI``'s, and bodies, joints, drives and poses are other prims. A body
+    whose mass USD computes from its colliders keeps them, so Newton reads it as a
+    simulator would. Returns the prims left out."""
+    from pxr import Sdf, Usd, UsdGeom, UsdPhysics
+
+    out: list = []
+    it = iter(Usd.PrimRange(stage.GetPseudoRoot()))
+    owner: dict = {}  # body prim path -> its mass is authored whole
+    for prim in it:
+        if prim.HasAPI(UsdPhysics.RigidBodyAPI):
+            owner[prim.GetPath()] = _mass_is_authored(prim)
+            continue
+        if not prim.IsA(UsdGeom.Gprim):
+            continue
+        path = prim.GetPath().GetParentPath()  # bodies come before what is under them
+        while path not in owner and path != Sdf.Path.absoluteRootPath:
+            path = path.GetParentPath()
+        # A shape is left out with everything under it, so only where nothing under it
+        # is a body or a joint.
+        if owner.get(path, False) and not any(
+            p.HasAPI(UsdPhysics.RigidBodyAPI) or p.IsA(UsdPhysics.Joint)
+            for p in Usd.PrimRange(prim)
+        ):
+            out.append(prim.GetPath())
+            it.PruneChildren()
+    layer = stage.GetSessionLayer()
+    with Sdf.ChangeBlock():  # one recomposition for all, not one a prim
+        for path in out:
+            Sdf.CreatePrimInLayer(layer, path).active = False
+    return len(out)
+
+
 def prove_usd(
     usd: str | Path,
     mjcf_model: mujoco.MjModel,
@@ -183,14 +244,15 @@ def prove_usd(
     wp = quiet_warp()  # before Newton initialises warp
     import newton
 
-    builder = newton.ModelBuilder()
-    # Nothing compared lies in a visual shape or a collision mesh's hull (each body's
-    # mass and inertia are on its prim): Newton skips reading and hulling them, which
-    # was most of the read on meshed robots (the G1: 1.8 of 2.3 s).
-    found = builder.add_usd(str(usd), load_visual_shapes=False, skip_mesh_approximation=True) or {}
-    model = builder.finalize(device="cpu")
     stage = Usd.Stage.Open(str(usd))
     names = display_names(stage)
+    _leave_out_shapes_that_change_nothing(stage)
+    builder = newton.ModelBuilder()
+    # Nothing compared lies in a visual shape or a collision mesh's hull: Newton skips
+    # reading and hulling them, which was most of the read on meshed robots (the G1:
+    # 1.8 of 2.3 s).
+    found = builder.add_usd(stage, load_visual_shapes=False, skip_mesh_approximation=True) or {}
+    model = builder.finalize(device="cpu")
     proof = UsdProof()
     diff = proof.differences
     mj = mjcf_model
@@ -200,8 +262,9 @@ def prove_usd(
     mass = model.body_mass.numpy()
     com = model.body_com.numpy()
     inertia = model.body_inertia.numpy()
+    body_names = [mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(mj.nbody)]
     for b in range(1, mj.nbody):
-        name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_BODY, b)
+        name = body_names[b]
         i = nb.get(name)
         if i is None:
             diff.append(f"body {name!r}: not in the USD")
@@ -218,9 +281,7 @@ def prove_usd(
                 f"body {name!r}: inertia tensor {want.round(9).tolist()} in MJCF, "
                 f"{np.asarray(inertia[i]).round(9).tolist()} in USD"
             )
-    extra = sorted(
-        set(nb) - {mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(mj.nbody)}
-    )
+    extra = sorted(set(nb) - set(body_names))
     for name in extra:
         diff.append(f"body {name!r}: in the USD, not in the MJCF")
 
@@ -311,10 +372,14 @@ def prove_usd(
     rng = np.random.default_rng(seed)
     data = mujoco.MjData(mj)
     state = model.state()
+    pairs = [(b, nb[n]) for b, n in enumerate(body_names) if b and n in nb]
+    ours = np.array([b for b, _ in pairs], dtype=int)
+    theirs = np.array([i for _, i in pairs], dtype=int)
     worst: dict[str, tuple[float, float, int]] = {}  # body -> (metres, radians, poses)
+    joint_q0 = model.joint_q.numpy()
     for _ in range(poses):
         qpos = mj.qpos0.copy()
-        joint_q = model.joint_q.numpy().copy()
+        joint_q = joint_q0.copy()
         for j, (s, _) in matched.items():
             a = mj.jnt_qposadr[j]
             t = int(mj.jnt_type[j])
@@ -337,20 +402,17 @@ def prove_usd(
             model.joint_qd,
             state,
         )
-        body_q = state.body_q.numpy()
         proof.poses += 1
-        for b in range(1, mj.nbody):
-            name = mujoco.mj_id2name(mj, mujoco.mjtObj.mjOBJ_BODY, b)
-            i = nb.get(name)
-            if i is None:
-                continue
-            err = float(np.abs(data.xpos[b] - body_q[i][:3]).max())
-            proof.max_pose_error = max(proof.max_pose_error, err)
-            x, y, z, w = body_q[i][3:]
-            ang = quat_angle(data.xquat[b], np.array([w, x, y, z]))
-            if err > max(tol, 2e-6) or ang > max(tol, 2e-6):
-                m, r, n = worst.get(name, (0.0, 0.0, 0))
-                worst[name] = (max(m, err), max(r, ang), n + 1)
+        if not pairs:
+            continue
+        body_q = state.body_q.numpy()[theirs]
+        err = np.abs(data.xpos[ours] - body_q[:, :3]).max(axis=1)
+        ang = quat_angles(data.xquat[ours], body_q[:, [6, 3, 4, 5]])  # x, y, z, w -> w, x, y, z
+        proof.max_pose_error = max(proof.max_pose_error, float(err.max()))
+        for k in np.flatnonzero((err > max(tol, 2e-6)) | (ang > max(tol, 2e-6))):
+            name = body_names[ours[k]]
+            m, r, n = worst.get(name, (0.0, 0.0, 0))
+            worst[name] = (max(m, float(err[k])), max(r, float(ang[k])), n + 1)
     for name, (m, r, n) in worst.items():
         diff.append(
             f"body {name!r}: world pose differs by up to {m:.3g} m, {r:.3g} rad (at {n} of "
