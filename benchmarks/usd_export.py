@@ -99,6 +99,11 @@ def _import_with_isaac_sim(importer, mjcf: Path, out: Path) -> None:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=5, help="alternating rounds per robot")
+    ap.add_argument(
+        "--without-isaac-sim",
+        action="store_true",
+        help="leave out Isaac Sim's importer (its rounds take most of the run's time)",
+    )
     args = ap.parse_args()
     try:
         import mujoco_usd_converter  # noqa: F401
@@ -109,8 +114,8 @@ def main() -> int:
     from robotwright.sources import load_robot
 
     warnings.simplefilter("ignore")  # the notes of each export are not what is timed
-    importer = _isaac_sim_importer()
-    if importer is None:
+    importer = None if args.without_isaac_sim else _isaac_sim_importer()
+    if importer is None and not args.without_isaac_sim:
         print(
             "Isaac Sim's MJCF importer is not installed here (isaacsim-asset-isolated): not timed"
         )
