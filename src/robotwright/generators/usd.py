@@ -430,16 +430,21 @@ def to_usd(
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         mjcf, lost = _robot_mjcf(hrdf, Path(tmp), root_at_origin)
+        # One flattened layer, as Isaac Sim's MJCF importer asks for it: what is authored
+        # next goes straight into the file written (an edit of the layered asset would
+        # recompose its payload, and it would be flattened anyway).
         with captured_library_output() as printed:
-            asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
+            asset = converter.Converter(layer_structure=False).convert(
+                str(mjcf), str(Path(tmp) / "usd")
+            )
         # What the libraries said is passed on as notes, never as a difference: --strict
         # refuses what the proof finds, not another library's remarks.
         said = _library_notes(printed, "mujoco-usd-converter")
-        # Authored into the flattened layer, the file written: an edit of the converter's
-        # layered stage recomposes its payload, and the layers would be flattened anyway.
-        flat = Usd.Stage.Open(asset.path).Flatten()
-        flat.documentation = "Written by robotwright (to_usd) through mujoco-usd-converter"
-        stage = Usd.Stage.Open(flat)  # usd-core's note named the temporary folder
+        stage = Usd.Stage.Open(asset.path)
+        # usd-core's own note named the converter's temporary folder
+        stage.GetRootLayer().documentation = (
+            "Written by robotwright (to_usd) through mujoco-usd-converter"
+        )
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
             root.SetDisplayName(hrdf.name)
