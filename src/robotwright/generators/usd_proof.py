@@ -11,6 +11,11 @@ no drive), and forward kinematics: the world pose of every body at random joint
 positions (within the joint ranges) and, for a free base, a random base pose. Each
 difference is one line naming the body, joint or actuator, the field and both values.
 
+Newton reads no shape the comparison does not need: no visual shape, no collision mesh's
+hull, and no collision shape of a body whose mass, centre of mass and inertia the file
+gives on the body (:func:`_leave_out_shapes_that_change_nothing`); so a change to a
+shape is not seen here.
+
 Needs Newton (Isaac Lab's environment).
 """
 
