@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
@@ -82,12 +83,16 @@ def roundtrip(
     # links made sites have no counterpart in MuJoCo's import (which keeps them bodies).
     whole = options.get("root_body") is None and options.get("fixed_joints") != "site"
     stepped = simulate and whole
-    if "work_dir" in options:
-        report = _roundtrip(Path(source), configs, urdf, reference, options, stepped)
-    else:
-        with tempfile.TemporaryDirectory(prefix=prefix("rt")) as tmp:
-            work = {**options, "work_dir": tmp}
-            report = _roundtrip(Path(source), configs, urdf, reference, work, stepped)
+    with ExitStack() as stack:
+        if "work_dir" not in options:
+            tmp = stack.enter_context(tempfile.TemporaryDirectory(prefix=prefix("rt")))
+            options = {**options, "work_dir": tmp}
+        # The three MuJoCo imports (the source, our MJCF, our URDF) run on threads as soon
+        # as each text is ready, beside the Python work that writes the next one: on a
+        # large robot they are most of the time, and MuJoCo releases the interpreter while
+        # it works. The pool ends before the staged meshes go.
+        pool = stack.enter_context(ThreadPoolExecutor(max_workers=3))
+        report = _roundtrip_on(pool, Path(source), configs, urdf, reference, options, stepped)
     if stepped and not report.error:
         report.rows.insert(_after_mjcf_rows(report), simulation_row(report))
     return report
@@ -144,21 +149,6 @@ def _check_input(path: Path, configs: int) -> None:
         )
         raise ConversionError([Problem(str(path), f"{what}: expected a .urdf or .xml file")])
     parse_xml(path)  # not well-formed or unsafe XML: an input error, named with its line
-
-
-def _roundtrip(
-    path: Path,
-    configs: int,
-    urdf: bool,
-    reference: str,
-    options: dict[str, Any],
-    stepped: bool = False,
-) -> RoundTripReport:
-    # The three MuJoCo imports (the source, our MJCF, our URDF) run on threads as soon as
-    # each text is ready, beside the Python work that writes the next one: on a large
-    # robot they are most of the time, and MuJoCo releases the interpreter while it works.
-    with ThreadPoolExecutor(max_workers=3) as pool:
-        return _roundtrip_on(pool, path, configs, urdf, reference, options, stepped)
 
 
 def _roundtrip_on(
@@ -248,13 +238,13 @@ def _roundtrip_on(
         if fused:
             fused()  # its reader waited for, not left behind
         return report
-    fused_model = fused() if fused else None
+    simulated_reference = fused() if fused else ref.model
     report.reference = ref.kind
     report.reference_model = ref.model
     try:
         report.mjcf_model = mjcf_job.result()
         report.simulated_model = sim_job.result() if sim_job else report.mjcf_model
-        report.simulated_reference = fused_model if fused else ref.model
+        report.simulated_reference = simulated_reference
         ours = view_from_model(report.mjcf_model)
     except Exception as exc:
         report.error = f"our MJCF does not compile: {type(exc).__name__}: {exc}"
