@@ -3,7 +3,6 @@ functions. Quaternions are (w, x, y, z); angles in radians; positions in metres.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import mujoco
@@ -78,10 +77,7 @@ def compose_pose(
 def quat_angle(a: Sequence[float], b: Sequence[float]) -> float:
     """Angle [rad] of the rotation between two unit quaternions (w, x, y, z): atan2, not
     acos, so that it is exact near zero, where float32 poses live."""
-    inv, rel = np.empty(4), np.empty(4)
-    mujoco.mju_negQuat(inv, np.asarray(a, dtype=np.float64))
-    mujoco.mju_mulQuat(rel, inv, np.asarray(b, dtype=np.float64))
-    return 2.0 * math.atan2(float(np.linalg.norm(rel[1:])), abs(float(rel[0])))
+    return float(quat_angles(np.asarray(a)[None], np.asarray(b)[None])[0])
 
 
 def quat_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
