@@ -4,8 +4,8 @@ For each robot, rounds alternate between:
 
   converter   mujoco-usd-converter's ``Converter().convert`` on the robot's own MJCF
               (its default: a layered asset, several .usda files)
-  one file    the same converter with ``layer_structure=False``: one flattened file, as
-              ours writes, and as Isaac Sim's MJCF importer calls the converter
+  one file    the same converter with ``layer_structure=False``: one flattened file (what
+              ours writes), as Isaac Sim's MJCF importer calls the converter
   Isaac Sim   Isaac Sim's kit-less MJCF importer (``MJCFImporter``, default config: the
               converter, then Isaac's schemas, PhysX conversion and asset packaging):
               what an Isaac Lab 3 user runs to bring an MJCF robot in; only where

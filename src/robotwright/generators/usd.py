@@ -25,6 +25,7 @@ mujoco-usd-converter 0.6.1 beside MuJoCo 3.12).
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 import tempfile
@@ -37,7 +38,7 @@ import numpy as np
 
 from robotwright._atomic import copy_file_atomic
 from robotwright._names import file_stem
-from robotwright._rotations import quat_angle
+from robotwright._rotations import quat_angles
 from robotwright._temporaries import prefix
 from robotwright._usd_format import FREE_JOINT_ATTR, USD_SUFFIXES
 from robotwright._usd_names import display_names
@@ -242,9 +243,15 @@ def _author_drives(
         out.velocity_limits[act.joint] = v
 
 
-def _angle(a, b) -> float:
-    """Angle [rad] between two rotations given as Gf quaternions."""
-    return quat_angle([a.GetReal(), *a.GetImaginary()], [b.GetReal(), *b.GetImaginary()])
+def _quat(q) -> list[float]:
+    """A Gf quaternion as (w, x, y, z)."""
+    return [q.GetReal(), *q.GetImaginary()]
+
+
+def _set_joint_frame(joint, pos, rot) -> None:
+    """Set a joint's frame in its parent body (``localPos0``, ``localRot0``)."""
+    joint.GetLocalRot0Attr().Set(rot)
+    joint.GetLocalPos0Attr().Set(pos)
 
 
 def _exact_frames(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
@@ -253,7 +260,8 @@ def _exact_frames(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
     rounded: it passes them through a 32-bit ``Gf.Rotation``, which for a slightly
     tilted body (Gymnasium's humanoid's 0.004 rad) is off by ~3e-5 rad. Only a body
     whose prim sits in its parent body's prim, and a joint between a body and its
-    parent, is set; each must already be within 1e-3 rad and 1e-4 m of the compile."""
+    parent, is set; each must already be within 1e-3 rad and 1e-4 m of the compile
+    (the angles are checked at once, after every frame is gathered)."""
     from pxr import UsdGeom, UsdPhysics
 
     def body_of(prim) -> int:
@@ -263,6 +271,8 @@ def _exact_frames(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
             return 0  # the world, or the scope the root body's prim sits in
         return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, shown[str(prim.GetPath())])
 
+    # (value as written, the exact value, what sets it) for each frame found
+    found: list[tuple[object, object, object]] = []
     for prim in stage.Traverse():
         if prim.HasAPI(UsdPhysics.RigidBodyAPI):
             b = body_of(prim)
@@ -270,11 +280,9 @@ def _exact_frames(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
                 continue
             w, x, y, z = (float(v) for v in model.body_quat[b])
             for op in UsdGeom.Xformable(prim).GetOrderedXformOps():
-                if op.GetOpType() != UsdGeom.XformOp.TypeOrient:
-                    continue
-                exact = type(op.Get())(w, x, y, z)
-                if _angle(op.Get(), exact) < 1e-3:
-                    op.Set(exact)
+                if op.GetOpType() == UsdGeom.XformOp.TypeOrient:
+                    now = op.Get()
+                    found.append((now, type(now)(w, x, y, z), op.Set))
         elif prim.IsA(UsdPhysics.Joint):
             joint = UsdPhysics.Joint(prim)
             t0, t1 = joint.GetBody0Rel().GetTargets(), joint.GetBody1Rel().GetTargets()
@@ -287,16 +295,24 @@ def _exact_frames(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
             rot0, pos0 = joint.GetLocalRot0Attr().Get(), joint.GetLocalPos0Attr().Get()
             if None in (rot1, pos1, rot0, pos0):
                 continue
-            q1 = np.array([rot1.GetReal(), *rot1.GetImaginary()], dtype=np.float64)
             q0, p0 = np.empty(4), np.empty(3)
-            mujoco.mju_mulQuat(q0, model.body_quat[c], q1)
+            mujoco.mju_mulQuat(q0, model.body_quat[c], np.array(_quat(rot1), dtype=np.float64))
             mujoco.mju_rotVecQuat(p0, np.array([float(v) for v in pos1]), model.body_quat[c])
             p0 += model.body_pos[c]
-            exact = type(rot0)(*(float(v) for v in q0))
-            near = max(abs(float(a) - float(b)) for a, b in zip(pos0, p0, strict=True)) < 1e-4
-            if near and _angle(rot0, exact) < 1e-3:
-                joint.GetLocalRot0Attr().Set(exact)
-                joint.GetLocalPos0Attr().Set(type(pos0)(*(float(v) for v in p0)))
+            if max(abs(float(a) - float(b)) for a, b in zip(pos0, p0, strict=True)) >= 1e-4:
+                continue
+            exact_pos = type(pos0)(*(float(v) for v in p0))
+            set_frame = functools.partial(_set_joint_frame, joint, exact_pos)
+            found.append((rot0, type(rot0)(*(float(v) for v in q0)), set_frame))
+    if not found:
+        return
+    angles = quat_angles(
+        np.array([_quat(now) for now, _, _ in found], dtype=np.float64),
+        np.array([_quat(exact) for _, exact, _ in found], dtype=np.float64),
+    )
+    for (_, exact, set_exact), angle in zip(found, angles, strict=True):
+        if angle < 1e-3:
+            set_exact(exact)
 
 
 def _author_free_joint_names(stage, shown: dict[str, str], model: mujoco.MjModel) -> None:
@@ -430,17 +446,17 @@ def to_usd(
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         mjcf, lost = _robot_mjcf(hrdf, Path(tmp), root_at_origin)
-        # One flattened layer, as Isaac Sim's MJCF importer asks for it: what is authored
-        # next goes straight into the file written (an edit of the layered asset would
-        # recompose its payload, and it would be flattened anyway).
+        # The converter's own layered asset, in our private folder, flattened once in
+        # memory: what is authored next goes straight into the one layer written (an
+        # edit of the layered asset would recompose its payload; the converter's own
+        # one-file output writes, reopens and saves that layer, in the system's
+        # temporary folder, before we could open it).
         with captured_library_output() as printed:
-            asset = converter.Converter(layer_structure=False).convert(
-                str(mjcf), str(Path(tmp) / "usd")
-            )
+            asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
+            stage = Usd.Stage.Open(Usd.Stage.Open(asset.path).Flatten())
         # What the libraries said is passed on as notes, never as a difference: --strict
         # refuses what the proof finds, not another library's remarks.
         said = _library_notes(printed, "mujoco-usd-converter")
-        stage = Usd.Stage.Open(asset.path)
         # usd-core's own note named the converter's temporary folder
         stage.GetRootLayer().documentation = (
             "Written by robotwright (to_usd) through mujoco-usd-converter"
