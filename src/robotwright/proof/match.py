@@ -98,10 +98,19 @@ def _match(src: _Side, res: _Side, fam: str, body_map: dict[int, int]) -> dict[i
         cands = pool.get(_structure_key(src, fam, i, body_map))
         if cands:
             # The one in the same place with the same size, else the next in order (an
-            # import may list a link's unnamed geoms in another order).
+            # import may list a link's unnamed geoms in another order). The first that
+            # fits is taken: in the usual case, the same order, that is the first looked
+            # at, so matching n objects costs n steps, not n squared.
             here = _placement(src, fam, i)
-            same = [k for k, j in enumerate(cands) if _same(here, _placement(res, fam, j))]
-            out[i] = cands.pop(same[0] if same else 0)
+            same = (
+                None
+                if here is None
+                else next(
+                    (k for k, j in enumerate(cands) if _same(here, _placement(res, fam, j))),
+                    None,
+                )
+            )
+            out[i] = cands.pop(same or 0)
     return out
 
 
