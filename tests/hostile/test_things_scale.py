@@ -74,17 +74,23 @@ def test_copy_keeps_overrides_and_internal_references():
 def _reference_names(root) -> dict[int, str]:
     """The naming rule of robotwright.things.base, transcribed literally: depth-first in
     child order, the first Thing keeps its name, each later one becomes ``name_k`` with
-    the smallest k >= 1 no Thing of its namespace requests or already got."""
+    the smallest k >= 1 no Thing of its namespace requests or already got.
+
+    The search for k starts where the last search for the same name ended: names are only
+    ever added to ``taken``, so no smaller k can have become free (and 5,000 copies of one
+    name then cost 5,000 steps, not 12.5 million)."""
     wanted = [(t, t._name) for t in root.walk() if t._NAMESPACE and t._name]
     requested = {(t._NAMESPACE, n) for t, n in wanted}
     taken: set[tuple[str, str]] = set()
+    searched_to: dict[tuple[str, str], int] = {}
     out = {}
     for thing, base in wanted:
         ns, final = thing._NAMESPACE, base
         if (ns, base) in taken:
-            k = 1
+            k = searched_to.get((ns, base), 1)
             while (ns, f"{base}_{k}") in taken or (ns, f"{base}_{k}") in requested:
                 k += 1
+            searched_to[(ns, base)] = k
             final = f"{base}_{k}"
         taken.add((ns, final))
         out[thing.ID] = final
