@@ -17,6 +17,10 @@ this process (CPU seconds, median of --repeat runs):
 CPU time counts this process and the reader processes it starts. One conversion of a
 small robot runs first, untimed (imports, caches).
 
+  keys        a one-joint MJCF robot with as many keyframes as the sizes say (unnamed:
+              the proof matches them by order): convert to HRDF and export MJCF, each with
+              its proof (--max-keyframes raised to fit)
+
   mujoco      mujoco.MjModel.from_xml_path(ROBOT.urdf): MuJoCo's own import of the source,
               the reference every proof compiles at least once
 
@@ -90,6 +94,27 @@ def _mujoco_import(source: Path) -> float | None:
     return _cpu() - c0
 
 
+def _keyframes(tmp: Path, n: int) -> dict[str, float]:
+    """CPU seconds of converting a one-joint robot with ``n`` keyframes to HRDF and of
+    exporting that HRDF as MJCF, each with its proof."""
+    folder = tmp / f"keys{n}"
+    folder.mkdir()
+    source = folder / "robot.xml"
+    keys = "".join(f'<key qpos="{i / n:.6f}"/>' for i in range(n))
+    body = '<body name="arm"><joint name="hinge"/><geom size="0.1" mass="1"/></body>'
+    source.write_text(
+        f"<mujoco><worldbody>{body}</worldbody><keyframe>{keys}</keyframe></mujoco>",
+        encoding="utf-8",
+    )
+    limit = ["--max-keyframes", str(max(n, 1))]
+    hrdf = folder / "hrdf"
+    out = folder / "out.xml"
+    return {
+        "convert": _run(["convert", str(source), "-o", str(hrdf), *limit]),
+        "export-mjcf": _run(["export", str(hrdf), "--format", "mjcf", "-o", str(out), *limit]),
+    }
+
+
 def exponent(sizes: list[int], times: list[float]) -> float:
     """k of ``time ~ size^k``, least squares on the logs."""
     xs = [math.log(s) for s in sizes]
@@ -150,13 +175,22 @@ def main() -> None:
                     times.append(spent)
                     cells.append(f"{spent:12.2f}")
                 print(f"{shape:6} {n:>6} " + " ".join(cells), flush=True)
-    print("growth exponent k (time ~ links^k; goal <= 1.2):")
+        for n in args.sizes:
+            cells = []
+            for step, spent in _keyframes(Path(tmp), n).items():
+                sizes, times = growth.setdefault(("keys", step), ([], []))
+                sizes.append(n)
+                times.append(spent)
+                cells.append(f"{spent:12.2f}")
+            print(f"{'keys':6} {n:>6} " + " ".join(cells), flush=True)
+    print("growth exponent k (time ~ links^k, or keyframes^k; goal <= 1.2):")
     for (shape, step), (sizes, times) in growth.items():
         if len(sizes) >= 2:
             k = exponent(sizes, times)
             last = exponent(sizes[-2:], times[-2:])
+            unit = "keyframes" if shape == "keys" else "links"
             print(
-                f"  {shape:6} {step:12} k = {k:.2f} over {sizes[0]}-{sizes[-1]} links, "
+                f"  {shape:6} {step:12} k = {k:.2f} over {sizes[0]}-{sizes[-1]} {unit}, "
                 f"{last:.2f} from {sizes[-2]} to {sizes[-1]}"
             )
 

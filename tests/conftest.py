@@ -23,6 +23,9 @@ FETCH_HINT = "run python tools/fetch_test_data.py"
 #: corpus, plus every file the test lists as an expected failure or refusal. .ci/run's
 #: MuJoCo 3.11 stage sets it; the first stage runs every file.
 CORPUS_SAMPLE_ENV = "ROBOTWRIGHT_CORPUS_SAMPLE"
+#: The hostile-input tests: each case of a parametrized test here is one hostile input,
+#: so the sample counts them as a corpus (see :func:`mark_hostile_inputs_as_corpus`).
+HOSTILE_TESTS = Path(__file__).resolve().parent / "hostile"
 
 
 def corpus_sample_size(value: str | None) -> int:
@@ -45,8 +48,10 @@ def corpus_sample(items: list[pytest.Item], size: int) -> list[pytest.Item]:
 
     Per test function and corpus (its ``corpus`` parameter), in collection order, every
     ``size``-th file is kept, starting at an offset taken from the function's name so
-    that two tests of the same corpus check different files. Kept always: a case with
-    an ``xfail`` mark, or whose id is in the marker's ``always`` (expected refusals).
+    that two tests of the same corpus check different files (and below the number of
+    cases, so that a test with fewer cases than ``size`` still runs one). Kept always: a
+    case with an ``xfail`` mark, or whose id is in the marker's ``always`` (expected
+    refusals).
     """
     groups: dict[tuple, list[pytest.Item]] = {}
     for item in items:
@@ -58,7 +63,8 @@ def corpus_sample(items: list[pytest.Item], size: int) -> list[pytest.Item]:
         groups.setdefault(key, []).append(item)
     left_out = []
     for (_, name, _), members in groups.items():
-        offset = zlib.crc32(name.encode()) % size
+        # Below len(members): every test function runs at least one of its cases.
+        offset = zlib.crc32(name.encode()) % min(size, len(members))
         for index, item in enumerate(members):
             always = item.get_closest_marker("corpus").kwargs.get("always", ())
             case_id = getattr(getattr(item, "callspec", None), "id", "")
@@ -68,13 +74,30 @@ def corpus_sample(items: list[pytest.Item], size: int) -> list[pytest.Item]:
     return left_out
 
 
+def mark_hostile_inputs_as_corpus(items: list[pytest.Item]) -> None:
+    """Marks ``corpus`` the cases of the parametrized tests under ``tests/hostile``: one
+    hostile input each, checked by robotwright's own guards, whose every case runs in the
+    first stage. Left whole: a test whose name says MuJoCo's verdict is what it checks
+    (``mujoco`` in it: ``..._mujoco_refuses``, ``..._agree_with_mujoco``), so that every
+    input MuJoCo itself judges is judged by each MuJoCo line."""
+    for item in items:
+        if (
+            HOSTILE_TESTS in Path(item.path).parents
+            and getattr(item, "callspec", None) is not None
+            and "mujoco" not in getattr(item, "originalname", item.name)
+            and item.get_closest_marker("corpus") is None
+        ):
+            item.add_marker(pytest.mark.corpus)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     size = corpus_sample_size(os.environ.get(CORPUS_SAMPLE_ENV))
     if size == 1:
         return
+    mark_hostile_inputs_as_corpus(items)
     reason = (
-        f"corpus sample ({CORPUS_SAMPLE_ENV}={size}: 1 file in {size} of each corpus runs "
-        "here); every corpus file runs in .ci/run's first stage (newest versions)"
+        f"corpus sample ({CORPUS_SAMPLE_ENV}={size}: 1 case in {size} of each corpus test "
+        "runs here); every corpus case runs in .ci/run's first stage (newest versions)"
     )
     left_out = corpus_sample(items, size)
     for item in left_out:

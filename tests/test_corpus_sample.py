@@ -84,7 +84,7 @@ def test_sample_keeps_one_in_n_per_corpus_and_every_expected_outcome(
     outcomes = result.parseoutcomes()
     assert outcomes["skipped"] == skipped and outcomes["passed"] == len(ran) - 2 + 1
     out = result.stdout.str()
-    assert "every corpus file runs in .ci/run's first stage" in out  # the skip reason
+    assert "every corpus case runs in .ci/run's first stage" in out  # the skip reason
     assert f"{len(ran)} of 20 corpus cases run, {skipped} skipped" in out
     assert "ROBOTWRIGHT_CORPUS_SAMPLE=4: a sample of the corpus tests runs" in out
 
@@ -95,3 +95,55 @@ def test_a_bad_value_is_a_usage_error(inner: pytest.Pytester, monkeypatch, value
     result = inner.runpytest_inprocess()
     assert result.ret == pytest.ExitCode.USAGE_ERROR
     assert "ROBOTWRIGHT_CORPUS_SAMPLE: expected an integer >= 1" in result.stderr.str()
+
+
+#: Hostile-input tests (a ``hostile`` folder beside the conftest): parametrized ones are
+#: sampled like a corpus, one whose name says it checks MuJoCo's verdict runs whole, and
+#: a test with fewer cases than the sample's N still runs one of them.
+HOSTILE_TESTS = """
+import pytest
+
+
+@pytest.mark.parametrize("junk", range(12))
+def test_junk_is_refused(junk):
+    pass
+
+
+@pytest.mark.parametrize("junk", range(12))
+def test_junk_mujoco_refuses_is_refused(junk):
+    pass
+
+
+@pytest.mark.parametrize("junk", range(2))
+def test_two_junks(junk):
+    pass
+
+
+def test_plain():
+    pass
+"""
+
+
+def _ran_per_test(result: pytest.RunResult) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for r in result.reprec.getreports("pytest_runtest_logreport"):
+        if r.when == "call":
+            name = r.nodeid.split("::", 1)[1].split("[", 1)[0]
+            counts[name] = counts.get(name, 0) + 1
+    return counts
+
+
+def test_hostile_inputs_are_sampled_as_a_corpus(inner: pytest.Pytester, monkeypatch) -> None:
+    hostile = inner.mkpydir("hostile")
+    (hostile / "test_inputs.py").write_text(HOSTILE_TESTS, encoding="utf-8")
+    monkeypatch.setenv("ROBOTWRIGHT_CORPUS_SAMPLE", "4")
+    result = inner.runpytest_inprocess("hostile")
+    assert _ran_per_test(result) == {
+        "test_junk_is_refused": 3,  # 1 in 4 of 12
+        "test_junk_mujoco_refuses_is_refused": 12,
+        "test_two_junks": 1,
+        "test_plain": 1,
+    }
+    monkeypatch.delenv("ROBOTWRIGHT_CORPUS_SAMPLE")
+    unset = _ran_per_test(inner.runpytest_inprocess("hostile"))
+    assert unset["test_junk_is_refused"] == 12 and unset["test_two_junks"] == 2
