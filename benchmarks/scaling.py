@@ -115,6 +115,19 @@ def _keyframes(tmp: Path, n: int) -> dict[str, float]:
     }
 
 
+def _record(
+    growth: dict[tuple[str, str], tuple[list[int], list[float]]],
+    key: tuple[str, str],
+    n: int,
+    spent: float,
+) -> str:
+    """Adds ``spent`` at size ``n`` to the growth series ``key`` (shape, step); its cell."""
+    sizes, times = growth.setdefault(key, ([], []))
+    sizes.append(n)
+    times.append(spent)
+    return f"{spent:12.2f}"
+
+
 def exponent(sizes: list[int], times: list[float]) -> float:
     """k of ``time ~ size^k``, least squares on the logs."""
     xs = [math.log(s) for s in sizes]
@@ -157,10 +170,7 @@ def main() -> None:
                             cells.append(f"{'(refused)':>12}")
                             continue
                         spent = statistics.median(runs)  # type: ignore[type-var]
-                        sizes, times = growth.setdefault((shape, step), ([], []))
-                        sizes.append(n)
-                        times.append(spent)
-                        cells.append(f"{spent:12.2f}")
+                        cells.append(_record(growth, (shape, step), n, spent))
                         continue
                     if step == "convert":
                         cmd = ["convert", str(source), "-o", str(hrdf), "--overwrite"]
@@ -170,18 +180,13 @@ def main() -> None:
                         cmd = ["export", str(hrdf), "--format", kind, "-o", str(out)]
                         cmd.append("--overwrite")
                     spent = statistics.median(_run(cmd) for _ in range(args.repeat))
-                    sizes, times = growth.setdefault((shape, step), ([], []))
-                    sizes.append(n)
-                    times.append(spent)
-                    cells.append(f"{spent:12.2f}")
+                    cells.append(_record(growth, (shape, step), n, spent))
                 print(f"{shape:6} {n:>6} " + " ".join(cells), flush=True)
         for n in args.sizes:
-            cells = []
-            for step, spent in _keyframes(Path(tmp), n).items():
-                sizes, times = growth.setdefault(("keys", step), ([], []))
-                sizes.append(n)
-                times.append(spent)
-                cells.append(f"{spent:12.2f}")
+            cells = [
+                _record(growth, ("keys", step), n, spent)
+                for step, spent in _keyframes(Path(tmp), n).items()
+            ]
             print(f"{'keys':6} {n:>6} " + " ".join(cells), flush=True)
     print("growth exponent k (time ~ links^k, or keyframes^k; goal <= 1.2):")
     for (shape, step), (sizes, times) in growth.items():

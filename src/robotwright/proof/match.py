@@ -102,15 +102,8 @@ def _match(src: _Side, res: _Side, fam: str, body_map: dict[int, int]) -> dict[i
             # fits is taken: in the usual case, the same order, that is the first looked
             # at, so matching n objects costs n steps, not n squared.
             here = _placement(src, fam, i)
-            same = (
-                None
-                if here is None
-                else next(
-                    (k for k, j in enumerate(cands) if _same(here, _placement(res, fam, j))),
-                    None,
-                )
-            )
-            out[i] = cands.pop(same or 0)
+            fits = (k for k, j in enumerate(cands) if _same(here, _placement(res, fam, j)))
+            out[i] = cands.pop(0 if here is None else next(fits, 0))
     return out
 
 
