@@ -130,6 +130,14 @@ def _per_iteration(stdout: str) -> dict[str, list[float]]:
     return out
 
 
+def mjlab_gpu_ids(device: str) -> str:
+    """``device`` as mjlab's train takes ``--gpu-ids``: ``None`` for the CPU, else a list
+    in Python syntax (``cuda:1`` -> ``[1]``; ``cuda`` is the first GPU)."""
+    if device == "cpu":
+        return "None"
+    return f"[{device.partition(':')[2] or 0}]"
+
+
 def train(framework: str, envs: int, device: str, iterations: int, limit: float) -> dict[str, Any]:
     """``iterations`` of the framework's train command; the per-iteration figures."""
     with tempfile.TemporaryDirectory(prefix="robotwright-gpu-suite-") as logs:
@@ -138,7 +146,7 @@ def train(framework: str, envs: int, device: str, iterations: int, limit: float)
                 "import sys; from mjlab.scripts.train import main; "
                 "sys.argv = ['train'] + sys.argv[1:]; main()"
             )
-            gpu = ["--gpu-ids", "None"] if device == "cpu" else ["--gpu-ids", device.split(":")[-1]]
+            gpu = ["--gpu-ids", mjlab_gpu_ids(device)]
             cmd = [sys.executable, "-c", code, "Robotwright-Mjlab-SemanticNav-Go2"]
             cmd += ["--env.scene.num-envs", str(envs), "--agent.max-iterations", str(iterations)]
             cmd += [*gpu, "--log-root", logs]

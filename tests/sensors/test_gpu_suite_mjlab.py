@@ -38,3 +38,21 @@ def test_the_gpu_suite_runs_its_mjlab_sections_on_the_cpu(tmp_path) -> None:
     assert len(train["value_loss"]) == 2 and all(math.isfinite(v) for v in train["value_loss"])
     for section in ("lidar_isaaclab", "nav_isaaclab", "train_isaaclab"):
         assert "not installed" in summary[section]["skipped"]
+
+
+@pytest.mark.skipif(find_entry("go2") is None, reason="the Go2 comes from example-robot-data")
+@pytest.mark.parametrize(
+    ("device", "parsed"), [("cpu", None), ("cuda", [0]), ("cuda:0", [0]), ("cuda:3", [3])]
+)
+def test_the_suite_names_the_gpu_as_mjlab_train_parses_it(device, parsed) -> None:
+    import mjlab
+    import tyro
+    from mjlab.scripts.train import TrainConfig
+
+    sys.path.insert(0, str(SUITE.parent))
+    from gpu_suite import mjlab_gpu_ids
+
+    default = TrainConfig.from_task("Robotwright-Mjlab-SemanticNav-Go2")
+    args = ["--gpu-ids", mjlab_gpu_ids(device)]
+    cfg = tyro.cli(TrainConfig, args=args, default=default, config=mjlab.TYRO_FLAGS)
+    assert cfg.gpu_ids == parsed
