@@ -118,12 +118,13 @@ def nav(framework: str, envs: int, device: str, steps: int) -> dict[str, Any]:
 
 
 def _per_iteration(stdout: str) -> dict[str, list[float]]:
-    """rsl_rl's printed losses and mean reward, one value per iteration."""
+    """rsl_rl's printed losses, mean episode reward and length, one value per iteration."""
     out: dict[str, list[float]] = {}
     for key, pattern in (
         ("value_loss", r"Mean value loss:\s*(\S+)"),
         ("surrogate_loss", r"Mean surrogate loss:\s*(\S+)"),
         ("mean_reward", r"Mean reward:\s*(\S+)"),
+        ("mean_episode_length", r"Mean episode length:\s*(\S+)"),
         ("iteration_s", r"Iteration time:\s*([\d.]+)s"),
     ):
         out[key] = [float(v) for v in re.findall(pattern, stdout)]

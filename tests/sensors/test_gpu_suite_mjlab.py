@@ -36,6 +36,9 @@ def test_the_gpu_suite_runs_its_mjlab_sections_on_the_cpu(tmp_path) -> None:
     assert nav["env_steps_per_s"] > 0 and nav["step_s"] > 0
     train = summary["train_mjlab"]
     assert len(train["value_loss"]) == 2 and all(math.isfinite(v) for v in train["value_loss"])
+    # rsl_rl prints an iteration's mean episode reward and length together, once an
+    # episode has ended.
+    assert len(train["mean_episode_length"]) == len(train["mean_reward"])
     for section in ("lidar_isaaclab", "nav_isaaclab", "train_isaaclab"):
         assert "not installed" in summary[section]["skipped"]
 
