@@ -109,7 +109,14 @@ def _site(root: Path) -> dict[str, bytes]:
     return made
 
 
-def test_the_pieces_fit_a_call_each_and_unpack_to_the_same_files(tmp_path) -> None:
+@pytest.mark.parametrize("xz_program", [True, False], ids=["xz", "python-lzma"])
+def test_the_pieces_fit_a_call_each_and_unpack_to_the_same_files(
+    tmp_path, monkeypatch, xz_program
+) -> None:
+    if xz_program and gpu_pack.shutil.which("xz") is None:
+        pytest.skip("no xz program here")
+    if not xz_program:
+        monkeypatch.setattr(gpu_pack.shutil, "which", lambda name: None)
     made = _site(tmp_path / "site")
     calls = gpu_pack.archive_and_cut(tmp_path / "site", tmp_path / "out", capacity=50_000)
     assert len(calls) >= 3

@@ -12,9 +12,9 @@ machine lacks into one folder, leaves out what the suite never loads (warp's CPU
 compiler, wandb's and imageio-ffmpeg's programs), adds the Go2 of example-robot-data and
 robotwright's entry points (mjlab finds the tasks through them), compresses the whole
 with xz and cuts it into ``.gpu/call-K`` folders, each small enough for one call beside
-this working tree (about 117 MB in three calls). ``.gpu/calls.txt`` lists the calls:
-each carries its folder and copies it to ``/tmp/gpu`` (the machine keeps ``/tmp`` while it
-is warm); the last then runs, there,
+this working tree (about 119 MB in three calls; packing takes about 11 minutes on 2
+cores). ``.gpu/calls.txt`` lists the calls: each carries its folder and copies it to
+``/tmp/gpu`` (the machine keeps ``/tmp`` while it is warm); the last then runs, there,
 
     python3 tools/gpu_pack.py unpack /tmp/gpu /tmp/site
     python3 tools/gpu_pack.py run /tmp/site -- --envs 4096 --out $OUT/gpu_suite.json
@@ -32,9 +32,11 @@ import io
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tarfile
+import tempfile
 import zipfile
 from pathlib import Path, PurePosixPath
 
@@ -165,16 +167,34 @@ def tree_size(root: Path = ROOT) -> int:
     return sum(p.stat().st_size for p in paths if p.is_file())
 
 
+def _xz_tar(folder: Path) -> bytes:
+    """``folder`` as a tar archive compressed with xz: by the ``xz`` program on every core
+    where there is one (Python's own xz runs on one core: several minutes for the
+    500 MB the suite needs), else by Python."""
+    size = sum(p.stat().st_size for p in folder.rglob("*") if p.is_file())
+    print(f"compressing {size / 1e6:.0f} MB with xz (minutes) ...", flush=True)
+    program = shutil.which("xz")
+    if program is None:
+        buffer = io.BytesIO()
+        with tarfile.open(fileobj=buffer, mode="w:xz", preset=6) as tar:
+            tar.add(folder, arcname=".")
+        return buffer.getvalue()
+    with tempfile.TemporaryFile() as plain:
+        with tarfile.open(fileobj=plain, mode="w") as tar:
+            tar.add(folder, arcname=".")
+        plain.seek(0)
+        return subprocess.run(
+            [program, "-6", "-T0", "-c"], stdin=plain, capture_output=True, check=True
+        ).stdout
+
+
 def archive_and_cut(site: Path, out: Path, capacity: int) -> list[Path]:
     """Compress ``site`` (tar, xz) and cut it into ``out/call-K`` folders of at most
     ``capacity`` bytes; the last also holds ``manifest.json`` (size and SHA-256 of the
     whole archive). Returns the call folders in order."""
     if capacity <= 0:
         raise SystemExit("the working tree alone fills a device call: nothing can be carried")
-    buffer = io.BytesIO()
-    with tarfile.open(fileobj=buffer, mode="w:xz", preset=6) as tar:
-        tar.add(site, arcname=".")
-    data = buffer.getvalue()
+    data = _xz_tar(site)
     calls = []
     for k, start in enumerate(range(0, len(data), capacity), start=1):
         folder = out / f"call-{k}"
@@ -223,9 +243,10 @@ def _carried(dist: str) -> bool:
 
 def pack(out: Path) -> list[Path]:
     """Resolve, download, unpack, prune and cut (the module docstring); returns the call
-    folders. Only the wheels carried are downloaded (pip resolves from the index's
-    metadata first: torch and its CUDA libraries are never fetched)."""
+    folders. Only the wheels carried are downloaded into ``out`` (resolving may fetch
+    torch into pip's cache to read its requirements; it is not kept)."""
     wheels, site = out / "wheels", out / "site"
+    out.mkdir(parents=True, exist_ok=True)
     target = ["--only-binary=:all:", "--python-version", "3.12", "--implementation", "cp"]
     target += [arg for p in PLATFORMS for arg in ("--platform", p)]
     pip = [sys.executable, "-m", "pip"]
