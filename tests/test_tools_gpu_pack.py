@@ -150,6 +150,14 @@ def test_a_damaged_or_missing_piece_is_refused(tmp_path, fault) -> None:
     assert not (tmp_path / "there").exists()
 
 
+def test_packing_again_leaves_no_call_of_the_earlier_packing(tmp_path) -> None:
+    _site(tmp_path / "site")
+    many = gpu_pack.archive_and_cut(tmp_path / "site", tmp_path / "out", capacity=30_000)
+    few = gpu_pack.archive_and_cut(tmp_path / "site", tmp_path / "out", capacity=10**6)
+    assert len(many) > len(few) == 1
+    assert sorted((tmp_path / "out").iterdir()) == few
+
+
 def test_a_tree_that_fills_the_call_alone_is_an_error(tmp_path) -> None:
     _site(tmp_path / "site")
     with pytest.raises(SystemExit, match="fills a device call"):

@@ -195,6 +195,8 @@ def archive_and_cut(site: Path, out: Path, capacity: int) -> list[Path]:
     if capacity <= 0:
         raise SystemExit("the working tree alone fills a device call: nothing can be carried")
     data = _xz_tar(site)
+    for stale in out.glob("call-*"):  # an earlier packing's calls
+        shutil.rmtree(stale)
     calls = []
     for k, start in enumerate(range(0, len(data), capacity), start=1):
         folder = out / f"call-{k}"
@@ -267,6 +269,8 @@ def pack(out: Path) -> list[Path]:
             print(f"{unpack_wheel(wheel, site):6d} files  {wheel.name}")
     write_entry_points(site)
     calls = archive_and_cut(site, out, CALL_LIMIT - tree_size() - MARGIN)
+    for folder in (wheels, site, out / "unused"):  # 900 MB of intermediates
+        shutil.rmtree(folder, ignore_errors=True)
     lines = []
     for k, call in enumerate(calls, start=1):
         rel = os.path.relpath(call, ROOT)
