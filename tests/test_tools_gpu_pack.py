@@ -109,6 +109,15 @@ def _site(root: Path) -> dict[str, bytes]:
     return made
 
 
+def _gather(calls: list[Path], folder: Path) -> Path:
+    """Every call's files in one folder, as the GPU machine's /tmp/gpu holds them."""
+    folder.mkdir()
+    for call in calls:
+        for f in call.iterdir():
+            (folder / f.name).write_bytes(f.read_bytes())
+    return folder
+
+
 @pytest.mark.parametrize("xz_program", [True, False], ids=["xz", "python-lzma"])
 def test_the_pieces_fit_a_call_each_and_unpack_to_the_same_files(
     tmp_path, monkeypatch, xz_program
@@ -120,14 +129,10 @@ def test_the_pieces_fit_a_call_each_and_unpack_to_the_same_files(
     made = _site(tmp_path / "site")
     calls = gpu_pack.archive_and_cut(tmp_path / "site", tmp_path / "out", capacity=50_000)
     assert len(calls) >= 3
-    gathered = tmp_path / "gathered"
-    gathered.mkdir()
     for call in calls:
         pieces = list(call.glob("site.tar.xz.part*"))
         assert len(pieces) == 1 and pieces[0].stat().st_size <= 50_000
-        for f in call.iterdir():
-            (gathered / f.name).write_bytes(f.read_bytes())
-    gpu_pack.unpack(gathered, tmp_path / "there")
+    gpu_pack.unpack(_gather(calls, tmp_path / "gathered"), tmp_path / "there")
     assert _files(tmp_path / "there") == made
 
 
@@ -135,11 +140,7 @@ def test_the_pieces_fit_a_call_each_and_unpack_to_the_same_files(
 def test_a_damaged_or_missing_piece_is_refused(tmp_path, fault) -> None:
     _site(tmp_path / "site")
     calls = gpu_pack.archive_and_cut(tmp_path / "site", tmp_path / "out", capacity=50_000)
-    gathered = tmp_path / "gathered"
-    gathered.mkdir()
-    for call in calls:
-        for f in call.iterdir():
-            (gathered / f.name).write_bytes(f.read_bytes())
+    gathered = _gather(calls, tmp_path / "gathered")
     piece = gathered / "site.tar.xz.part02"
     if fault == "missing":
         piece.unlink()

@@ -264,9 +264,8 @@ def pack(out: Path) -> list[Path]:
     subprocess.run(
         [*pip, "download", "--no-deps", "--dest", str(wheels), *target, *pins], check=True
     )
-    for wheel in sorted(wheels.glob("*.whl")):
-        if _carried(distribution(wheel.name)):
-            print(f"{unpack_wheel(wheel, site):6d} files  {wheel.name}")
+    for wheel in sorted(wheels.glob("*.whl")):  # only the carried ones were downloaded
+        print(f"{unpack_wheel(wheel, site):6d} files  {wheel.name}")
     write_entry_points(site)
     calls = archive_and_cut(site, out, CALL_LIMIT - tree_size() - MARGIN)
     for folder in (wheels, site, out / "unused"):  # 900 MB of intermediates
