@@ -178,3 +178,35 @@ def test_invalid_hrdf_is_rejected_on_load(synth):
     bad = HRDF(name="bad", bodies=synth.bodies, joints=[*synth.joints, synth.joints[1]])
     with pytest.raises(Exception, match="bad"):
         MJCFHumanoidGenerator.from_hrdf(bad)
+
+
+def test_meshes_in_place_refers_to_a_parsers_staged_meshes(tmp_path):
+    """A parsed robot's meshes are staged in a temporary folder: an export copies them
+    (the folder goes with the robot), unless asked to refer to them where they are (a
+    private file read while the robot is held: the USD export's MJCF)."""
+    import trimesh
+
+    from robotwright.sources import load_robot
+
+    src = tmp_path / "src"
+    src.mkdir()
+    trimesh.creation.box(extents=(0.1, 0.2, 0.3)).export(src / "part.stl")
+    (src / "robot.urdf").write_text(
+        '<robot name="r"><link name="base"><inertial><mass value="1"/><inertia ixx="0.01" '
+        'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial><visual><geometry>'
+        '<mesh filename="part.stl"/></geometry></visual></link></robot>'
+    )
+    hrdf = load_robot(str(src / "robot.urdf"))
+    assert hrdf.temp_assets is not None
+    in_place = tmp_path / "in_place" / "robot.xml"
+    MJCFHumanoidGenerator.from_hrdf(hrdf).export(in_place, meshes_in_place=True)
+    assert [p.name for p in in_place.parent.iterdir()] == ["robot.xml"]  # nothing copied
+    model = mujoco.MjModel.from_xml_path(str(in_place))
+    assert model.nmesh == 1 and model.mesh_vertnum[0] == 8
+    copied = tmp_path / "copied" / "robot.xml"
+    MJCFHumanoidGenerator.from_hrdf(hrdf).export(copied)  # staged meshes: always copied
+    assert (copied.parent / "meshes").is_dir()
+    with pytest.raises(GeneratorError, match="exclude each other"):
+        MJCFHumanoidGenerator.from_hrdf(hrdf).export(
+            tmp_path / "x.xml", copy_meshes=True, meshes_in_place=True
+        )

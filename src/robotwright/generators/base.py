@@ -139,7 +139,12 @@ class GeneratorBase(ABC):
         return []
 
     def export(
-        self, file_path: str | Path | None = None, *, copy_meshes: bool = False, **kwargs: Any
+        self,
+        file_path: str | Path | None = None,
+        *,
+        copy_meshes: bool = False,
+        meshes_in_place: bool = False,
+        **kwargs: Any,
     ) -> str:
         """Generate (from scratch) and return the XML string; write it when ``file_path``
         is given.
@@ -150,15 +155,20 @@ class GeneratorBase(ABC):
         under ``<folder>/meshes/<robot>/`` and the file references the copies, giving a
         self-contained folder. Meshes a parser staged in a temporary folder (a robot read
         from MJCF/URDF, see :mod:`robotwright.parsers.meshes`) are always copied: that
-        folder goes away with the robot.
+        folder goes away with the robot, unless ``meshes_in_place``.
 
         Args:
             file_path: where to write, or ``None`` to only return the string.
             copy_meshes: copy mesh files next to the output (needs ``file_path``).
+            meshes_in_place: reference every mesh where it is, a parser's staged copy
+                included: for a private file read at once while the robot is held (the
+                MJCF a USD export converts), which the staging folder outlives.
             **kwargs: passed to ``generate``.
         """
         self._require_loaded("export")
-        if file_path is not None and self._uses_temporary_meshes():
+        if copy_meshes and meshes_in_place:
+            raise GeneratorError("export: copy_meshes and meshes_in_place exclude each other")
+        if file_path is not None and self._uses_temporary_meshes() and not meshes_in_place:
             copy_meshes = True
         if copy_meshes and file_path is None:
             raise GeneratorError("export(copy_meshes=True) needs a file_path to copy next to")

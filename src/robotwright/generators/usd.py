@@ -133,7 +133,7 @@ def converter_model_name(name: str) -> str:
 
 def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple[Path, list[str]]:
     """Our MJCF of the robot alone (its model named by :func:`converter_model_name`),
-    meshes copied beside it, and the values the MJCF could not hold that the USD does
+    its meshes referenced where they are, and the values the MJCF could not hold that the USD does
     not get either (``peak_velocity`` it does get). ``root_at_origin``: a free base's
     body is put at the model's origin (see :func:`to_usd`)."""
     import dataclasses
@@ -152,7 +152,9 @@ def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple
         robot = dataclasses.replace(robot, bodies=bodies)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        MJCFHumanoidGenerator.from_hrdf(robot).export(path, copy_meshes=True, add_scene=False)
+        # Read at once, while the robot (and a parser's staging folder) is held: the
+        # meshes are referenced where they are, not copied (the G1's 35: 0.035 s).
+        MJCFHumanoidGenerator.from_hrdf(robot).export(path, meshes_in_place=True, add_scene=False)
     lost = []
     for w in caught:
         lines = str(w.message).splitlines()
@@ -440,9 +442,8 @@ def to_usd(
     if layout not in USD_LAYOUTS:
         raise GeneratorError(f"layout={layout!r}: expected one of {', '.join(USD_LAYOUTS)}")
     converter = _converter(prove)
-    from pxr import Usd
-
     from robotwright._library_output import captured_library_output
+    from robotwright.generators.usd_converted import converted_stage
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         mjcf, lost = _robot_mjcf(hrdf, Path(tmp), root_at_origin)
@@ -452,8 +453,7 @@ def to_usd(
         # one-file output writes, reopens and saves that layer, in the system's
         # temporary folder, before we could open it).
         with captured_library_output() as printed:
-            asset = converter.Converter().convert(str(mjcf), str(Path(tmp) / "usd"))
-            stage = Usd.Stage.Open(Usd.Stage.Open(asset.path).Flatten())
+            stage = converted_stage(converter, mjcf, Path(tmp) / "usd")
         # What the libraries said is passed on as notes, never as a difference: --strict
         # refuses what the proof finds, not another library's remarks.
         said = _library_notes(printed, "mujoco-usd-converter")
