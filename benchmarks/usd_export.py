@@ -1,6 +1,6 @@
 """USD export against mujoco-usd-converter alone, side by side on the same robots.
 
-For each robot, rounds alternate between:
+For each robot, rounds alternate between (in an order shuffled each round):
 
   converter   mujoco-usd-converter's ``Converter().convert`` on the robot's own MJCF
               (its default: a layered asset, several .usda files)
@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import random
 import statistics
 import sys
 import tempfile
@@ -104,6 +105,7 @@ def main() -> int:
         action="store_true",
         help="leave out Isaac Sim's importer (its rounds take most of the run's time)",
     )
+    ap.add_argument("--seed", type=int, default=0, help="seed of each round's order of steps")
     args = ap.parse_args()
     try:
         import mujoco_usd_converter  # noqa: F401
@@ -114,6 +116,7 @@ def main() -> int:
     from robotwright.sources import load_robot
 
     warnings.simplefilter("ignore")  # the notes of each export are not what is timed
+    shuffle = random.Random(args.seed)
     importer = None if args.without_isaac_sim else _isaac_sim_importer()
     if importer is None and not args.without_isaac_sim:
         print(
@@ -147,8 +150,11 @@ def main() -> int:
                 times: dict[str, list[float]] = {key: [] for key in steps}
                 for step in steps.values():  # warm-up: imports, kernels
                     step(-1)
+                order = list(steps)
                 for k in range(args.rounds):
-                    for key, step in steps.items():
+                    shuffle.shuffle(order)  # no step always runs after the same one
+                    for key in order:
+                        step = steps[key]
                         times[key].append(_timed(lambda step=step, k=k: step(k)))
             med = {key: statistics.median(v) for key, v in times.items()}
 

@@ -148,6 +148,12 @@ def test_humanoid_multi_hinge_bodies_are_matched_axis_by_axis(tmp_path):
     assert [d.split("'")[1] for d in order] == ["lwaist", "right_thigh", "left_thigh"]
     assert "'abdomen_z', 'abdomen_y' as one D6 joint turning them in the order 'abdomen_y', 'abdomen_z'" in order[0]  # fmt: skip
     assert proof.max_pose_error > 0.01
+    # The poses differ at the bodies those joints move, and nowhere else (the torso,
+    # the head and the arms hang above the abdomen).
+    moved = {d.split("'")[1] for d in proof.differences if "world pose differs" in d}
+    legs = {f"{side}_{part}" for side in ("left", "right") for part in ("thigh", "shin", "foot")}
+    assert moved == {"lwaist", "pelvis"} | legs
+    assert all("of 20 random configurations" in d for d in proof.differences if "world pose" in d)
     # Listed in Newton's order, the same humanoid reads back with the same kinematics:
     # no difference at all, the torso's 0.004 rad tilts included (the converter rounds
     # them by 3e-5 rad; the export puts the exact frames back).

@@ -374,14 +374,17 @@ def prove_usd(
                 diff.append(f"{who}: drive {key} {w:.9g} in MJCF, {g:.9g} in USD")
 
     # -- forward kinematics at random poses -----------------------------------------
+    # Each pose is set and evaluated in turn (one joint-position array, filled in
+    # place); the body poses are compared for all of them at once afterwards.
     rng = np.random.default_rng(seed)
     data = mujoco.MjData(mj)
     state = model.state()
     pairs = [(b, nb[n]) for b, n in enumerate(body_names) if b and n in nb]
     ours = np.array([b for b, _ in pairs], dtype=int)
     theirs = np.array([i for _, i in pairs], dtype=int)
-    worst: dict[str, tuple[float, float, int]] = {}  # body -> (metres, radians, poses)
     joint_q0 = model.joint_q.numpy()
+    joint_q_in = wp.array(joint_q0, dtype=wp.float32, device="cpu")
+    mj_pos, mj_quat, newton_q = [], [], []  # per pose: (bodies, 3), (bodies, 4), (bodies, 7)
     for _ in range(poses):
         qpos = mj.qpos0.copy()
         joint_q = joint_q0.copy()
@@ -401,23 +404,28 @@ def prove_usd(
                 joint_q[s] = v
         data.qpos[:] = qpos
         mujoco.mj_kinematics(mj, data)
-        newton.eval_fk(
-            model,
-            wp.array(joint_q, dtype=wp.float32, device="cpu"),
-            model.joint_qd,
-            state,
-        )
+        joint_q_in.assign(joint_q.astype(np.float32))
+        newton.eval_fk(model, joint_q_in, model.joint_qd, state)
         proof.poses += 1
-        if not pairs:
-            continue
-        body_q = state.body_q.numpy()[theirs]
-        err = np.abs(data.xpos[ours] - body_q[:, :3]).max(axis=1)
-        ang = quat_angles(data.xquat[ours], body_q[:, [6, 3, 4, 5]])  # x, y, z, w -> w, x, y, z
-        proof.max_pose_error = max(proof.max_pose_error, float(err.max()))
-        for k in np.flatnonzero((err > max(tol, 2e-6)) | (ang > max(tol, 2e-6))):
-            name = body_names[ours[k]]
-            m, r, n = worst.get(name, (0.0, 0.0, 0))
-            worst[name] = (max(m, float(err[k])), max(r, float(ang[k])), n + 1)
+        mj_pos.append(data.xpos[ours])  # indexing with an array copies
+        mj_quat.append(data.xquat[ours])
+        newton_q.append(state.body_q.numpy()[theirs])
+    worst: dict[str, tuple[float, float, int]] = {}  # body -> (metres, radians, poses)
+    if pairs and poses:
+        body_q = np.stack(newton_q)  # (poses, bodies, 7): x, y, z, qx, qy, qz, qw
+        err = np.abs(np.stack(mj_pos) - body_q[..., :3]).max(axis=2)
+        ang = quat_angles(
+            np.stack(mj_quat).reshape(-1, 4), body_q[..., [6, 3, 4, 5]].reshape(-1, 4)
+        ).reshape(err.shape)
+        proof.max_pose_error = float(err.max())
+        off = (err > max(tol, 2e-6)) | (ang > max(tol, 2e-6))
+        for k in np.flatnonzero(off.any(axis=0)):
+            hit = off[:, k]
+            worst[body_names[ours[k]]] = (
+                float(err[hit, k].max()),
+                float(ang[hit, k].max()),
+                int(hit.sum()),
+            )
     for name, (m, r, n) in worst.items():
         diff.append(
             f"body {name!r}: world pose differs by up to {m:.3g} m, {r:.3g} rad (at {n} of "
