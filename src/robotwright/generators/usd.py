@@ -132,10 +132,11 @@ def converter_model_name(name: str) -> str:
 
 
 def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple[Path, list[str]]:
-    """Our MJCF of the robot alone (its model named by :func:`converter_model_name`),
-    its meshes referenced where they are, and the values the MJCF could not hold that the USD does
-    not get either (``peak_velocity`` it does get). ``root_at_origin``: a free base's
-    body is put at the model's origin (see :func:`to_usd`)."""
+    """Our MJCF of the robot alone (its model named by :func:`converter_model_name`), its
+    meshes referred to where they are (read while ``hrdf`` is held), and the values the
+    MJCF could not hold that the USD does not get either (``peak_velocity`` it does
+    get). ``root_at_origin``: a free base's body is put at the model's origin (see
+    :func:`to_usd`)."""
     import dataclasses
     import warnings
 
@@ -247,7 +248,7 @@ def _author_drives(
 
 def _quat(q) -> list[float]:
     """A Gf quaternion as (w, x, y, z). Indexed, not iterated: a Gf vector iterates by
-    catching IndexError, about ten times slower (the hand's frames: 10 of 14 ms)."""
+    catching IndexError, about ten times slower."""
     im = q.GetImaginary()
     return [q.GetReal(), im[0], im[1], im[2]]
 
