@@ -273,3 +273,73 @@ def test_a_free_base_asked_for_is_in_the_roundtrip_reference_too() -> None:
     assert rows["MJCF: joints (ref/ours)"].value == "13/13"
     assert rows[SIMULATION_CHECK].compared == 1 and rows[SIMULATION_CHECK].ok
     assert report.simulated_reference.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
+
+
+def _overlapping_tree(folder: Path) -> Path:
+    """A 100-link tree (branching 4) whose box links overlap at rest: thousands of
+    contacts, more than MuJoCo's arena holds (MuJoCo 4 stops stepping it)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
+    from test_roundtrip_scale import tree_urdf
+
+    path = folder / "tree.urdf"
+    path.write_text(tree_urdf(100, branching=4), encoding="utf-8")
+    return path
+
+
+def test_a_source_overlapping_at_rest_is_not_simulated_and_says_why(tmp_path, capsys) -> None:
+    """The proof's simulation is a note, not a crash or minutes of stepping, where the
+    source has more contacts at rest than MAX_ROLLOUT_CONTACTS (the command's exit 0)."""
+    from robotwright.cli import main
+    from robotwright.proof.rollout import MAX_ROLLOUT_CONTACTS
+    from robotwright.proof.roundtrip.run import SIMULATION_CHECK, roundtrip
+
+    source = _overlapping_tree(tmp_path)
+    model = mujoco.MjModel.from_xml_path(str(source))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert data.ncon > MAX_ROLLOUT_CONTACTS
+    messages = convert(source, tmp_path / "hrdf", simulate=True)
+    skipped = [m for m in messages if "simulation not compared" in m]
+    assert len(skipped) == 1 and f"{data.ncon} contacts" in skipped[0], messages
+    assert main(["convert", str(source), "-o", str(tmp_path / "cli"), "-v"]) == 0
+    assert "proof: simulation not compared" in capsys.readouterr().err
+    report = roundtrip(source, configs=2, urdf=False)
+    row = {r.check: r for r in report.rows}[SIMULATION_CHECK]
+    assert row.compared == 0 and "not simulated" in row.value and "contacts" in row.value
+
+
+def test_mujoco_stopping_the_source_or_the_output_is_told_apart(tmp_path) -> None:
+    """MuJoCo's own error while stepping: the source's makes the simulation a note
+    (RolloutNotMade), the output's alone a difference naming the step."""
+    import pytest
+
+    import robotwright.proof.rollout as rollout
+
+    a, b = _model(tmp_path), _model(tmp_path)
+    real_step, real_alone = mujoco.mj_step, rollout._robot_alone
+    copies: list = []  # the source's and the output's copies, world geoms made inert
+    fails = {"which": 1}  # 0: the source, 1: the output
+
+    def alone(model):
+        copies.append(real_alone(model))
+        return copies[-1]
+
+    def step(m, d):
+        if m is copies[fails["which"]] and d.time > 0.05:
+            raise mujoco.FatalError("mj_stackAlloc: out of memory\nsecond line")
+        real_step(m, d)
+
+    qpos, act = {0: 0, 1: 1}, {0: 0, 1: 1}
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(rollout, "_robot_alone", alone)
+        patch.setattr(mujoco, "mj_step", step)
+        found = rollout.rollout_differences(a, b, qpos, act)
+        assert len(found) == 2 and all("stops stepping the output" in d.result for d in found)
+        assert "mj_stackAlloc: out of memory" in found[0].result
+        assert "second line" not in found[0].result
+        copies.clear()
+        fails["which"] = 0
+        with pytest.raises(rollout.RolloutNotMade, match="stops stepping the source at step"):
+            rollout.rollout_differences(a, b, qpos, act)

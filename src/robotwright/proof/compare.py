@@ -345,13 +345,22 @@ def prove(
         geom_order=kind != "urdf",
     )
     if simulate and root is None:
-        diffs += _rollouts(src, res) or []
+        from robotwright.proof.rollout import RolloutNotMade
+
+        try:
+            diffs += _rollouts(src, res) or []
+        except RolloutNotMade as why:
+            found.append(
+                Problem(str(source), f"proof: simulation not compared: {why}", severity="warning")
+            )
     return found + as_problems(str(source), uncovered(diffs, [*notes, *written]))
 
 
 def _rollouts(source: mujoco.MjModel, result: mujoco.MjModel) -> list[Difference] | None:
     """The two models simulated side by side (:mod:`robotwright.proof.rollout`); None
-    when they cannot be (:func:`~robotwright.proof.rollout.can_roll_out`)."""
+    when they cannot be (:func:`~robotwright.proof.rollout.can_roll_out`). Raises
+    :class:`~robotwright.proof.rollout.RolloutNotMade` where the source cannot be
+    simulated (too many contacts at rest, or MuJoCo stops stepping it)."""
     from robotwright._mujoco_log import gathered
     from robotwright.proof.rollout import can_roll_out, rollout_differences
 

@@ -24,6 +24,11 @@ the joint it is largest at and the source's own.
 Run only where every joint position and actuator of the source has its counterpart in
 the result (and the result has no others), and for models up to :data:`MAX_ROLLOUT_DOFS`
 degrees of freedom: a longer chain is a test of the writer, not a robot to simulate.
+Not made (:class:`RolloutNotMade`, which the proof reports as a note) where the source has
+more than :data:`MAX_ROLLOUT_CONTACTS` contacts at its reference pose (links that overlap
+at rest: MuJoCo's arena fills, and every step costs as much as thousands of contacts), or
+where MuJoCo stops stepping the source (its error, e.g. the arena too small); where it
+stops the result alone, that is a difference.
 """
 
 from __future__ import annotations
@@ -38,11 +43,13 @@ from robotwright.proof.objects import Difference
 __all__ = [
     "CHAOS_MARGIN",
     "can_roll_out",
+    "MAX_ROLLOUT_CONTACTS",
     "MAX_ROLLOUT_DOFS",
     "PERTURBATION",
     "ROLLOUT_STEPS",
     "ROLLOUT_TOL",
     "ROUND_OFF",
+    "RolloutNotMade",
     "round_off_twin",
     "rollout_differences",
 ]
@@ -57,11 +64,26 @@ PERTURBATION = 1e-12
 CHAOS_MARGIN = 100.0
 #: Degrees of freedom above which no rollout is made.
 MAX_ROLLOUT_DOFS = 300
+#: Contacts of the source at its reference pose above which no rollout is made (a robot
+#: at rest has tens: the talos 34).
+MAX_ROLLOUT_CONTACTS = 1000
 #: Steps each value of the pseudo-random control is held for.
 _HOLD = 10
 #: Two arrays differ by round-off only where every element is within this share of
 #: the array's largest magnitude (a mesh centre rounded differs by ~1e-15).
 ROUND_OFF = 1e-12
+
+
+class RolloutNotMade(Exception):
+    """The source cannot be simulated here; the message says why."""
+
+
+class _Stopped(Exception):
+    """MuJoCo stopped stepping one of the models: which, at which step, and why."""
+
+    def __init__(self, model: int, step: int, reason: str) -> None:
+        super().__init__(reason)
+        self.model, self.step, self.reason = model, step, reason
 
 
 def round_off_twin(source: mujoco.MjModel, result: mujoco.MjModel) -> tuple[mujoco.MjModel, int]:
@@ -146,9 +168,29 @@ def _steps(
     for t in range(len(ctrl)):
         for k, (m, d) in enumerate(zip(models, datas, strict=True)):
             d.ctrl[actuators[k]] = ctrl[t, actuators[0]]
-            mujoco.mj_step(m, d)
+            try:
+                mujoco.mj_step(m, d)
+            except mujoco.FatalError as exc:  # MuJoCo's own error: its first line says it
+                raise _Stopped(k, t + 1, str(exc).strip().splitlines()[0]) from None
             out[k][t] = d.qpos
     return out
+
+
+def _moves_alike(
+    twin: mujoco.MjModel,
+    result: mujoco.MjModel,
+    ctrl: np.ndarray,
+    actuators: tuple[np.ndarray, np.ndarray],
+    coordinates: tuple[np.ndarray, np.ndarray],
+) -> bool:
+    """Whether the round-off twin and the result move alike (within
+    :data:`ROLLOUT_TOL`) under ``ctrl``; not where MuJoCo stops either."""
+    try:
+        like, them = _steps((twin, result), ctrl, actuators)
+    except _Stopped:
+        return False
+    gap = np.abs(like[:, coordinates[0]] - them[:, coordinates[1]])
+    return gap.max(initial=0.0) <= ROLLOUT_TOL
 
 
 def _largest_gaps(gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -212,7 +254,12 @@ def rollout_differences(
     """The rollouts of ``source`` and ``result`` compared (see the module docstring).
     ``qpos_map``: source joint position index -> the result's; ``actuator_map``: source
     actuator -> the result's. Empty when they agree or cannot be compared
-    (:func:`can_roll_out`)."""
+    (:func:`can_roll_out`).
+
+    Raises:
+        RolloutNotMade: the source has more than :data:`MAX_ROLLOUT_CONTACTS` contacts
+            at its reference pose, or MuJoCo stops stepping it.
+    """
     if not can_roll_out(source, result, qpos_map, actuator_map):
         return []
     src_q = np.fromiter(qpos_map.keys(), dtype=int)
@@ -220,13 +267,39 @@ def rollout_differences(
     src_u = np.fromiter(actuator_map.keys(), dtype=int)
     res_u = np.fromiter(actuator_map.values(), dtype=int)
     source, result = _robot_alone(source), _robot_alone(result)
+    start = mujoco.MjData(source)
+    mujoco.mj_forward(source, start)
+    if start.ncon > MAX_ROLLOUT_CONTACTS:
+        raise RolloutNotMade(
+            f"the source has {start.ncon} contacts at its reference pose (more than "
+            f"{MAX_ROLLOUT_CONTACTS}: links that overlap at rest collide); exclude those "
+            "contacts in the source to have it simulated"
+        )
     zero = np.zeros((steps, source.nu))
     twin: tuple[mujoco.MjModel, int] | None = None
     out = []
     for what, ctrl in (("zero control", zero), ("pseudo-random control", _controls(source, steps))):
-        mine, theirs, moved = _steps(
-            (source, result, source), ctrl, (src_u, res_u, src_u), (False, False, True)
-        )
+        try:
+            mine, theirs, moved = _steps(
+                (source, result, source), ctrl, (src_u, res_u, src_u), (False, False, True)
+            )
+        except _Stopped as stop:
+            if stop.model != 1:
+                raise RolloutNotMade(
+                    f"MuJoCo stops stepping the source at step {stop.step} ({what}): {stop.reason}"
+                ) from None
+            out.append(
+                Difference(
+                    f"simulation, {what}, {steps} steps",
+                    "model",
+                    "the robot",
+                    "the source's joint positions",
+                    f"MuJoCo stops stepping the output at step {stop.step}, where the "
+                    f"source steps on: {stop.reason}",
+                    (),
+                )
+            )
+            continue
         per_step, column = _largest_gaps(np.abs(mine[:, src_q] - theirs[:, res_q]))
         t = int(per_step.argmax())  # the first step reaching the largest
         worst = max(float(per_step[t]), 0.0)
@@ -240,10 +313,8 @@ def rollout_differences(
             # only: where it moves as the result does, the divergence is the model's
             # sensitivity to its last digits, not a change the conversion made.
             twin = twin or round_off_twin(source, result)
-            if twin[1]:
-                like, them = _steps((twin[0], result), ctrl, (src_u, res_u))
-                if np.abs(like[:, src_q] - them[:, res_q]).max(initial=0.0) <= ROLLOUT_TOL:
-                    continue
+            if twin[1] and _moves_alike(twin[0], result, ctrl, (src_u, res_u), (src_q, res_q)):
+                continue
             out.append(
                 Difference(
                     f"simulation, {what}, {steps} steps",

@@ -116,7 +116,12 @@ def simulation_row(report: RoundTripReport) -> Row:
     ours = report.simulated_model
     if source is None or ours is None or not report.reference.startswith("mujoco"):
         return Row(SIMULATION_CHECK, "no MuJoCo model of the source", True, compared=0)
-    found = _rollouts(source, ours)
+    from robotwright.proof.rollout import RolloutNotMade
+
+    try:
+        found = _rollouts(source, ours)
+    except RolloutNotMade as why:
+        return Row(SIMULATION_CHECK, f"not simulated: {why}", True, compared=0)
     if found is None:
         return Row(SIMULATION_CHECK, "not comparable one to one", True, compared=0)
     if not found:
