@@ -91,8 +91,8 @@ def _mujoco_import(source: Path) -> float | None:
     c0 = _cpu()
     try:
         mujoco.MjModel.from_xml_path(str(source))
-    except (ValueError, RuntimeError):  # deeper than its compiler's own depth limit (3.12
-        return None  # says so as a RuntimeError)
+    except (ValueError, RuntimeError):  # deeper than its compiler's own depth limit
+        return None  # (MuJoCo 3.12 refuses it with a RuntimeError)
     return _cpu() - c0
 
 
