@@ -222,6 +222,19 @@ def _robot_alone(model: mujoco.MjModel) -> mujoco.MjModel:
     return alone
 
 
+def _simulation_difference(what: str, steps: int, result: str) -> Difference:
+    """One difference of the rollout under control ``what``: ``result`` says how the
+    output moved against the source's joint positions."""
+    return Difference(
+        f"simulation, {what}, {steps} steps",
+        "model",
+        "the robot",
+        "the source's joint positions",
+        result,
+        (),
+    )
+
+
 def _joint_at(model: mujoco.MjModel, qpos_index: int) -> str:
     j = int(np.searchsorted(model.jnt_qposadr, qpos_index, side="right")) - 1
     return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or f"joint #{j}"
@@ -289,14 +302,11 @@ def rollout_differences(
                     f"MuJoCo stops stepping the source at step {stop.step} ({what}): {stop.reason}"
                 ) from None
             out.append(
-                Difference(
-                    f"simulation, {what}, {steps} steps",
-                    "model",
-                    "the robot",
-                    "the source's joint positions",
+                _simulation_difference(
+                    what,
+                    steps,
                     f"MuJoCo stops stepping the output at step {stop.step}, where the "
                     f"source steps on: {stop.reason}",
-                    (),
                 )
             )
             continue
@@ -316,15 +326,12 @@ def rollout_differences(
             if twin[1] and _moves_alike(twin[0], result, ctrl, (src_u, res_u), (src_q, res_q)):
                 continue
             out.append(
-                Difference(
-                    f"simulation, {what}, {steps} steps",
-                    "model",
-                    "the robot",
-                    "the source's joint positions",
+                _simulation_difference(
+                    what,
+                    steps,
                     f"joint positions differing from step {first} on, by up to {worst:.3g} "
                     f"(joint '{_joint_at(source, where)}'; the source itself moves by "
                     f"{own:.3g} from a start {PERTURBATION:g} away)",
-                    (),
                 )
             )
     return out
