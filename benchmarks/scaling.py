@@ -162,9 +162,9 @@ def main() -> None:
                 source.write_text(tree_urdf(n, branching=branching), encoding="utf-8")
                 hrdf = folder / "hrdf"
                 cells = []
+                # USD goes out through our MJCF: neither holds a chain that deep
+                too_deep = _depth(n, branching) > MJCF_MAX_BODY_DEPTH
                 for step in steps:
-                    # USD goes out through our MJCF: neither holds a chain that deep
-                    too_deep = _depth(n, branching) > MJCF_MAX_BODY_DEPTH
                     if step in ("export-mjcf", "export-usd") and too_deep:
                         cells.append(f"{'(too deep)':>12}")
                         continue
