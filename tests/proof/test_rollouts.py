@@ -343,3 +343,101 @@ def test_mujoco_stopping_the_source_or_the_output_is_told_apart(tmp_path) -> Non
         fails["which"] = 0
         with pytest.raises(rollout.RolloutNotMade, match="stops stepping the source at step"):
             rollout.rollout_differences(a, b, qpos, act)
+
+
+def _chain(n: int) -> mujoco.MjModel:
+    """MuJoCo's import of a chain of ``n`` box links on hinges (a mass matrix of
+    n(n-1)/2 entries)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
+    from test_roundtrip_scale import tree_urdf
+
+    return mujoco.MjModel.from_xml_string(tree_urdf(n, branching=1))
+
+
+def test_a_long_chain_is_stepped_fewer_times_within_the_budget() -> None:
+    """A step costs as the mass matrix's entries, a chain's growing as its length
+    squared: a robot's 200 steps, a 300-link chain's as many as the budget buys, and a
+    chain too long for MIN_ROLLOUT_STEPS is not simulated, saying why."""
+    import pytest
+
+    from robotwright.proof.rollout import (
+        MIN_ROLLOUT_STEPS,
+        ROLLOUT_STEPS,
+        ROLLOUT_WORK,
+        RolloutNotMade,
+        rollout_steps,
+    )
+
+    short, long = _chain(100), _chain(300)
+    assert short.nM == 99 * 100 // 2 and rollout_steps(short) == ROLLOUT_STEPS
+    steps = rollout_steps(long)
+    assert MIN_ROLLOUT_STEPS <= steps < ROLLOUT_STEPS
+    assert steps * long.nM <= ROLLOUT_WORK < (steps + 1) * long.nM
+    too_long = _chain(480)
+    assert too_long.nM > ROLLOUT_WORK // MIN_ROLLOUT_STEPS
+    with pytest.raises(RolloutNotMade, match=f"{too_long.nM:,} entries"):
+        rollout_steps(too_long)
+
+
+def test_a_long_chain_changed_is_found_in_its_fewer_steps() -> None:
+    """The 300-link chain, damped (undamped, it falls chaotically: a start 1e-12 away
+    ends 0.1 rad away), with one link's centre of mass moved 2 cm: the shorter
+    rollouts still find it, naming their steps; unchanged, the chain moves the same."""
+    from robotwright.proof.rollout import rollout_steps
+
+    source, result = _chain(300), _chain(300)
+    for model in (source, result):
+        model.dof_damping[:] = 1.0  # N m s / rad
+    assert _rollouts(source, result) == []
+    result.body_ipos[150, 0] += 0.02
+    found = _rollouts(source, result)
+    steps = rollout_steps(source)
+    assert found and found[0].field == f"simulation, zero control, {steps} steps", found
+
+
+def test_a_chain_too_long_to_step_is_a_note_and_a_row(tmp_path, capsys) -> None:
+    """convert of a 480-link chain (within MJCF's depth): the proof compares it without
+    the simulation and says so (exit 0); roundtrip's row says why, not 'not comparable'."""
+    import sys
+
+    from robotwright.cli import main
+    from robotwright.proof.roundtrip.run import SIMULATION_CHECK, simulation_row
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
+    from test_roundtrip_scale import tree_urdf
+
+    source = tmp_path / "chain.urdf"
+    source.write_text(tree_urdf(480, branching=1), encoding="utf-8")
+    assert main(["convert", str(source), "-o", str(tmp_path / "hrdf"), "-v"]) == 0
+    err = capsys.readouterr().err
+    assert "proof: simulation not compared: its mass matrix has 114,960 entries" in err, err
+
+    class Report:  # what simulation_row reads of a round trip's report
+        reference = "mujoco"
+        simulated_reference = simulated_model = _chain(480)
+
+    row = simulation_row(Report())  # type: ignore[arg-type]
+    assert row.check == SIMULATION_CHECK and row.compared == 0 and row.ok
+    assert row.value.startswith("not simulated: its mass matrix has 114,960 entries")
+
+
+def test_contacts_past_mujocos_arena_are_a_reason_not_a_crash_or_minutes() -> None:
+    """Trees of overlapping boxes: 300 links fill MuJoCo's arena at rest (MuJoCo 3.x then
+    keeps no contact at all, and stepping it took 23 s), 1,000 links stop its collision
+    with a FatalError. Both are a reason not to simulate, found before any step."""
+    import sys
+
+    import pytest
+
+    from robotwright.proof.rollout import RolloutNotMade
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
+    from test_roundtrip_scale import tree_urdf
+
+    for links, reason in ((300, "than MuJoCo's arena holds"), (1000, "MuJoCo cannot hold")):
+        model = mujoco.MjModel.from_xml_string(tree_urdf(links, branching=4))
+        qpos = {i: i for i in range(model.nq)}
+        with pytest.raises(RolloutNotMade, match=reason):
+            rollout_differences(model, model, qpos, {})

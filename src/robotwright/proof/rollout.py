@@ -22,11 +22,16 @@ naming the control, the step it first exceeded the tolerance, the largest differ
 the joint it is largest at and the source's own.
 
 Run only where every joint position and actuator of the source has its counterpart in
-the result (and the result has no others), and for models up to :data:`MAX_ROLLOUT_DOFS`
-degrees of freedom: a longer chain is a test of the writer, not a robot to simulate.
-Not made (:class:`RolloutNotMade`, which the proof reports as a note) where the source has
-more than :data:`MAX_ROLLOUT_CONTACTS` contacts at its reference pose (links that overlap
-at rest: MuJoCo's arena fills, and every step costs as much as thousands of contacts), or
+the result (and the result has no others). A step costs in proportion to the entries of
+MuJoCo's mass matrix (``MjModel.nM``: each degree of freedom with its ancestors), which a
+long chain makes grow as its length squared: a model with more than
+``ROLLOUT_WORK / ROLLOUT_STEPS`` entries is stepped fewer times
+(:func:`rollout_steps`), so the simulation costs at most about as much as a 10,000-entry
+model's 200 steps, and the proof stays linear in the robot's size. Not made
+(:class:`RolloutNotMade`, which the proof reports as a note) where that leaves fewer than
+:data:`MIN_ROLLOUT_STEPS` steps (a chain of about 450 joints), where the source has more
+than :data:`MAX_ROLLOUT_CONTACTS` contacts at its reference pose (links that overlap at
+rest: MuJoCo's arena fills, and every step costs as much as thousands of contacts), or
 where MuJoCo stops stepping the source (its error, e.g. the arena too small); where it
 stops the result alone, that is a difference.
 """
@@ -34,6 +39,7 @@ stops the result alone, that is a difference.
 from __future__ import annotations
 
 import copy
+import math
 
 import mujoco
 import numpy as np
@@ -44,26 +50,33 @@ __all__ = [
     "CHAOS_MARGIN",
     "can_roll_out",
     "MAX_ROLLOUT_CONTACTS",
-    "MAX_ROLLOUT_DOFS",
+    "MIN_ROLLOUT_STEPS",
     "PERTURBATION",
     "ROLLOUT_STEPS",
     "ROLLOUT_TOL",
+    "ROLLOUT_WORK",
     "ROUND_OFF",
     "RolloutNotMade",
     "round_off_twin",
     "rollout_differences",
+    "rollout_steps",
 ]
 
-#: Steps of each rollout (at the model's own timestep).
+#: Steps of each rollout (at the model's own timestep), for a model whose mass matrix has
+#: at most ``ROLLOUT_WORK / ROLLOUT_STEPS`` (10,000) entries: every robot arm, hand,
+#: quadruped and humanoid (the 44-joint JVRC-1: 299 entries; a 100-joint chain: 4,950).
 ROLLOUT_STEPS = 200
+#: The simulation's budget: its steps times the entries of the source's mass matrix
+#: (``MjModel.nM``), what a step's cost grows with.
+ROLLOUT_WORK = 2_000_000
+#: Fewest steps a rollout is made with (a mass matrix of up to 100,000 entries).
+MIN_ROLLOUT_STEPS = 20
 #: Largest joint position difference (m or rad) that is not a difference.
 ROLLOUT_TOL = 1e-6
 #: The source's own start moved by this much in every joint position (rad or m).
 PERTURBATION = 1e-12
 #: How many times the source's own divergence the result's must exceed to count.
 CHAOS_MARGIN = 100.0
-#: Degrees of freedom above which no rollout is made.
-MAX_ROLLOUT_DOFS = 300
 #: Contacts of the source at its reference pose above which no rollout is made (a robot
 #: at rest has tens: the talos 34).
 MAX_ROLLOUT_CONTACTS = 1000
@@ -247,14 +260,29 @@ def can_roll_out(
     actuator_map: dict[int, int],
 ) -> bool:
     """Whether the two models can be simulated side by side: every joint position and
-    actuator of the source matched in the result (which has no others), and at most
-    :data:`MAX_ROLLOUT_DOFS` degrees of freedom."""
+    actuator of the source matched in the result (which has no others)."""
     return (
         source.nq == result.nq == len(qpos_map)
         and source.nu == result.nu == len(actuator_map)
-        and source.nv <= MAX_ROLLOUT_DOFS
         and all(r >= 0 for r in actuator_map.values())
     )
+
+
+def rollout_steps(source: mujoco.MjModel) -> int:
+    """Steps of each rollout of ``source``: :data:`ROLLOUT_STEPS`, fewer where its mass
+    matrix has more than ``ROLLOUT_WORK / ROLLOUT_STEPS`` entries (a long chain).
+
+    Raises:
+        RolloutNotMade: that would be fewer than :data:`MIN_ROLLOUT_STEPS`.
+    """
+    steps = min(ROLLOUT_STEPS, ROLLOUT_WORK // max(source.nM, 1))
+    if steps < MIN_ROLLOUT_STEPS:
+        raise RolloutNotMade(
+            f"its mass matrix has {source.nM:,} entries (a chain of joints about "
+            f"{math.isqrt(2 * source.nM):,} deep; more than "
+            f"{ROLLOUT_WORK // MIN_ROLLOUT_STEPS:,}): each step costs too much to simulate"
+        )
+    return steps
 
 
 def rollout_differences(
@@ -262,30 +290,48 @@ def rollout_differences(
     result: mujoco.MjModel,
     qpos_map: dict[int, int],
     actuator_map: dict[int, int],
-    steps: int = ROLLOUT_STEPS,
+    steps: int | None = None,
 ) -> list[Difference]:
     """The rollouts of ``source`` and ``result`` compared (see the module docstring).
     ``qpos_map``: source joint position index -> the result's; ``actuator_map``: source
-    actuator -> the result's. Empty when they agree or cannot be compared
-    (:func:`can_roll_out`).
+    actuator -> the result's; ``steps``: of each rollout (default :func:`rollout_steps`).
+    Empty when they agree or cannot be compared (:func:`can_roll_out`).
 
     Raises:
-        RolloutNotMade: the source has more than :data:`MAX_ROLLOUT_CONTACTS` contacts
-            at its reference pose, or MuJoCo stops stepping it.
+        RolloutNotMade: the source's mass matrix is too large to step
+            :data:`MIN_ROLLOUT_STEPS` times within :data:`ROLLOUT_WORK`, it has more than
+            :data:`MAX_ROLLOUT_CONTACTS` contacts at its reference pose, or MuJoCo stops
+            stepping it.
     """
     if not can_roll_out(source, result, qpos_map, actuator_map):
         return []
+    if steps is None:
+        steps = rollout_steps(source)
     src_q = np.fromiter(qpos_map.keys(), dtype=int)
     res_q = np.fromiter(qpos_map.values(), dtype=int)
     src_u = np.fromiter(actuator_map.keys(), dtype=int)
     res_u = np.fromiter(actuator_map.values(), dtype=int)
     source, result = _robot_alone(source), _robot_alone(result)
     start = mujoco.MjData(source)
-    mujoco.mj_forward(source, start)
-    if start.ncon > MAX_ROLLOUT_CONTACTS:
+    try:  # the contacts alone: the solver on thousands of them costs seconds
+        mujoco.mj_kinematics(source, start)
+        mujoco.mj_collision(source, start)
+    except mujoco.FatalError as exc:  # its arena cannot hold them
         raise RolloutNotMade(
-            f"the source has {start.ncon} contacts at its reference pose (more than "
-            f"{MAX_ROLLOUT_CONTACTS}: links that overlap at rest collide); exclude those "
+            "MuJoCo cannot hold the source's contacts at its reference pose (links that "
+            f"overlap at rest collide): {str(exc).strip().splitlines()[0]}"
+        ) from None
+    # MuJoCo 3.x keeps no contact when its arena is full (ncon 0, and a warning)
+    full = bool(start.warning[mujoco.mjtWarning.mjWARN_CONTACTFULL].number)
+    if full or start.ncon > MAX_ROLLOUT_CONTACTS:
+        many = (
+            "more contacts at its reference pose than MuJoCo's arena holds"
+            + (f" ({start.ncon} contacts held)" if start.ncon else "")
+            if full
+            else f"{start.ncon} contacts at its reference pose (more than {MAX_ROLLOUT_CONTACTS})"
+        )
+        raise RolloutNotMade(
+            f"the source has {many}: links that overlap at rest collide; exclude those "
             "contacts in the source to have it simulated"
         )
     zero = np.zeros((steps, source.nu))
