@@ -111,3 +111,45 @@ def test_a_failing_converter_leaves_the_saves_as_they_were(tmp_path) -> None:
     with pytest.raises(ValueError, match="not an MJCF"):
         converted_stage(_converter_module(convert), tmp_path / "robot.xml", tmp_path / "out")
     assert usdex.core.saveStage is _REAL_SAVE
+
+
+def test_the_spec_given_is_what_the_converter_reads(tmp_path) -> None:
+    """Given MuJoCo's parse of the MJCF, the converter's own MjSpec.from_file of that file
+    gets a copy of it (this thread only: another thread's read parses the file), and
+    MjSpec.from_file is MuJoCo's own again after; the G1's asset is the same layer."""
+    import mujoco
+
+    raw = mujoco.MjSpec.__dict__["from_file"]
+    hrdf = robot_named("arm6")
+    mjcf, _ = _robot_mjcf(hrdf, tmp_path / "robot")
+    parsed = mujoco.MjSpec.from_file(str(mjcf))
+    parsed.modelname = "given"  # what tells the copy from a new parse
+    seen: dict[str, str] = {}
+
+    def convert(path: str, folder: str) -> Sdf.AssetPath:
+        Path(folder).mkdir()
+        seen["mine"] = mujoco.MjSpec.from_file(path).modelname
+        other = threading.Thread(
+            target=lambda: seen.setdefault("other", mujoco.MjSpec.from_file(path).modelname)
+        )
+        other.start()
+        other.join()
+        asset = _stage_with_a_cube(Path(folder) / "asset.usda")
+        usdex.core.saveStage(asset)
+        return Sdf.AssetPath(asset.GetRootLayer().identifier)
+
+    converted_stage(_converter_module(convert), mjcf, tmp_path / "out", parsed)
+    assert seen == {"mine": "given", "other": mjcf.stem}
+    assert mujoco.MjSpec.__dict__["from_file"] is raw and parsed.modelname == "given"
+
+    g1 = robot_named("g1")
+    mjcf, _ = _robot_mjcf(g1, tmp_path / "g1")
+    with captured_library_output():
+        read = converted_stage(mujoco_usd_converter, mjcf, tmp_path / "read")
+        given = converted_stage(
+            mujoco_usd_converter, mjcf, tmp_path / "given", mujoco.MjSpec.from_file(str(mjcf))
+        )
+    assert _text(given.GetRootLayer(), tmp_path / "given") == _text(
+        read.GetRootLayer(), tmp_path / "read"
+    )
+    assert mujoco.MjSpec.__dict__["from_file"] is raw

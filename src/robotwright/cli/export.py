@@ -235,8 +235,9 @@ def _export(args: argparse.Namespace) -> int:
         )
     hrdf = load_robot(args.robot)
     out = Path(args.output)
-    # What MuJoCo refuses is not written (validate calls such a robot invalid).
-    require_compiles(hrdf, f"cannot write {out}")
+    # What MuJoCo refuses is not written (validate calls such a robot invalid); the robot
+    # alone where the output has no scene, as the proof compiles it (one parse for both).
+    require_compiles(hrdf, f"cannot write {out}", scene=args.format == "mjcf")
     if args.format == "urdf":
         _prove_urdf(hrdf, out, args.strict)
     if args.format == "usd":

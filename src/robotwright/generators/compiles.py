@@ -43,10 +43,10 @@ def _mujoco_message(exc: Exception) -> str:
 
 def _compile_xml(xml: str) -> str | None:
     """MuJoCo's message when ``xml`` does not compile, else ``None``."""
-    import mujoco
+    from robotwright._mjspec_cache import parsed_spec
 
     try:
-        mujoco.MjSpec.from_string(xml).compile()
+        parsed_spec(xml).compile()
     except Exception as exc:  # noqa: BLE001 - MuJoCo raises ValueError or its own types
         return _mujoco_message(exc)
     return None
@@ -154,6 +154,17 @@ def _generated_xml(hrdf: HRDF) -> str:
     return to_xml_string(root)
 
 
+def robot_xml(hrdf: HRDF) -> str:
+    """Our MJCF of ``hrdf`` as a string: the robot alone (no scene), mesh paths
+    absolute."""
+    from robotwright.generators import MJCFHumanoidGenerator
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # conversion warnings are reported on export
+        gen = MJCFHumanoidGenerator.from_hrdf(hrdf)
+        return gen.export(None, relative_mesh_path=False, add_scene=False)
+
+
 def check_compiles(hrdf: HRDF) -> list[Problem]:
     """Problems that stop ``hrdf`` from exporting or compiling (empty list when it does).
 
@@ -228,11 +239,14 @@ def too_deep_for_mjcf(hrdf: HRDF) -> str | None:
     )
 
 
-def require_compiles(hrdf: HRDF, doing: str) -> None:
+def require_compiles(hrdf: HRDF, doing: str, *, scene: bool = True) -> None:
     """Refuse a model MuJoCo refuses, saying where: ``convert``/``export`` call it before
     writing (so they never write what ``validate`` calls invalid, and exit 0), ``render``
     and ``view`` when MuJoCo cannot compile what they were given. ``doing`` starts the
-    message (``"cannot write out.xml"``).
+    message (``"cannot write out.xml"``). ``scene``: the MJCF with the scene export adds
+    (a floor, a light and a sky), else the robot alone, as :func:`robot_xml` writes it
+    and the proof compiles it (MuJoCo's parse of it is then made once:
+    :mod:`robotwright._mjspec_cache`).
 
     The whole model is compiled once; only when MuJoCo refuses it are the per-mesh and
     per-row checks of :func:`check_compiles` run to say where.
@@ -247,7 +261,8 @@ def require_compiles(hrdf: HRDF, doing: str) -> None:
         return  # MuJoCo cannot judge it: the MJCF writer refuses it, flat formats hold it
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # conversion warnings are reported on export
-        message = _compile_xml(_generated_xml(hrdf))  # table errors raise HRDFError here
+        # table errors raise HRDFError here
+        message = _compile_xml(_generated_xml(hrdf) if scene else robot_xml(hrdf))
     if message is None:
         return
     problems = [p for p in check_compiles(hrdf) if p.severity == "error"]
@@ -265,6 +280,7 @@ __all__ = [
     "check_compiles",
     "check_meshes",
     "require_compiles",
+    "robot_xml",
     "too_deep_for_mjcf",
     "validate_dir",
 ]

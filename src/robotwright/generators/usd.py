@@ -164,14 +164,14 @@ def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple
     return path, lost
 
 
-def _kinematic_model(mjcf: Path) -> mujoco.MjModel:
-    """MuJoCo's compile of our MJCF without its mesh geoms: the same bodies, masses,
-    inertias (each body's is explicit in our MJCF, so no geom contributes), joints,
-    actuators and keyframes, without reading or hulling a mesh (the G1's 35 meshes took
-    0.3-1.1 s of a 2 s export). Nothing the export or its proof reads is in a mesh. A
-    model in which something refers to a mesh geom (a contact pair, a sensor) is
-    compiled whole."""
-    spec = mujoco.MjSpec.from_file(str(mjcf))
+def _kinematic_model(parsed: mujoco.MjSpec) -> mujoco.MjModel:
+    """MuJoCo's compile of our MJCF (``parsed``: its spec, left as it is) without its
+    mesh geoms: the same bodies, masses, inertias (each body's is explicit in our MJCF,
+    so no geom contributes), joints, actuators and keyframes, without reading or hulling
+    a mesh (the G1's 35 meshes took 0.3-1.1 s of a 2 s export). Nothing the export or its
+    proof reads is in a mesh. A model in which something refers to a mesh geom (a
+    contact pair, a sensor) is compiled whole."""
+    spec = parsed.copy()
     for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
         spec.delete(geom)
     for mesh in list(spec.meshes):
@@ -179,7 +179,7 @@ def _kinematic_model(mjcf: Path) -> mujoco.MjModel:
     try:
         return spec.compile()
     except ValueError:
-        return mujoco.MjModel.from_xml_path(str(mjcf))
+        return parsed.copy().compile()
 
 
 def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
@@ -455,8 +455,10 @@ def to_usd(
         # edit of the layered asset would recompose its payload; the converter's own
         # one-file output writes, reopens and saves that layer, in the system's
         # temporary folder, before we could open it).
+        # MuJoCo's parse of our MJCF, made once: the converter's and the proof's
+        parsed = mujoco.MjSpec.from_file(str(mjcf))
         with captured_library_output() as printed:
-            stage = converted_stage(converter, mjcf, Path(tmp) / "usd")
+            stage = converted_stage(converter, mjcf, Path(tmp) / "usd", parsed)
         # What the libraries said is passed on as notes, never as a difference: --strict
         # refuses what the proof finds, not another library's remarks.
         said = _library_notes(printed, "mujoco-usd-converter")
@@ -467,7 +469,7 @@ def to_usd(
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
             root.SetDisplayName(hrdf.name)
-        model = mujoco.MjModel.from_xml_path(str(mjcf)) if geometry else _kinematic_model(mjcf)
+        model = parsed.copy().compile() if geometry else _kinematic_model(parsed)
         result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost, mjcf_model=model)
         for body in _zero_inertia_bodies(model):
             result.notes.append(

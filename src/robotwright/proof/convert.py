@@ -146,7 +146,6 @@ def _convert(
     simulate: bool = False,
 ) -> list[str]:
     from robotwright._confine import run_confined
-    from robotwright.generators.compiles import require_compiles
     from robotwright.parsers.collision import pop_config
     from robotwright.parsers.packages import source_read_roots
 
@@ -171,6 +170,7 @@ def _convert(
         repairs,
         proof,
         simulate,
+        (dst_p, scene),
         roots=source_read_roots(src_p, file_kind(src_p, existing=True), options),
         writable=[work] if work else [],
         what=str(src_p),
@@ -178,8 +178,6 @@ def _convert(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            # What MuJoCo refuses is not written (validate calls such a folder invalid).
-            require_compiles(hrdf, f"cannot write {dst_p}")
             if proof:
                 if proved is None:  # the reader could not prove it: say why here
                     proved = _proof(src_p, hrdf, out_kind, messages, strict, options, simulate)
@@ -204,18 +202,23 @@ def _convert(
                         dst_p, copy_meshes=True, strict=strict
                     )
         except HRDFError as exc:
-            massless = any(p.column in ("mass", "diag_inertia") for p in exc.problems)
-            hint = (
-                " (massless links: try fixed_joints='merge' / --fixed-joints merge, or "
-                "bound_mass / --bound-mass)"
-                if massless
-                else ""
-            )
-            raise ConversionError(
-                exc.problems, summary=f"cannot write {dst_p}: the robot is not a valid HRDF{hint}"
-            ) from exc
+            raise _not_valid(exc, dst_p) from exc
     messages += [str(w.message) for w in caught]
     return messages
+
+
+def _not_valid(exc: HRDFError, dst_p: Path) -> ConversionError:
+    """The conversion's error for a robot that is not a valid HRDF (its problems)."""
+    massless = any(p.column in ("mass", "diag_inertia") for p in exc.problems)
+    hint = (
+        " (massless links: try fixed_joints='merge' / --fixed-joints merge, or "
+        "bound_mass / --bound-mass)"
+        if massless
+        else ""
+    )
+    return ConversionError(
+        exc.problems, summary=f"cannot write {dst_p}: the robot is not a valid HRDF{hint}"
+    )
 
 
 def _read_and_prove(
@@ -226,16 +229,33 @@ def _read_and_prove(
     repairs: Any,
     proof: bool,
     simulate: bool = False,
+    check: tuple[Path, bool] | None = None,
 ) -> tuple[HRDF, list[str], list[str] | None]:
-    """Read the source, repair its collision meshes and prove the conversion (run in a
-    confined reader): the robot, the notes, and the proof's notes (None: not proved
-    here, for example because the output does not compile; the caller says why)."""
+    """Read the source, repair its collision meshes, refuse an output MuJoCo refuses
+    (``check``: the output and whether it has a scene, for
+    :func:`~robotwright.generators.compiles.require_compiles`; in the same process as the
+    proof, which then compiles our MJCF from MuJoCo's parse already made) and prove the
+    conversion (run in a confined reader): the robot, the notes, and the proof's notes
+    (None: not proved here, for example because the output does not compile; the caller
+    says why).
+
+    Raises:
+        ConversionError: MuJoCo refuses the output (its problems), or ``strict`` and the
+            proof found a difference.
+    """
+    from robotwright.generators.compiles import require_compiles
     from robotwright.parsers.collision import repair_collision_meshes
 
     hrdf, problems = load_any(src_p, strict=strict, **options)
     messages = [str(p) for p in problems]
     hrdf, repaired = repair_collision_meshes(hrdf, repairs)
     messages += [str(r) for r in repaired]
+    if check is not None:  # what MuJoCo refuses is not written
+        dst_p, scene = check
+        try:
+            require_compiles(hrdf, f"cannot write {dst_p}", scene=scene)
+        except HRDFError as exc:
+            raise _not_valid(exc, dst_p) from exc
     proved = None
     if proof:
         try:

@@ -173,7 +173,9 @@ def _compile_with_same_files(
         key = _file_key(p)
         if key is not None:
             by_key.setdefault(key, str(p))
-    spec = mujoco.MjSpec.from_string(xml)
+    from robotwright._mjspec_cache import parsed_spec
+
+    spec = parsed_spec(xml)
     if discard_visual:
         spec.compiler.discardvisual = True
     folder, meshdir, names = source or ("", "", {})
@@ -219,6 +221,7 @@ def result_model(
     source. ``source``: the source as :func:`source_model` compiled it (its meshes are
     read by the same names, from MuJoCo's cache)."""
     files = _SOURCE_MESHES.pop(id(source), None) if source is not None else None
+    import dataclasses
     import tempfile
     import warnings
 
@@ -241,6 +244,9 @@ def result_model(
                     folder = Path(tmp) / "robot"
                     hrdf.save(folder)
                     loaded = _HRDF.from_dir(folder, asset_roots=hrdf.asset_roots)
+                    # named after the folder it is read from; under the robot's own name
+                    # the text is the one the export's check parsed (parsed once)
+                    loaded = dataclasses.replace(loaded, name=hrdf.name)
                     model = _compile_with_same_files(
                         our_mjcf_text(loaded), originals, discard_visual, files
                     )

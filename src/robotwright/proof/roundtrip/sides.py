@@ -46,19 +46,16 @@ def parse_source(path: Path, strict: bool = False, **options: Any):
 
 def our_mjcf_text(hrdf: HRDF) -> str:
     """Our MJCF of ``hrdf`` as a string (no scene, mesh paths absolute)."""
-    import warnings
+    from robotwright.generators.compiles import robot_xml
 
-    from robotwright.generators import MJCFHumanoidGenerator
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        gen = MJCFHumanoidGenerator.from_hrdf(hrdf)
-        return gen.export(None, relative_mesh_path=False, add_scene=False)
+    return robot_xml(hrdf)
 
 
 def our_mjcf_model(hrdf: HRDF) -> mujoco.MjModel:
     """Our MJCF of ``hrdf`` compiled by MuJoCo (no scene)."""
-    return mujoco.MjSpec.from_string(our_mjcf_text(hrdf)).compile()
+    from robotwright._mjspec_cache import parsed_spec
+
+    return parsed_spec(our_mjcf_text(hrdf)).compile()
 
 
 @dataclass
