@@ -16,6 +16,9 @@ this process (CPU seconds, median of --repeat runs):
                                                             our MJCF, so not a chain
                                                             too deep for it either)
 
+  converter   mujoco-usd-converter alone on our MJCF of the robot (no scene; --usd):
+              what the USD export hands it, the reference its time is set against
+
 CPU time counts this process and the reader processes it starts. One conversion of a
 small robot and its exports run first, untimed (imports, caches, warp's kernels).
 
@@ -111,6 +114,21 @@ def _mujoco_import(source: Path) -> float | None:
     return None if answer == "refused" else float(answer)
 
 
+def _converter_alone(hrdf: Path, folder: Path) -> float:
+    """CPU seconds of mujoco-usd-converter alone on our MJCF of ``hrdf`` (the robot alone,
+    written untimed into ``folder``)."""
+    import mujoco_usd_converter
+
+    from robotwright._library_output import captured_library_output
+
+    mjcf = folder / "robot.xml"
+    _run(["export", str(hrdf), "--format", "mjcf", "--no-scene", "-o", str(mjcf), "--overwrite"])
+    c0 = _cpu()
+    with captured_library_output():
+        mujoco_usd_converter.Converter().convert(str(mjcf), str(folder / "usd"))
+    return _cpu() - c0
+
+
 def _keyframes(tmp: Path, n: int) -> dict[str, float]:
     """CPU seconds of converting a one-joint robot with ``n`` keyframes to HRDF and of
     exporting that HRDF as MJCF, each with its proof."""
@@ -161,7 +179,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1, help="runs per step (median)")
     ap.add_argument("--usd", action="store_true", help="also export USD (Isaac Lab's env)")
     args = ap.parse_args()
-    steps = ["convert", "export-mjcf", "export-urdf"] + (["export-usd"] if args.usd else [])
+    steps = ["convert", "export-mjcf", "export-urdf"]
+    steps += ["export-usd", "converter"] if args.usd else []
     steps.append("mujoco")
     print(f"{'shape':6} {'links':>6} " + " ".join(f"{s:>12}" for s in steps) + "   (CPU s)")
     growth: dict[tuple[str, str], tuple[list[int], list[float]]] = {}
@@ -172,7 +191,7 @@ def main() -> None:
         for step in steps:  # the first USD export loads Newton and builds warp's kernels
             if step.startswith("export-"):
                 kind = step.split("-")[1]
-                out = Path(tmp) / f"warm.{'xml' if kind == 'mjcf' else kind}"
+                out = Path(tmp) / f"warm-out.{'xml' if kind == 'mjcf' else kind}"
                 _run(["export", str(Path(tmp) / "warm"), "--format", kind, "-o", str(out)])
         for shape, branching in SHAPES.items():
             for n in args.sizes:
@@ -185,7 +204,7 @@ def main() -> None:
                 # USD goes out through our MJCF: neither holds a chain that deep
                 too_deep = _depth(n, branching) > MJCF_MAX_BODY_DEPTH
                 for step in steps:
-                    if step in ("export-mjcf", "export-usd") and too_deep:
+                    if step in ("export-mjcf", "export-usd", "converter") and too_deep:
                         cells.append(f"{'(too deep)':>12}")
                         continue
                     if step == "mujoco":
@@ -195,6 +214,12 @@ def main() -> None:
                             continue
                         spent = statistics.median(runs)  # type: ignore[type-var]
                         cells.append(_record(growth, (shape, step), n, spent))
+                        continue
+                    if step == "converter":
+                        runs = [
+                            _converter_alone(hrdf, folder / "alone") for _ in range(args.repeat)
+                        ]
+                        cells.append(_record(growth, (shape, step), n, statistics.median(runs)))
                         continue
                     if step == "convert":
                         cmd = ["convert", str(source), "-o", str(hrdf), "--overwrite"]
