@@ -356,6 +356,16 @@ def _chain(n: int) -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_string(tree_urdf(n, branching=1))
 
 
+class _Report:
+    """What simulation_row reads of a round trip's report: the source's model (MuJoCo's
+    import) and ours."""
+
+    reference = "mujoco"
+
+    def __init__(self, source: mujoco.MjModel, ours: mujoco.MjModel) -> None:
+        self.simulated_reference, self.simulated_model = source, ours
+
+
 def test_a_long_chain_is_stepped_fewer_times_within_the_budget() -> None:
     """A step costs as the mass matrix's entries, a chain's growing as its length
     squared: a robot's 200 steps, a 300-link chain's as many as the budget buys, and a
@@ -384,16 +394,20 @@ def test_a_long_chain_is_stepped_fewer_times_within_the_budget() -> None:
 def test_a_long_chain_changed_is_found_in_its_fewer_steps() -> None:
     """The 300-link chain, damped (undamped, it falls chaotically: a start 1e-12 away
     ends 0.1 rad away), with one link's centre of mass moved 2 cm: the shorter
-    rollouts still find it, naming their steps; unchanged, the chain moves the same."""
+    rollouts still find it, naming their steps; unchanged, the chain moves the same,
+    and roundtrip's row says over how many steps."""
     from robotwright.proof.rollout import rollout_steps
+    from robotwright.proof.roundtrip.run import simulation_row
 
     source, result = _chain(300), _chain(300)
     for model in (source, result):
         model.dof_damping[:] = 1.0  # N m s / rad
-    assert _rollouts(source, result) == []
+    steps = rollout_steps(source)
+    row = simulation_row(_Report(source, result))  # type: ignore[arg-type]
+    assert row.ok and row.compared == 1
+    assert row.value == f"the same motion over {steps} steps, fewer for a long chain (within 1e-6)"
     result.body_ipos[150, 0] += 0.02
     found = _rollouts(source, result)
-    steps = rollout_steps(source)
     assert found and found[0].field == f"simulation, zero control, {steps} steps", found
 
 
@@ -414,11 +428,7 @@ def test_a_chain_too_long_to_step_is_a_note_and_a_row(tmp_path, capsys) -> None:
     err = capsys.readouterr().err
     assert "proof: simulation not compared: its mass matrix has 114,960 entries" in err, err
 
-    class Report:  # what simulation_row reads of a round trip's report
-        reference = "mujoco"
-        simulated_reference = simulated_model = _chain(480)
-
-    row = simulation_row(Report())  # type: ignore[arg-type]
+    row = simulation_row(_Report(_chain(480), _chain(480)))  # type: ignore[arg-type]
     assert row.check == SIMULATION_CHECK and row.compared == 0 and row.ok
     assert row.value.startswith("not simulated: its mass matrix has 114,960 entries")
 

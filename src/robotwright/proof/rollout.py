@@ -39,7 +39,6 @@ stops the result alone, that is a difference.
 from __future__ import annotations
 
 import copy
-import math
 
 import mujoco
 import numpy as np
@@ -278,8 +277,8 @@ def rollout_steps(source: mujoco.MjModel) -> int:
     steps = min(ROLLOUT_STEPS, ROLLOUT_WORK // max(source.nM, 1))
     if steps < MIN_ROLLOUT_STEPS:
         raise RolloutNotMade(
-            f"its mass matrix has {source.nM:,} entries (a chain of joints about "
-            f"{math.isqrt(2 * source.nM):,} deep; more than "
+            f"its mass matrix has {source.nM:,} entries (each degree of freedom with those "
+            f"it hangs from: long chains of joints; more than "
             f"{ROLLOUT_WORK // MIN_ROLLOUT_STEPS:,}): each step costs too much to simulate"
         )
     return steps

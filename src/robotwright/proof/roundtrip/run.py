@@ -127,7 +127,7 @@ def simulation_row(report: RoundTripReport) -> Row:
         return Row(SIMULATION_CHECK, "not comparable one to one", True, compared=0)
     if not found:
         steps = rollout_steps(source)
-        over = "" if steps == ROLLOUT_STEPS else f" over {steps} steps (a long chain)"
+        over = "" if steps == ROLLOUT_STEPS else f" over {steps} steps, fewer for a long chain"
         return Row(SIMULATION_CHECK, f"the same motion{over} (within 1e-6)", True, compared=1)
     return Row(SIMULATION_CHECK, "; ".join(d.result for d in found), False, compared=1)
 
