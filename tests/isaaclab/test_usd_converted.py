@@ -153,3 +153,42 @@ def test_the_spec_given_is_what_the_converter_reads(tmp_path) -> None:
         read.GetRootLayer(), tmp_path / "read"
     )
     assert mujoco.MjSpec.__dict__["from_file"] is raw
+
+
+def test_the_usd_export_parses_the_robot_once(tmp_path, monkeypatch, capsys) -> None:
+    """`robotwright export --format usd`: the compile check, the converter and the proof
+    read one MuJoCo parse of the robot's MJCF (it costs as the bodies squared; three
+    before), and the file is the same."""
+    from collections import OrderedDict
+
+    import mujoco
+
+    import robotwright._mjspec_cache
+    from robotwright.cli import main
+
+    monkeypatch.setattr(robotwright._mjspec_cache, "_parsed", OrderedDict())  # none kept
+    hrdf = robot_named("arm6")
+    hrdf.save(tmp_path / "arm6")
+    marker = hrdf.bodies[-1].name  # in the robot's MJCF, not in MuJoCo's own probes
+    parses: list[str] = []
+    real_string, real_file = mujoco.MjSpec.from_string, mujoco.MjSpec.from_file
+
+    def from_string(xml, *args, **kwargs):
+        if f'"{marker}"' in xml:
+            parses.append("text")
+        return real_string(xml, *args, **kwargs)
+
+    def from_file(path, *args, **kwargs):
+        parses.append(str(path))
+        return real_file(path, *args, **kwargs)
+
+    monkeypatch.setattr(mujoco.MjSpec, "from_string", staticmethod(from_string))
+    monkeypatch.setattr(mujoco.MjSpec, "from_file", staticmethod(from_file))
+    out = tmp_path / "arm6.usda"
+    assert main(["export", str(tmp_path / "arm6"), "--format", "usd", "-o", str(out)]) == 0
+    assert "0 difference(s)" in capsys.readouterr().out
+    assert parses == ["text"]
+    monkeypatch.undo()
+    again = tmp_path / "again.usda"
+    assert main(["export", str(tmp_path / "arm6"), "--format", "usd", "-o", str(again)]) == 0
+    assert out.read_bytes() == again.read_bytes()

@@ -144,13 +144,7 @@ def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple
 
     model = converter_model_name(hrdf.name)
     path = folder / "mjcf" / f"{model}.xml"
-    robot = dataclasses.replace(hrdf, name=model)
-    if root_at_origin and hrdf.floating_base and any(hrdf.root_body.pos):
-        bodies = [
-            dataclasses.replace(b, pos=(0.0, 0.0, 0.0)) if b is hrdf.root_body else b
-            for b in hrdf.bodies
-        ]
-        robot = dataclasses.replace(robot, bodies=bodies)
+    robot = dataclasses.replace(_usd_robot(hrdf, root_at_origin), name=model)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         # Read at once, while the robot (and a parser's staging folder) is held: the
@@ -162,6 +156,34 @@ def _robot_mjcf(hrdf: HRDF, folder: Path, root_at_origin: bool = False) -> tuple
         items = [ln.strip()[2:] for ln in lines[1:] if ln.strip().startswith("- ")] or lines
         lost += [ln for ln in items if "'peak_velocity'" not in ln]
     return path, lost
+
+
+def _usd_robot(hrdf: HRDF, root_at_origin: bool) -> HRDF:
+    """The robot as the USD holds it: ``root_at_origin`` puts a free base's body at the
+    model's origin (see :func:`to_usd`)."""
+    import dataclasses
+
+    if not (root_at_origin and hrdf.floating_base and any(hrdf.root_body.pos)):
+        return hrdf
+    bodies = [
+        dataclasses.replace(b, pos=(0.0, 0.0, 0.0)) if b is hrdf.root_body else b
+        for b in hrdf.bodies
+    ]
+    return dataclasses.replace(hrdf, bodies=bodies)
+
+
+def _parsed_robot(hrdf: HRDF, root_at_origin: bool) -> mujoco.MjSpec:
+    """MuJoCo's parse of our MJCF of the robot as the USD holds it, named for the
+    converter (:func:`converter_model_name`): the file :func:`_robot_mjcf` writes, its
+    mesh folder given absolute. Parsed from the text the export's compile check parses
+    (:func:`~robotwright.generators.compiles.require_compiles` of the robot alone), so
+    MuJoCo parses it once (:mod:`robotwright._mjspec_cache`)."""
+    from robotwright._mjspec_cache import parsed_spec
+    from robotwright.generators.compiles import robot_xml
+
+    spec = parsed_spec(robot_xml(_usd_robot(hrdf, root_at_origin)))
+    spec.modelname = converter_model_name(hrdf.name)
+    return spec
 
 
 def _kinematic_model(parsed: mujoco.MjSpec) -> mujoco.MjModel:
@@ -455,8 +477,8 @@ def to_usd(
         # edit of the layered asset would recompose its payload; the converter's own
         # one-file output writes, reopens and saves that layer, in the system's
         # temporary folder, before we could open it).
-        # MuJoCo's parse of our MJCF, made once: the converter's and the proof's
-        parsed = mujoco.MjSpec.from_file(str(mjcf))
+        # MuJoCo's parse of our MJCF, made once: the check's, the converter's, the proof's
+        parsed = _parsed_robot(hrdf, root_at_origin)
         with captured_library_output() as printed:
             stage = converted_stage(converter, mjcf, Path(tmp) / "usd", parsed)
         # What the libraries said is passed on as notes, never as a difference: --strict
