@@ -56,6 +56,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "parsers"
 from test_roundtrip_scale import tree_urdf  # noqa: E402
 
 from robotwright._inputs import MJCF_MAX_BODY_DEPTH  # noqa: E402
+from robotwright._mjspec_cache import forget  # noqa: E402
 from robotwright.cli import main as cli  # noqa: E402
 
 SHAPES = {"chain": 1, "tree": 4}
@@ -78,8 +79,10 @@ def _cpu() -> float:
 
 
 def _run(args: list[str]) -> float:
-    """CPU seconds of one command (its output swallowed); exit code 0 required."""
+    """CPU seconds of one command (its output swallowed), as its own process would spend
+    them (no MuJoCo parse kept from the command before); exit code 0 required."""
     out, err = io.StringIO(), io.StringIO()
+    forget()
     c0 = _cpu()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = cli(args)

@@ -43,3 +43,10 @@ def parsed_spec(xml: str) -> mujoco.MjSpec:
         while len(_parsed) > _KEPT:
             _parsed.popitem(last=False)
         return spec.copy()
+
+
+def forget() -> None:
+    """Drop every parse kept (a benchmark timing each command as its own process
+    would)."""
+    with _lock:
+        _parsed.clear()
