@@ -3,15 +3,19 @@ its proof read the same generated MJCF, and MuJoCo's parse costs as the bodies s
 (each body added rebuilds its lists of the whole tree: MuJoCo 3.12 takes 7-10 s for a
 3,000-link tree, 4.0 about 1 s), where a copy of the parsed spec costs 0.02 s.
 
-Only a text read without files (:meth:`mujoco.MjSpec.from_string` without assets: our
-generated MJCF names every mesh by its absolute path, read at compile) is kept; the
-spec handed out is always a copy, which the caller may change and compile.
+A parse is kept only once it has compiled: ``MjSpec.copy`` drops what refers to
+something the model does not have (a sensor of a missing joint compiles in a copy, and
+not in the parse), so a copy stands for a new parse only of a model MuJoCo accepts.
+Only texts read without files are kept (:meth:`mujoco.MjSpec.from_string` without
+assets: our generated MJCF names every mesh by its path, which MuJoCo reads when it
+compiles, not when it parses). What a caller gets is always its own spec.
 """
 
 from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -23,26 +27,55 @@ _parsed: OrderedDict[str, mujoco.MjSpec] = OrderedDict()
 _lock = threading.Lock()
 
 
+def _kept_copy(xml: str) -> mujoco.MjSpec | None:
+    """A copy of the kept parse of ``xml``, or None."""
+    with _lock:  # copies are made under it: no thread copies a spec being dropped
+        spec = _parsed.get(xml)
+        if spec is None:
+            return None
+        _parsed.move_to_end(xml)
+        return spec.copy()
+
+
 def parsed_spec(xml: str) -> mujoco.MjSpec:
-    """A copy of MuJoCo's parse of ``xml`` (parsed on its first call; the last
-    :data:`_KEPT` texts kept).
+    """MuJoCo's parse of ``xml``, the caller's own: a copy of the parse kept (one that
+    compiled), else a new parse (kept once :func:`compiled` compiles it).
 
     Raises:
-        ValueError: MuJoCo refuses the text (nothing is kept).
+        ValueError: MuJoCo refuses the text.
     """
     import mujoco
 
-    with _lock:  # copies are made under it: no thread copies a spec being dropped
-        spec = _parsed.get(xml)
-        if spec is not None:
-            _parsed.move_to_end(xml)
-            return spec.copy()
-    spec = mujoco.MjSpec.from_string(xml)  # outside the lock: other threads parse on
-    with _lock:
-        _parsed[xml] = spec
-        while len(_parsed) > _KEPT:
-            _parsed.popitem(last=False)
-        return spec.copy()
+    kept = _kept_copy(xml)
+    return kept if kept is not None else mujoco.MjSpec.from_string(xml)
+
+
+def compiled(xml: str, prepare: Callable[[mujoco.MjSpec], None] | None = None) -> mujoco.MjModel:
+    """MuJoCo's compile of ``xml``, from the parse kept or a new one (``prepare``, given
+    the caller's spec, changes it first: where meshes are read, visuals dropped); a new
+    parse compiled as it is (no ``prepare``: what it holds is then known to resolve) is
+    kept when it compiles.
+
+    Raises:
+        ValueError: MuJoCo refuses the text or the model (nothing is kept).
+    """
+    import mujoco
+
+    spec = _kept_copy(xml)
+    pristine = None
+    if spec is None:
+        spec = mujoco.MjSpec.from_string(xml)
+        if prepare is None:  # copied before compile changes the spec; kept if it compiles
+            pristine = spec.copy()
+    if prepare is not None:
+        prepare(spec)
+    model = spec.compile()
+    if pristine is not None:
+        with _lock:
+            _parsed[xml] = pristine
+            while len(_parsed) > _KEPT:
+                _parsed.popitem(last=False)
+    return model
 
 
 def forget() -> None:

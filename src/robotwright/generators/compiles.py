@@ -43,10 +43,10 @@ def _mujoco_message(exc: Exception) -> str:
 
 def _compile_xml(xml: str) -> str | None:
     """MuJoCo's message when ``xml`` does not compile, else ``None``."""
-    from robotwright._mjspec_cache import parsed_spec
+    from robotwright._mjspec_cache import compiled
 
     try:
-        parsed_spec(xml).compile()
+        compiled(xml)
     except Exception as exc:  # noqa: BLE001 - MuJoCo raises ValueError or its own types
         return _mujoco_message(exc)
     return None

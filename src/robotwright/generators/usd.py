@@ -172,36 +172,36 @@ def _usd_robot(hrdf: HRDF, root_at_origin: bool) -> HRDF:
     return dataclasses.replace(hrdf, bodies=bodies)
 
 
-def _parsed_robot(hrdf: HRDF, root_at_origin: bool) -> mujoco.MjSpec:
-    """MuJoCo's parse of our MJCF of the robot as the USD holds it, named for the
-    converter (:func:`converter_model_name`): the file :func:`_robot_mjcf` writes, its
-    mesh folder given absolute. Parsed from the text the export's compile check parses
+def _robot_text(hrdf: HRDF, root_at_origin: bool) -> str:
+    """Our MJCF of the robot as the USD holds it, as text: the file :func:`_robot_mjcf`
+    writes, under the robot's own name and with its mesh folder given absolute. The text
+    the export's compile check parses
     (:func:`~robotwright.generators.compiles.require_compiles` of the robot alone), so
     MuJoCo parses it once (:mod:`robotwright._mjspec_cache`)."""
-    from robotwright._mjspec_cache import parsed_spec
     from robotwright.generators.compiles import robot_xml
 
-    spec = parsed_spec(robot_xml(_usd_robot(hrdf, root_at_origin)))
-    spec.modelname = converter_model_name(hrdf.name)
-    return spec
+    return robot_xml(_usd_robot(hrdf, root_at_origin))
 
 
-def _kinematic_model(parsed: mujoco.MjSpec) -> mujoco.MjModel:
-    """MuJoCo's compile of our MJCF (``parsed``: its spec, left as it is) without its
-    mesh geoms: the same bodies, masses, inertias (each body's is explicit in our MJCF,
-    so no geom contributes), joints, actuators and keyframes, without reading or hulling
-    a mesh (the G1's 35 meshes took 0.3-1.1 s of a 2 s export). Nothing the export or its
-    proof reads is in a mesh. A model in which something refers to a mesh geom (a
-    contact pair, a sensor) is compiled whole."""
-    spec = parsed.copy()
-    for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
-        spec.delete(geom)
-    for mesh in list(spec.meshes):
-        spec.delete(mesh)
+def _kinematic_model(text: str) -> mujoco.MjModel:
+    """MuJoCo's compile of our MJCF (``text``) without its mesh geoms: the same bodies,
+    masses, inertias (each body's is explicit in our MJCF, so no geom contributes),
+    joints, actuators and keyframes, without reading or hulling a mesh (the G1's 35
+    meshes took 0.3-1.1 s of a 2 s export). Nothing the export or its proof reads is in
+    a mesh. A model in which something refers to a mesh geom (a contact pair, a sensor)
+    is compiled whole."""
+    from robotwright._mjspec_cache import compiled
+
+    def without_meshes(spec: mujoco.MjSpec) -> None:
+        for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
+            spec.delete(geom)
+        for mesh in list(spec.meshes):
+            spec.delete(mesh)
+
     try:
-        return spec.compile()
+        return compiled(text, without_meshes)
     except ValueError:
-        return parsed.copy().compile()
+        return compiled(text)
 
 
 def _zero_inertia_bodies(model: mujoco.MjModel) -> list[str]:
@@ -468,6 +468,7 @@ def to_usd(
         raise GeneratorError(f"layout={layout!r}: expected one of {', '.join(USD_LAYOUTS)}")
     converter = _converter(prove)
     from robotwright._library_output import captured_library_output
+    from robotwright._mjspec_cache import compiled, parsed_spec
     from robotwright.generators.usd_converted import converted_stage
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
@@ -477,10 +478,14 @@ def to_usd(
         # edit of the layered asset would recompose its payload; the converter's own
         # one-file output writes, reopens and saves that layer, in the system's
         # temporary folder, before we could open it).
-        # MuJoCo's parse of our MJCF, made once: the check's, the converter's, the proof's
-        parsed = _parsed_robot(hrdf, root_at_origin)
+        # MuJoCo parses our MJCF once: the export's check, the proof's model, the
+        # converter's spec (named for it) are that parse compiled or copied
+        text = _robot_text(hrdf, root_at_origin)
+        model = compiled(text) if geometry else _kinematic_model(text)
+        given = parsed_spec(text)
+        given.modelname = converter_model_name(hrdf.name)
         with captured_library_output() as printed:
-            stage = converted_stage(converter, mjcf, Path(tmp) / "usd", parsed)
+            stage = converted_stage(converter, mjcf, Path(tmp) / "usd", given)
         # What the libraries said is passed on as notes, never as a difference: --strict
         # refuses what the proof finds, not another library's remarks.
         said = _library_notes(printed, "mujoco-usd-converter")
@@ -491,7 +496,6 @@ def to_usd(
         root = stage.GetDefaultPrim()
         if root.GetName() != hrdf.name:  # the robot's own name, as data, for the user
             root.SetDisplayName(hrdf.name)
-        model = parsed.copy().compile() if geometry else _kinematic_model(parsed)
         result = UsdExport(path=out_path, root=str(root.GetPath()), notes=lost, mjcf_model=model)
         for body in _zero_inertia_bodies(model):
             result.notes.append(

@@ -173,37 +173,40 @@ def _compile_with_same_files(
         key = _file_key(p)
         if key is not None:
             by_key.setdefault(key, str(p))
-    from robotwright._mjspec_cache import parsed_spec
+    from robotwright._mjspec_cache import compiled
 
-    spec = parsed_spec(xml)
-    if discard_visual:
-        spec.compiler.discardvisual = True
     folder, meshdir, names = source or ("", "", {})
-    # Where MuJoCo reads each file (the writer may give a mesh folder); every file is
-    # then given as an absolute path or, read as the source read it, by the source's name.
-    own = Path(spec.modelfiledir or ".") / (spec.compiler.meshdir or "")
-    relative = False
-    for mesh in spec.meshes:
-        if mesh.file:
-            path = own / mesh.file
-            key = _file_key(path)
-            if key is not None and key in names:
-                mesh.file = names[key]
-                relative = True
-            else:
-                mesh.file = by_key.get(key, str(path.absolute())) if key else str(path.absolute())
-    if relative:
-        # Other files, read from the writer's folders, by absolute paths.
-        home = Path(spec.modelfiledir or ".")
-        for tex in spec.textures:
-            if tex.file:
-                tex.file = str((home / (spec.compiler.texturedir or "") / tex.file).absolute())
-        for other in (*spec.hfields, *spec.skins):
-            if other.file:
-                other.file = str((home / other.file).absolute())
-        spec.compiler.texturedir = ""
-    spec.modelfiledir, spec.compiler.meshdir = (folder, meshdir) if relative else ("", "")
-    return spec.compile()
+
+    def read_as_the_source(spec: mujoco.MjSpec) -> None:
+        if discard_visual:
+            spec.compiler.discardvisual = True
+        # Where MuJoCo reads each file (the writer may give a mesh folder); every file is
+        # then given as an absolute path or, read as the source read it, by its name.
+        own = Path(spec.modelfiledir or ".") / (spec.compiler.meshdir or "")
+        relative = False
+        for mesh in spec.meshes:
+            if mesh.file:
+                path = own / mesh.file
+                key = _file_key(path)
+                if key is not None and key in names:
+                    mesh.file = names[key]
+                    relative = True
+                else:
+                    absolute = str(path.absolute())
+                    mesh.file = by_key.get(key, absolute) if key else absolute
+        if relative:
+            # Other files, read from the writer's folders, by absolute paths.
+            home = Path(spec.modelfiledir or ".")
+            for tex in spec.textures:
+                if tex.file:
+                    tex.file = str((home / (spec.compiler.texturedir or "") / tex.file).absolute())
+            for other in (*spec.hfields, *spec.skins):
+                if other.file:
+                    other.file = str((home / other.file).absolute())
+            spec.compiler.texturedir = ""
+        spec.modelfiledir, spec.compiler.meshdir = (folder, meshdir) if relative else ("", "")
+
+    return compiled(xml, read_as_the_source)
 
 
 def result_model(

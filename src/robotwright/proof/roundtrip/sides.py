@@ -53,9 +53,9 @@ def our_mjcf_text(hrdf: HRDF) -> str:
 
 def our_mjcf_model(hrdf: HRDF) -> mujoco.MjModel:
     """Our MJCF of ``hrdf`` compiled by MuJoCo (no scene)."""
-    from robotwright._mjspec_cache import parsed_spec
+    from robotwright._mjspec_cache import compiled
 
-    return parsed_spec(our_mjcf_text(hrdf)).compile()
+    return compiled(our_mjcf_text(hrdf))
 
 
 @dataclass
