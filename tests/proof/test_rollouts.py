@@ -36,6 +36,16 @@ _ARM = """<mujoco model="arm">
 </mujoco>"""
 
 
+def _tree_urdf(n: int, branching: int) -> str:
+    """tests/parsers' URDF of ``n`` box links (link i on link (i-1)//branching)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
+    from test_roundtrip_scale import tree_urdf
+
+    return tree_urdf(n, branching=branching)
+
+
 def _model(folder: Path, hull: str = "") -> mujoco.MjModel:
     if not (folder / "part.stl").exists():
         m = trimesh.creation.icosphere(subdivisions=3, radius=0.1)
@@ -278,13 +288,8 @@ def test_a_free_base_asked_for_is_in_the_roundtrip_reference_too() -> None:
 def _overlapping_tree(folder: Path) -> Path:
     """A 100-link tree (branching 4) whose box links overlap at rest: thousands of
     contacts, more than MuJoCo's arena holds (MuJoCo 4 stops stepping it)."""
-    import sys
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
-    from test_roundtrip_scale import tree_urdf
-
     path = folder / "tree.urdf"
-    path.write_text(tree_urdf(100, branching=4), encoding="utf-8")
+    path.write_text(_tree_urdf(100, branching=4), encoding="utf-8")
     return path
 
 
@@ -348,12 +353,8 @@ def test_mujoco_stopping_the_source_or_the_output_is_told_apart(tmp_path) -> Non
 def _chain(n: int) -> mujoco.MjModel:
     """MuJoCo's import of a chain of ``n`` box links on hinges (a mass matrix of
     n(n-1)/2 entries)."""
-    import sys
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
-    from test_roundtrip_scale import tree_urdf
-
-    return mujoco.MjModel.from_xml_string(tree_urdf(n, branching=1))
+    return mujoco.MjModel.from_xml_string(_tree_urdf(n, branching=1))
 
 
 class _Report:
@@ -414,16 +415,11 @@ def test_a_long_chain_changed_is_found_in_its_fewer_steps() -> None:
 def test_a_chain_too_long_to_step_is_a_note_and_a_row(tmp_path, capsys) -> None:
     """convert of a 480-link chain (within MJCF's depth): the proof compares it without
     the simulation and says so (exit 0); roundtrip's row says why, not 'not comparable'."""
-    import sys
-
     from robotwright.cli import main
     from robotwright.proof.roundtrip.run import SIMULATION_CHECK, simulation_row
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
-    from test_roundtrip_scale import tree_urdf
-
     source = tmp_path / "chain.urdf"
-    source.write_text(tree_urdf(480, branching=1), encoding="utf-8")
+    source.write_text(_tree_urdf(480, branching=1), encoding="utf-8")
     assert main(["convert", str(source), "-o", str(tmp_path / "hrdf"), "-v"]) == 0
     err = capsys.readouterr().err
     assert "proof: simulation not compared: its mass matrix has 114,960 entries" in err, err
@@ -437,17 +433,12 @@ def test_contacts_past_mujocos_arena_are_a_reason_not_a_crash_or_minutes() -> No
     """Trees of overlapping boxes: 300 links fill MuJoCo's arena at rest (MuJoCo 3.x then
     keeps no contact at all, and stepping it took 23 s), 1,000 links stop its collision
     with a FatalError. Both are a reason not to simulate, found before any step."""
-    import sys
-
     import pytest
 
     from robotwright.proof.rollout import RolloutNotMade
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parsers"))
-    from test_roundtrip_scale import tree_urdf
-
     for links, reason in ((300, "than MuJoCo's arena holds"), (1000, "MuJoCo cannot hold")):
-        model = mujoco.MjModel.from_xml_string(tree_urdf(links, branching=4))
+        model = mujoco.MjModel.from_xml_string(_tree_urdf(links, branching=4))
         qpos = {i: i for i in range(model.nq)}
         with pytest.raises(RolloutNotMade, match=reason):
             rollout_differences(model, model, qpos, {})
