@@ -473,17 +473,17 @@ def to_usd(
 
     with tempfile.TemporaryDirectory(prefix=prefix("usd")) as tmp:
         mjcf, lost = _robot_mjcf(hrdf, Path(tmp), root_at_origin)
-        # The converter's own layered asset, in our private folder, flattened once in
-        # memory: what is authored next goes straight into the one layer written (an
-        # edit of the layered asset would recompose its payload; the converter's own
-        # one-file output writes, reopens and saves that layer, in the system's
-        # temporary folder, before we could open it).
         # MuJoCo parses our MJCF once: the export's check, the proof's model, the
         # converter's spec (named for it) are that parse compiled or copied
         text = _robot_text(hrdf, root_at_origin)
         model = compiled(text) if geometry else _kinematic_model(text)
         given = parsed_spec(text)
         given.modelname = converter_model_name(hrdf.name)
+        # The converter's own layered asset, in our private folder, flattened once in
+        # memory: what is authored next goes straight into the one layer written (an
+        # edit of the layered asset would recompose its payload; the converter's own
+        # one-file output writes, reopens and saves that layer, in the system's
+        # temporary folder, before we could open it).
         with captured_library_output() as printed:
             stage = converted_stage(converter, mjcf, Path(tmp) / "usd", given)
         # What the libraries said is passed on as notes, never as a difference: --strict
